@@ -1,0 +1,37 @@
+"""The models: rule sets that move objects and resolve collisions (SPEC section 3).
+
+Every model is a class built as `Model(world, bodies, **options)` with the same surface:
+
+    tick                  ticks run so far
+    advance(ticks, log)   run that many ticks; returns the events (EVENT_DTYPE array, in order;
+                          empty when `log` is False)
+    positions()           (n, 2) float64 current top-left corners
+    velocities()          (n, 2) float64 current velocities, px/s
+
+`make` picks one by name. Each model's tick runs move -> walls -> pairs -> record.
+"""
+
+from __future__ import annotations
+
+import importlib
+
+from engine.world import Bodies, WorldSpec
+
+MODEL_NAMES = ("paper", "stepped", "exact")
+
+
+class ModelUnavailable(Exception):
+    """The named model is not built into this version."""
+
+
+def make(name: str, world: WorldSpec, bodies: Bodies, **options):
+    """Build the model `name` over `world` and `bodies`; options go to its constructor."""
+    if name not in MODEL_NAMES:
+        raise ValueError(f"unknown model {name!r}; expected one of {', '.join(MODEL_NAMES)}")
+    try:
+        module = importlib.import_module(f"engine.models.{name}")
+    except ModuleNotFoundError as exc:
+        if exc.name == f"engine.models.{name}":
+            raise ModelUnavailable(f"model {name!r} is not available yet") from exc
+        raise
+    return module.Model(world, bodies, **options)

@@ -1,0 +1,105 @@
+"""The world's state as parallel arrays: what every model, the rasteriser and the writers share.
+
+`WorldSpec` is the fixed frame (size in pixels, ticks per second). `Bodies` is the per-object table
+in id order: hot arrays (`pos`, `vel`, `size`, `inv_mass`, `kind`) that the kernels read, and the
+drawing data (`color`, `fill`, polygon vertices) that only the rasteriser reads. Names and YAML
+lines are cold data and live with the scenario, not here. A box's position is its top-left corner;
+its box covers `[x, x+w) x [y, y+h)`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+KIND_BOX = 0
+KIND_CIRCLE = 1
+KIND_POLYGON = 2
+KIND_NAMES = ("box", "circle", "polygon")
+
+
+@dataclass(frozen=True)
+class WorldSpec:
+    """The world rectangle in pixels (x right, y down) and the ticks per simulated second."""
+
+    width: int
+    height: int
+    fps: int
+
+
+@dataclass(frozen=True)
+class Bodies:
+    """Per-object arrays in id order; n objects, m polygon vertices in all.
+
+    kind       (n,)   int8     KIND_BOX / KIND_CIRCLE / KIND_POLYGON
+    pos        (n, 2) float64  top-left corner of the box, px
+    size       (n, 2) float64  box width and height, px
+    vel        (n, 2) float64  px per second
+    mass       (n,)   float64  inf for static objects
+    static     (n,)   bool     static objects never move
+    color      (n,)   uint8    index into the scenario's palette (0 is the background)
+    fill       (n,)   bool     paint the inside as well as the outline
+    vert_start (n+1,) int64    polygon i's vertices are verts[vert_start[i]:vert_start[i+1]]
+    verts      (m, 2) int64    polygon vertices relative to the box's top-left corner
+    """
+
+    kind: np.ndarray
+    pos: np.ndarray
+    size: np.ndarray
+    vel: np.ndarray
+    mass: np.ndarray
+    static: np.ndarray
+    color: np.ndarray
+    fill: np.ndarray
+    vert_start: np.ndarray
+    verts: np.ndarray
+
+    @property
+    def n(self) -> int:
+        return int(self.kind.shape[0])
+
+    @property
+    def inv_mass(self) -> np.ndarray:
+        """(n,) float64: 1/mass, 0 for static objects."""
+        inv = np.zeros(self.n)
+        movable = ~self.static
+        inv[movable] = 1.0 / self.mass[movable]
+        return inv
+
+    @staticmethod
+    def boxes(pos, size, vel, *, mass=None, static=None, color=None, fill=None) -> Bodies:
+        """Bodies made only of boxes, for tests and generated scenes."""
+        pos = np.asarray(pos, dtype=np.float64).reshape(-1, 2)
+        n = pos.shape[0]
+        size = np.broadcast_to(np.asarray(size, dtype=np.float64), (n, 2)).copy()
+        vel = np.broadcast_to(np.asarray(vel, dtype=np.float64), (n, 2)).copy()
+        static = np.zeros(n, bool) if static is None else np.asarray(static, bool).copy()
+        mass = np.ones(n) if mass is None else np.asarray(mass, np.float64).copy()
+        mass = np.where(static, np.inf, mass)
+        vel[static] = 0.0
+        return Bodies(
+            kind=np.full(n, KIND_BOX, np.int8),
+            pos=pos.copy(),
+            size=size,
+            vel=vel,
+            mass=mass,
+            static=static,
+            color=np.ones(n, np.uint8) if color is None else np.asarray(color, np.uint8),
+            fill=np.zeros(n, bool) if fill is None else np.asarray(fill, bool),
+            vert_start=np.zeros(n + 1, np.int64),
+            verts=np.zeros((0, 2), np.int64),
+        )
+
+
+def kinetic_energy(mass: np.ndarray, static: np.ndarray, vel: np.ndarray) -> float:
+    """Total kinetic energy, sum of m|v|^2/2 over movable objects (px^2/s^2 per unit mass)."""
+    m = np.where(static, 0.0, mass)
+    return float(0.5 * np.sum(m * np.einsum("ij,ij->i", vel, vel)))
+
+
+def momentum(mass: np.ndarray, static: np.ndarray, vel: np.ndarray) -> tuple[float, float]:
+    """Total momentum (px/s per unit mass) over movable objects."""
+    m = np.where(static, 0.0, mass)
+    p = (m[:, None] * vel).sum(axis=0)
+    return float(p[0]), float(p[1])
