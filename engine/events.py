@@ -20,7 +20,8 @@ TYPE_NAMES = ("wall", "pair")
 AXIS_X = 0
 AXIS_Y = 1
 AXIS_XY = 2
-AXIS_NAMES = ("x", "y", "xy")
+AXIS_NORMAL = 3  # a contact normal that is not axis-aligned (exact shapes)
+AXIS_NAMES = ("x", "y", "xy", "n")
 
 SIDE_LEFT = 0
 SIDE_RIGHT = 1

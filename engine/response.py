@@ -1,0 +1,133 @@
+"""Collision response: the elastic exchange, pushing a pair apart, and reflection at the walls.
+
+Input: velocities (n, 2) px/s, positions (n, 2) px (top-left corners), box sizes, inverse masses
+(1/mass, 0 for static objects), and a contact from contact.py (code, nx, ny). Output: the arrays
+changed in place. These are the only places where the accurate models change a velocity.
+
+The elastic exchange, derived once. Two bodies with inverse masses w1, w2 (one may be 0) meet with
+unit normal n from 1 to 2; let u = (v2 - v1)·n, negative when they approach. An impulse J along n
+gives v1' = v1 - J w1 n and v2' = v2 + J w2 n, so u' = u + J (w1 + w2). Momentum is kept for any J
+(m1 J w1 = m2 J w2 = J). Kinetic energy is kept when u' = -u, which gives
+
+    J = -2 u / (w1 + w2),   v1' = v1 + 2 u r1 n,   v2' = v2 - 2 u r2 n,   r_i = w_i / (w1 + w2).
+
+Written with the ratios r1 + r2 = 1 it stays finite and exact in the limits: a static partner
+(w2 = 0) gives r1 = 1, a mirror reflection; masses 1 : 10^10 give r = 1 - 1e-10 and 1e-10 and no
+cancellation. With AXIS_XY (corner to corner) the exchange acts on x and on y apart, each with its
+own sign, and only on an axis along which the pair approaches.
+"""
+
+from __future__ import annotations
+
+from numba import njit
+
+from engine.events import AXIS_XY
+
+# More folds than this at one wall axis in one step is refused (a runaway, not a bounce).
+MAX_FOLDS_PER_STEP = 1000
+
+
+@njit(cache=True)
+def exchange_along(vel, a, b, wa, wb, nx, ny):
+    """Elastic exchange of a and b along the unit normal n (from a to b), in place.
+
+    vel (n, 2) px/s; wa, wb inverse masses (not both 0). Returns True when they were approaching
+    along n and the exchange was made, False (and no change) otherwise.
+    """
+    u = (vel[b, 0] - vel[a, 0]) * nx + (vel[b, 1] - vel[a, 1]) * ny
+    if not u < 0.0:
+        return False
+    ra = wa / (wa + wb)
+    rb = wb / (wa + wb)
+    ja = 2.0 * u * ra
+    jb = 2.0 * u * rb
+    vel[a, 0] += ja * nx
+    vel[a, 1] += ja * ny
+    vel[b, 0] -= jb * nx
+    vel[b, 1] -= jb * ny
+    return True
+
+
+@njit(cache=True)
+def exchange(vel, a, b, wa, wb, code, nx, ny):
+    """The elastic response to a contact (code, nx, ny) from contact.py, in place.
+
+    AXIS_XY: a 1-D exchange on x (sign nx) and on y (sign ny), each where approaching. Otherwise
+    one exchange along the unit normal. Returns True when any velocity changed.
+    """
+    if code == AXIS_XY:
+        done_x = exchange_along(vel, a, b, wa, wb, nx, 0.0)
+        done_y = exchange_along(vel, a, b, wa, wb, 0.0, ny)
+        return done_x or done_y
+    return exchange_along(vel, a, b, wa, wb, nx, ny)
+
+
+@njit(cache=True)
+def _shift_within(pos, i, axis, d, span):
+    """Move pos[i, axis] by d but keep it in [0, span]; returns the part of d actually made."""
+    x = pos[i, axis]
+    target = min(max(x + d, 0.0), max(span, 0.0))
+    pos[i, axis] = target
+    return target - x
+
+
+@njit(cache=True)
+def _separate_axis(pos, a, b, wa, wb, axis, push, span_a, span_b):
+    """Push b by +push·wb/(wa+wb) and a by -push·wa/(wa+wb) along one axis, in the world;
+    what one of them cannot take at a wall is handed to the other."""
+    da = -push * (wa / (wa + wb))
+    db = push * (wb / (wa + wb))
+    made_a = _shift_within(pos, a, axis, da, span_a) if wa > 0.0 else 0.0
+    made_b = _shift_within(pos, b, axis, db + (da - made_a) * -1.0, span_b) if wb > 0.0 else 0.0
+    left = push - (made_b - made_a)
+    if wa > 0.0 and left != 0.0:
+        _shift_within(pos, a, axis, -left, span_a)
+
+
+@njit(cache=True)
+def separate(pos, size, a, b, wa, wb, code, nx, ny, depth_x, depth_y, width, height):
+    """Push an overlapping pair apart along the contact normal, shared by inverse mass, in place.
+
+    pos/size (n, 2) px; the pair moves apart by depth_x along x (sign nx) and depth_y along y
+    (sign ny) for AXIS_XY, else by depth_x along the unit normal (nx, ny). No object is pushed out
+    of the world [0, width) × [0, height); when one side is blocked the other takes the rest.
+    """
+    span_ax = width - size[a, 0]
+    span_ay = height - size[a, 1]
+    span_bx = width - size[b, 0]
+    span_by = height - size[b, 1]
+    if code == AXIS_XY:
+        _separate_axis(pos, a, b, wa, wb, 0, depth_x * nx, span_ax, span_bx)
+        _separate_axis(pos, a, b, wa, wb, 1, depth_y * ny, span_ay, span_by)
+    else:
+        if nx != 0.0:
+            _separate_axis(pos, a, b, wa, wb, 0, depth_x * nx, span_ax, span_bx)
+        if ny != 0.0:
+            _separate_axis(pos, a, b, wa, wb, 1, depth_x * ny, span_ay, span_by)
+
+
+@njit(cache=True)
+def fold(x, v, span):
+    """Reflect a coordinate into [0, span] as walls would (SPEC 3.2), folding while outside.
+
+    x px (top-left corner), v px/s, span = world side - box side. Returns (x', v', folds_low,
+    folds_high, first_low): x -> -x at the low wall, x -> 2 span - x at the high wall, v reversed
+    at each fold; first_low tells which wall came first. span <= 0 pins x at 0 without a fold.
+    Raises ValueError past MAX_FOLDS_PER_STEP folds (a step far too long for the speed).
+    """
+    if span <= 0.0:
+        return 0.0, v, 0, 0, False
+    if x < -MAX_FOLDS_PER_STEP * span or x > (MAX_FOLDS_PER_STEP + 1) * span:
+        raise ValueError("an object crosses the world too many times in one step; use substeps")
+    low = 0
+    high = 0
+    first_low = x < 0.0
+    while x < 0.0 or x > span:
+        if x < 0.0:
+            x = -x
+            low += 1
+        else:
+            x = 2.0 * span - x
+            high += 1
+        v = -v
+    return x, v, low, high, first_low

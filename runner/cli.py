@@ -1,0 +1,151 @@
+"""The `collide2d` command line (also `python -m runner`): parse, dispatch, map errors to exits.
+
+Each subcommand lives with what it drives (`run` here; `validate`/`schema` in runner.validate;
+`check`/`bless` in runner.golden.cli) and registers itself on the parser. Exit status: 0 fine,
+1 a check found a difference, 2 bad input or usage. A refused scenario prints
+`FILE:LINE:COL: error: MESSAGE` on stderr and writes nothing.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from importlib import resources
+
+from engine.models import MODEL_NAMES, ModelUnavailable
+from runner import validate
+from runner.golden import cli as golden_cli
+from runner.run import RunOptions, run_to_dir
+from runner.scenario import Limits, ScenarioError, load
+
+EXIT_OK = 0
+EXIT_DIFFERENCE = 1
+EXIT_BAD_INPUT = 2
+
+
+def demo_path() -> str:
+    """The bundled scenario of the paper's section IV: 50 boxes, 10x10, 10 px/s, 10 fps."""
+    return str(resources.files("runner") / "data" / "paper_fifty_boxes.yaml")
+
+
+def add_limit_options(parser: argparse.ArgumentParser) -> None:
+    """--max-objects, --max-ticks, --max-side, --max-output-bytes (SPEC section 8)."""
+    defaults = Limits()
+    group = parser.add_argument_group("limits")
+    group.add_argument("--max-objects", type=_positive_int, default=defaults.max_objects,
+                       metavar="N", help=f"most objects allowed (default {defaults.max_objects:,})")
+    group.add_argument("--max-ticks", type=_positive_int, default=defaults.max_ticks,
+                       metavar="N", help=f"most ticks allowed (default {defaults.max_ticks:,})")
+    group.add_argument("--max-side", type=_positive_int, default=defaults.max_side, metavar="PX",
+                       help=f"largest world side in px (default {defaults.max_side:,})")
+    group.add_argument("--max-output-bytes", type=_positive_int,
+                       default=defaults.max_output_bytes, metavar="BYTES",
+                       help=f"bound on frame output (default {defaults.max_output_bytes:,})")
+
+
+def limits_from(args: argparse.Namespace) -> Limits:
+    return Limits(
+        max_objects=args.max_objects, max_ticks=args.max_ticks, max_side=args.max_side,
+        max_output_bytes=args.max_output_bytes,
+    )
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {value}")
+    return value
+
+
+def _count(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got {value}")
+    return value
+
+
+def register_run(subparsers) -> None:
+    p = subparsers.add_parser(
+        "run", help="run a scenario and write its frames, GIF and event log",
+        description="Run SCENARIO (default: the bundled 50-box demo of the paper's section IV) "
+        "and write OUT/NAME/: frames/*.png, animation.gif, events.jsonl, final.csv, summary.json. "
+        "Flags override the scenario's output and settings.",
+    )
+    p.add_argument("scenario", nargs="?", help="scenario YAML file (default: the bundled demo)")
+    p.add_argument("--out", default="out", metavar="DIR", help="output folder (default: out)")
+    p.add_argument("--gif", action=argparse.BooleanOptionalAction, default=None,
+                   help="write animation.gif (default: the scenario's output.gif)")
+    p.add_argument("--png", action=argparse.BooleanOptionalAction, default=None,
+                   help="write PNG frames: the scenario's output.frames, or all when it asks for "
+                   "none (default: only if output.frames asks for some)")
+    p.add_argument("--events", action=argparse.BooleanOptionalAction, default=None,
+                   help="write events.jsonl (default: the scenario's output.events)")
+    p.add_argument("--model", choices=MODEL_NAMES, help="run under this model instead")
+    p.add_argument("--fps", type=_positive_int, help="ticks per second instead of world.fps")
+    p.add_argument("--ticks", type=_count, help="run this many ticks instead")
+    p.add_argument("--scale", type=_positive_int, default=1, metavar="K",
+                   help="enlarge PNG and GIF frames K times, nearest neighbour (default 1)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar, no notes")
+    add_limit_options(p)
+    p.set_defaults(func=cmd_run)
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    path = args.scenario or demo_path()
+    overrides = {k: getattr(args, k) for k in ("model", "fps", "ticks") if getattr(args, k)
+                 is not None}
+    limits = limits_from(args)
+    scenario = load(path, overrides=overrides, limits=limits)
+    out = scenario.output
+    options = RunOptions(
+        png=bool(out.frames) if args.png is None else args.png,
+        gif=out.gif if args.gif is None else args.gif,
+        events=out.events if args.events is None else args.events,
+        scale=args.scale,
+        quiet=args.quiet,
+    )
+    target, summary = run_to_dir(scenario, args.out, options, limits)
+    if not args.quiet:
+        counts = summary["events"]
+        said = f", {counts['wall']} wall and {counts['pair']} pair events" if counts else ""
+        print(f"{scenario.name}: {scenario.ticks} ticks under {scenario.model}{said} "
+              f"in {summary['run_time_s']:.3f}s -> {target}")
+    return EXIT_OK
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="collide2d",
+        description="Declarative 2D collision scenarios: run them, see them, keep them honest.",
+    )
+    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    register_run(subparsers)
+    golden_cli.register(subparsers)
+    validate.register(subparsers)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return args.func(args)
+    except ScenarioError as err:
+        print(str(err), file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except ModelUnavailable as err:
+        print(f"collide2d: error: {err}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        print("collide2d: interrupted; outputs already written are whole", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

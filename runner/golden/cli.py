@@ -1,0 +1,233 @@
+"""The `check` and `bless` commands (SPEC sections 6 and 7).
+
+Inputs: command-line arguments — scenario files or names (none: every file in `scenarios/`), the
+project root (`--root`, default the nearest folder upward with `scenarios/`), `--report DIR`,
+`--prune`, `--quiet`. Outputs: console text (stdout: one block per scenario and a closing count;
+stderr: errors and, on a terminal, progress), report folders, golden folders, and the exit status:
+0 fine, 1 a check found a difference (or a golden is missing), 2 bad input or usage.
+
+`register(subparsers)` adds both commands to the `collide2d` parser; each sets `func(args) -> int`.
+The scenario loader and the simulator can be handed in (tests use synthetic ones); by default they
+are `runner.scenario.load` and `runner.run.simulate`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from functools import partial
+from pathlib import Path
+
+from runner.golden import bless_run, check_run, golden_frames, report, shown_path
+from runner.golden.store import (
+    GOLDENS_DIR,
+    SCENARIO_SUFFIXES,
+    SCENARIOS_DIR,
+    GoldenError,
+    GoldenStore,
+    ci_active,
+    find_root,
+    scenario_files,
+)
+
+EXIT_OK = 0
+EXIT_DIFFERENT = 1
+EXIT_USAGE = 2
+
+
+class _Usage(Exception):
+    """Bad input: the message goes to stderr and the command exits with EXIT_USAGE."""
+
+
+def default_load(path):
+    """runner.scenario.load (imported when first needed)."""
+    from runner.scenario import load
+
+    return load(path)
+
+
+def default_simulate(scenario, **kwargs):
+    """runner.run.simulate (imported when first needed)."""
+    from runner.run import simulate
+
+    return simulate(scenario, **kwargs)
+
+
+def run_scenario(scenario, simulate, *, progress=False):
+    """The golden run of `scenario`: events logged, its golden frames kept."""
+    return simulate(
+        scenario, keep_frames=tuple(golden_frames(scenario)), log_events=True, progress=progress
+    )
+
+
+def register(subparsers, *, load=None, simulate=None) -> None:
+    """Add `check` and `bless` to an argparse subparsers object."""
+    load = load or default_load
+    simulate = simulate or default_simulate
+    p = subparsers.add_parser(
+        "check",
+        help="compare runs with their goldens",
+        description="Run scenarios and compare them with goldens/; exit 1 on any difference.",
+    )
+    p.add_argument("scenarios", nargs="*", metavar="SCENARIO", help="file or name (default: all)")
+    p.add_argument("--report", metavar="DIR", help="write expected/actual/diff images and HTML")
+    _common(p)
+    p.set_defaults(func=partial(check_command, load=load, simulate=simulate))
+    p = subparsers.add_parser(
+        "bless",
+        help="write goldens anew",
+        description="Run scenarios and write their goldens atomically; print what changed.",
+    )
+    p.add_argument("scenarios", nargs="*", metavar="SCENARIO", help="file or name (default: all)")
+    p.add_argument("--prune", action="store_true", help="remove goldens no scenario uses")
+    _common(p)
+    p.set_defaults(func=partial(bless_command, load=load, simulate=simulate))
+
+
+def _common(p) -> None:
+    p.add_argument("--root", metavar="DIR", help="project folder holding scenarios/ and goldens/")
+    p.add_argument("--quiet", action="store_true", help="no progress output")
+
+
+def main(argv=None, *, load=None, simulate=None) -> int:
+    """Run `check` or `bless` from `argv` on their own (the `collide2d` CLI adds the others)."""
+    parser = argparse.ArgumentParser(prog="collide2d")
+    register(parser.add_subparsers(dest="command", required=True), load=load, simulate=simulate)
+    args = parser.parse_args(argv)
+    return args.func(args)
+
+
+def check_command(args, *, load=default_load, simulate=default_simulate) -> int:
+    """`collide2d check`: 0 when every scenario matches its golden, 1 if not, 2 on bad input."""
+    try:
+        root, scenarios = _prepare(args, load)
+        report_dir = Path(args.report) if args.report else None
+        store = GoldenStore(root)
+        if report_dir is not None and _inside(report_dir, store.dir):
+            raise _Usage(f"--report {args.report} is inside {GOLDENS_DIR}/; name another folder")
+        # Unused goldens are only known when every scenario is checked.
+        used = None if args.scenarios else [scn.name for _p, scn in scenarios]
+    except _Usage as exc:
+        print(f"collide2d: error: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    outcomes = []
+    for i, (path, scn) in enumerate(scenarios, start=1):
+        _progress(args, f"[{i}/{len(scenarios)}] checking {scn.name}")
+        result = run_scenario(scn, simulate, progress=_show_progress(args))
+        outcome = check_run(scn, result, store, path=path, report_dir=report_dir)
+        outcomes.append(outcome)
+        print(outcome.message(), flush=True)
+    unused = store.unused(used) if used is not None else []
+    if unused:
+        print(
+            f"unused goldens (no scenario uses them): {', '.join(unused)}; "
+            "remove them with: collide2d bless --prune"
+        )
+    if report_dir is not None:
+        print(f"report: {shown_path(report.write_index(report_dir, outcomes, unused))}")
+    failed = [o for o in outcomes if not o.ok]
+    print(f"{len(outcomes) - len(failed)} passed, {len(failed)} failed")
+    return EXIT_DIFFERENT if failed else EXIT_OK
+
+
+def bless_command(args, *, load=default_load, simulate=default_simulate) -> int:
+    """`collide2d bless`: write the named goldens (all with no argument); 2 on bad input, in CI."""
+    try:
+        if ci_active():
+            raise _Usage(
+                "CI is set: goldens are never written in CI; bless locally and commit goldens/"
+            )
+        root, scenarios = _prepare(args, load)
+        store = GoldenStore(root)
+        used = _all_names(root, scenarios, load) if args.prune else []
+    except _Usage as exc:
+        print(f"collide2d: error: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    for i, (_path, scn) in enumerate(scenarios, start=1):
+        _progress(args, f"[{i}/{len(scenarios)}] running {scn.name}")
+        result = run_scenario(scn, simulate, progress=_show_progress(args))
+        print(bless_run(scn, result, store).line(), flush=True)
+    if args.prune:
+        for name in store.unused(used):
+            store.remove(name)
+            print(f"{'removed':<9} {name}: no scenario uses it")
+    elif not args.scenarios:
+        unused = store.unused(scn.name for _p, scn in scenarios)
+        if unused:
+            print(f"unused goldens kept: {', '.join(unused)} (remove them with --prune)")
+    return EXIT_OK
+
+
+def _prepare(args, load):
+    """(root, [(path, Scenario)]) for the command's arguments; _Usage on any bad input, before
+    anything runs."""
+    try:
+        root = Path(args.root).resolve() if args.root else find_root()
+    except GoldenError as exc:
+        raise _Usage(str(exc)) from None
+    if args.root and not (root / SCENARIOS_DIR).is_dir():
+        raise _Usage(f"--root {args.root} has no {SCENARIOS_DIR}/ folder")
+    paths = [_resolve(a, root) for a in args.scenarios] or scenario_files(root)
+    if not paths:
+        raise _Usage(f"no scenario files in {shown_path(root / SCENARIOS_DIR)}")
+    scenarios = _load_all(paths, load)
+    seen = {}
+    for path, scn in scenarios:
+        if scn.name in seen:
+            raise _Usage(
+                f"{shown_path(path)} and {shown_path(seen[scn.name])} are both named "
+                f"{scn.name!r}; a golden belongs to one scenario"
+            )
+        seen[scn.name] = path
+    return root, scenarios
+
+
+def _load_all(paths, load):
+    errors = scenario_errors()
+    out = []
+    for path in paths:
+        try:
+            out.append((path, load(str(path))))
+        except errors as exc:
+            raise _Usage(str(exc)) from None
+    return out
+
+
+def scenario_errors() -> tuple:
+    """The exception types that mean "this scenario file is refused"."""
+    from runner.scenario import ScenarioError
+
+    return (ScenarioError, GoldenError)
+
+
+def _resolve(arg: str, root: Path) -> Path:
+    """A scenario argument as a file: the path itself, else ROOT/scenarios/ARG.yaml."""
+    path = Path(arg)
+    if path.is_file():
+        return path
+    for suffix in SCENARIO_SUFFIXES:
+        candidate = root / SCENARIOS_DIR / f"{arg}{suffix}"
+        if candidate.is_file():
+            return candidate
+    raise _Usage(f"no scenario {arg!r}: not a file, and no {SCENARIOS_DIR}/{arg}.yaml")
+
+
+def _all_names(root, scenarios, load) -> list[str]:
+    """The names of every scenario in ROOT/scenarios/ plus the ones given."""
+    loaded = {Path(p).resolve(): s.name for p, s in scenarios}
+    rest = [p for p in scenario_files(root) if p.resolve() not in loaded]
+    return sorted(set(loaded.values()) | {s.name for _p, s in _load_all(rest, load)})
+
+
+def _inside(path: Path, folder: Path) -> bool:
+    path, folder = path.resolve(), folder.resolve()
+    return path == folder or folder in path.parents
+
+
+def _show_progress(args) -> bool:
+    return not args.quiet and sys.stderr.isatty()
+
+
+def _progress(args, text: str) -> None:
+    if _show_progress(args):
+        print(text, file=sys.stderr, flush=True)

@@ -1,0 +1,176 @@
+"""The pytest plugin of the goldens: every scenario a test, `test_golden[fig2_case1]` (SPEC §7).
+
+Registered by the project's root `conftest.py` (`pytest_plugins = ["runner.golden.plugin"]`).
+Inputs: the scenario files of the project (`ROOT/scenarios/`, ROOT found upward from the current
+directory or given by `--golden-root`) and the options below. Outputs: test outcomes whose failure
+text is the same as `collide2d check` prints, a report per failing scenario, and with
+`--update-goldens` the goldens of the tests that ran.
+
+    --update-goldens     bless what runs instead of comparing (refused with exit status 2 when the
+                         CI environment variable is set)
+    --golden-report DIR  write failure reports under DIR (default: pytest's temporary folder)
+    --golden-root DIR    the project folder holding scenarios/ and goldens/
+
+A test function asks for the `golden_scenario` argument to be parametrised over the scenario
+files, and calls the `golden_check` fixture with it. Each test writes only its own scenario's
+golden and report folder, so `pytest -n auto` (pytest-xdist) has no write races. The fixtures
+`golden_load` and `golden_simulate` give the scenario loader and the simulator; a conftest can
+override them. The terminal summary lists the goldens written and the goldens no scenario uses.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+# Every pytest run of the project loads this plugin: the harness (numpy, Pillow, the engine) is
+# imported inside the hooks and fixtures that use it, so that it costs nothing until they run.
+
+# user_properties keys a golden test records (they travel from xdist workers to the controller).
+PROP_NAME = "golden_name"
+PROP_BLESSED = "golden_blessed"
+
+
+def pytest_addoption(parser) -> None:
+    group = parser.getgroup("goldens", "collide2d golden regression")
+    group.addoption(
+        "--update-goldens",
+        action="store_true",
+        default=False,
+        help="bless the goldens of the golden tests that run (never when CI is set)",
+    )
+    group.addoption(
+        "--golden-report",
+        metavar="DIR",
+        default=None,
+        help="write golden failure reports under DIR (default: pytest's temporary folder)",
+    )
+    group.addoption(
+        "--golden-root",
+        metavar="DIR",
+        default=None,
+        help="project folder holding scenarios/ and goldens/ (default: found upward from here)",
+    )
+
+
+def pytest_configure(config) -> None:
+    from runner.golden.store import ci_active
+
+    if config.getoption("update_goldens") and ci_active():
+        pytest.exit(
+            "--update-goldens: CI is set: goldens are never written in CI; "
+            "bless locally and commit goldens/",
+            returncode=2,
+        )
+
+
+def _root(config) -> Path:
+    from runner.golden.store import find_root
+
+    given = config.getoption("golden_root")
+    if given:
+        return Path(given).resolve()
+    return find_root(config.invocation_params.dir)
+
+
+def pytest_generate_tests(metafunc) -> None:
+    if "golden_scenario" not in metafunc.fixturenames:
+        return
+    from runner.golden.store import GoldenError, scenario_files
+
+    try:
+        root = _root(metafunc.config)
+    except GoldenError as exc:
+        pytest.fail(str(exc), pytrace=False)
+    params = [pytest.param(p, id=p.stem) for p in scenario_files(root)]
+    if not params:
+        params = [pytest.param(None, id="no-scenarios")]
+    metafunc.parametrize("golden_scenario", params)
+
+
+@pytest.fixture(scope="session")
+def golden_root(pytestconfig) -> Path:
+    """The project folder holding scenarios/ and goldens/."""
+    return _root(pytestconfig)
+
+
+@pytest.fixture(scope="session")
+def golden_load():
+    """The scenario loader: path -> Scenario."""
+    from runner.golden.cli import default_load
+
+    return default_load
+
+
+@pytest.fixture(scope="session")
+def golden_simulate():
+    """The simulator, called as runner.run.simulate."""
+    from runner.golden.cli import default_simulate
+
+    return default_simulate
+
+
+@pytest.fixture
+def golden_check(request, golden_root, golden_load, golden_simulate, tmp_path_factory):
+    """check(path): run the scenario file `path` and compare it with its golden (or, with
+    --update-goldens, bless it); fails the test with the text `collide2d check` prints."""
+    from runner.golden import bless_run, check_run
+    from runner.golden.cli import run_scenario, scenario_errors
+    from runner.golden.store import SCENARIOS_DIR, GoldenStore
+
+    config = request.config
+
+    def check(path) -> None:
+        if path is None:
+            pytest.fail(f"no scenario files in {golden_root / SCENARIOS_DIR}", pytrace=False)
+        try:
+            scenario = golden_load(str(path))
+        except scenario_errors() as exc:
+            pytest.fail(str(exc), pytrace=False)
+        request.node.user_properties.append((PROP_NAME, scenario.name))
+        result = run_scenario(scenario, golden_simulate)
+        store = GoldenStore(golden_root)
+        if config.getoption("update_goldens"):
+            blessed = bless_run(scenario, result, store)
+            request.node.user_properties.append((PROP_BLESSED, blessed.line()))
+            return
+        given = config.getoption("golden_report")
+        report_dir = Path(given) if given else tmp_path_factory.getbasetemp() / "golden-report"
+        outcome = check_run(scenario, result, store, path=path, report_dir=report_dir)
+        if not outcome.ok:
+            pytest.fail(outcome.message(), pytrace=False)
+
+    return check
+
+
+def pytest_terminal_summary(terminalreporter, exitstatus, config) -> None:
+    reports = [
+        r
+        for key in ("passed", "failed")
+        for r in terminalreporter.stats.get(key, [])
+        if getattr(r, "when", None) == "call"
+    ]
+    props = [(k, v) for r in reports for k, v in r.user_properties]
+    blessed = sorted(v for k, v in props if k == PROP_BLESSED)
+    if blessed:
+        terminalreporter.section("goldens written (--update-goldens)")
+        for line in blessed:
+            terminalreporter.write_line(line)
+    names = {v for k, v in props if k == PROP_NAME}
+    if not names:
+        return
+    from runner.golden.store import GoldenError, GoldenStore, scenario_files
+
+    try:
+        root = _root(config)
+    except GoldenError:
+        return
+    # Unused goldens are only known when every scenario ran.
+    if len(names) == len(scenario_files(root)):
+        unused = GoldenStore(root).unused(names)
+        if unused:
+            terminalreporter.section("unused goldens")
+            terminalreporter.write_line(
+                f"no scenario uses: {', '.join(unused)}; remove them with: collide2d bless --prune"
+            )

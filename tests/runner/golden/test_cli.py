@@ -1,0 +1,156 @@
+"""Tests of runner/golden/cli.py: `check` and `bless` on a project tree of synthetic scenarios."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from runner.golden import cli
+
+from . import synthetic
+
+
+def _run(*argv):
+    return cli.main(list(argv), load=synthetic.load, simulate=synthetic.simulate)
+
+
+def _write(tree, name, **changes):
+    return synthetic.write(tree / "scenarios" / f"{name}.yaml", synthetic.spec(name=name, **changes))
+
+
+def _changed_pixel():
+    return synthetic.BASE["pixels"] + [[4, 6, 1, 0, 0, 9]]
+
+
+def test_check_passes_on_an_identical_run(tree, capsys):
+    assert _run("bless") == 0
+    capsys.readouterr()
+    assert _run("check") == 0
+    out = capsys.readouterr().out
+    assert out.splitlines() == ["ok      demo", "1 passed, 0 failed"]
+
+
+def test_check_fails_with_a_readable_message_and_report(tree, capsys):
+    assert _run("bless") == 0
+    _write(tree, "demo", pixels=_changed_pixel())
+    capsys.readouterr()
+    assert _run("check", "--report", "rep") == 1
+    out = capsys.readouterr().out
+    assert "FAILED  demo (scenarios/demo.yaml)" in out
+    assert "frame 4: 1 pixel(s) differ (colour threshold 0, budget 0) within x 6..6, y 1..1" in out
+    for kind in ("expected", "actual", "diff"):
+        assert f"rep/demo/frame_000004_{kind}.png" in out
+        assert (tree / "rep" / "demo" / f"frame_000004_{kind}.png").is_file()
+    assert "to accept this run as the golden: collide2d bless scenarios/demo.yaml" in out
+    assert "report: rep/index.html" in out
+    assert out.rstrip().endswith("0 passed, 1 failed")
+    summary = json.loads((tree / "rep" / "summary.json").read_text())
+    assert summary["failed"] == 1 and summary["scenarios"][0]["name"] == "demo"
+
+
+def test_check_of_a_missing_golden_fails_and_writes_nothing(tree, capsys):
+    assert _run("check") == 1
+    out = capsys.readouterr().out
+    assert "MISSING demo" in out
+    assert "to create it: collide2d bless scenarios/demo.yaml" in out
+    assert not (tree / "goldens").exists()
+
+
+def test_check_and_bless_by_name_or_path(tree, capsys):
+    _write(tree, "other")
+    assert _run("bless", "other") == 0
+    assert capsys.readouterr().out.splitlines() == [
+        "created   other: 2 events, 2 frames, 2 objects"
+    ]
+    assert sorted(p.name for p in (tree / "goldens").iterdir()) == ["other"]
+    assert _run("check", "scenarios/other.yaml") == 0
+    assert _run("check", "demo") == 1
+
+
+def test_bless_reports_each_status(tree, capsys):
+    _write(tree, "other")
+    assert _run("bless") == 0
+    capsys.readouterr()
+    _write(tree, "other", pixels=_changed_pixel())
+    assert _run("bless") == 0
+    assert capsys.readouterr().out.splitlines() == [
+        "unchanged demo: no change",
+        "updated   other: frames 4 (1 px)",
+    ]
+    assert _run("check") == 0
+
+
+def test_unused_goldens_are_reported_and_pruned_only_when_asked(tree, capsys):
+    _write(tree, "gone")
+    assert _run("bless") == 0
+    (tree / "scenarios" / "gone.yaml").unlink()
+    capsys.readouterr()
+    assert _run("check") == 0
+    assert "unused goldens (no scenario uses them): gone" in capsys.readouterr().out
+    assert _run("bless", "demo") == 0
+    assert _run("bless") == 0
+    assert "unused goldens kept: gone (remove them with --prune)" in capsys.readouterr().out
+    assert (tree / "goldens" / "gone").is_dir()
+    assert _run("bless", "--prune") == 0
+    assert "removed   gone: no scenario uses it" in capsys.readouterr().out
+    assert not (tree / "goldens" / "gone").exists()
+    assert (tree / "goldens" / "demo").is_dir()
+
+
+def test_ci_refuses_bless_and_check_writes_nothing_to_goldens(tree, monkeypatch, capsys):
+    monkeypatch.setenv("CI", "true")
+    assert _run("bless") == 2
+    assert "CI is set" in capsys.readouterr().err
+    assert _run("bless", "--prune") == 2
+    assert _run("check", "--report", "rep") == 1
+    assert not (tree / "goldens").exists()
+    assert (tree / "rep" / "index.html").is_file()
+
+
+@pytest.mark.parametrize(
+    "argv, error",
+    [
+        (["check", "nosuch"], "no scenario 'nosuch'"),
+        (["bless", "nosuch"], "no scenario 'nosuch'"),
+        (["check", "--report", "goldens/rep"], "is inside goldens/"),
+        (["check", "--root", "scenarios"], "has no scenarios/ folder"),
+    ],
+)
+def test_bad_input_exits_2(tree, capsys, argv, error):
+    assert _run(*argv) == 2
+    assert error in capsys.readouterr().err
+    assert not (tree / "goldens").exists()
+
+
+def test_two_scenarios_with_one_name_exit_2(tree, capsys):
+    _write(tree, "twin").write_text(json.dumps(synthetic.spec(name="demo")))
+    assert _run("bless") == 2
+    assert "are both named 'demo'" in capsys.readouterr().err
+    assert not (tree / "goldens").exists()
+
+
+def test_no_project_found_exits_2(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert _run("check") == 2
+    assert "no scenarios/ folder" in capsys.readouterr().err
+
+
+def test_root_option_and_empty_corpus(tmp_path, capsys):
+    (tmp_path / "scenarios").mkdir()
+    assert _run("check", "--root", str(tmp_path)) == 2
+    assert "no scenario files in" in capsys.readouterr().err
+    synthetic.write(tmp_path / "scenarios" / "demo.yaml", synthetic.spec())
+    assert _run("bless", "--root", str(tmp_path)) == 0
+    assert (tmp_path / "goldens" / "demo" / "manifest.json").is_file()
+
+
+def test_register_adds_both_commands():
+    import argparse
+
+    parser = argparse.ArgumentParser(prog="collide2d")
+    cli.register(parser.add_subparsers(dest="command"))
+    args = parser.parse_args(["bless", "a", "b", "--prune", "--quiet"])
+    assert (args.scenarios, args.prune, args.quiet) == (["a", "b"], True, True)
+    args = parser.parse_args(["check", "--report", "r"])
+    assert args.report == "r" and callable(args.func)

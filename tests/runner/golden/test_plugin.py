@@ -1,0 +1,125 @@
+"""Tests of runner/golden/plugin.py: golden tests per scenario, --update-goldens, CI, xdist."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from runner.golden.store import GoldenStore
+
+from . import synthetic
+
+pytest_plugins = ["pytester"]
+
+CONFTEST = """
+import pytest
+import golden_synthetic
+
+pytest_plugins = ["runner.golden.plugin"]
+
+
+@pytest.fixture(scope="session")
+def golden_load():
+    return golden_synthetic.load
+
+
+@pytest.fixture(scope="session")
+def golden_simulate():
+    return golden_synthetic.simulate
+"""
+
+TEST_FILE = """
+def test_golden(golden_scenario, golden_check):
+    golden_check(golden_scenario)
+"""
+
+
+@pytest.fixture
+def project(pytester):
+    """A pytester project: synthetic scenarios a and b, the plugin, one golden test module."""
+    pytester.makepyfile(
+        golden_synthetic=Path(synthetic.__file__).read_text(),
+        conftest=CONFTEST,
+        test_goldens=TEST_FILE,
+    )
+    for name in ("a", "b"):
+        synthetic.write(pytester.path / "scenarios" / f"{name}.yaml", synthetic.spec(name=name))
+    return pytester
+
+
+def test_a_missing_golden_fails_naming_the_command(project):
+    result = project.runpytest("-v")
+    result.assert_outcomes(failed=2)
+    result.stdout.fnmatch_lines(["*test_golden?a? FAILED*", "*test_golden?b? FAILED*"])
+    result.stdout.fnmatch_lines(["*to create it: collide2d bless scenarios/a.yaml*"])
+    assert not (project.path / "goldens").exists()
+
+
+def test_update_goldens_blesses_what_runs_then_checks_pass(project):
+    result = project.runpytest("--update-goldens", "-k", "a")
+    result.assert_outcomes(passed=1, deselected=1)
+    result.stdout.fnmatch_lines(["*goldens written*", "created   a: 2 events, 2 frames, 2 objects"])
+    assert GoldenStore(project.path).names() == ["a"]
+    project.runpytest("--update-goldens").assert_outcomes(passed=2)
+    result = project.runpytest("-v")
+    result.assert_outcomes(passed=2)
+    assert "goldens written" not in result.stdout.str()
+
+
+def test_a_difference_fails_with_the_check_message_and_a_report(project):
+    project.runpytest("--update-goldens").assert_outcomes(passed=2)
+    changed = synthetic.spec(name="b", pixels=synthetic.BASE["pixels"] + [[0, 0, 0, 7, 7, 7]])
+    synthetic.write(project.path / "scenarios" / "b.yaml", changed)
+    rep = project.path / "rep"
+    result = project.runpytest("--golden-report", str(rep))
+    result.assert_outcomes(passed=1, failed=1)
+    result.stdout.fnmatch_lines(
+        [
+            "*FAILED  b (scenarios/b.yaml)*",
+            "*frame 0: 1 pixel(s) differ*within x 0..0, y 0..0*",
+            "*diff:*rep/b/frame_000000_diff.png*",
+            "*to accept this run as the golden: collide2d bless scenarios/b.yaml*",
+        ]
+    )
+    summary = json.loads((rep / "b" / "summary.json").read_text())
+    assert summary["frames"][0]["n_diff"] == 1
+
+
+def test_update_goldens_is_refused_in_ci(project, monkeypatch):
+    monkeypatch.setenv("CI", "true")
+    result = project.runpytest_subprocess("--update-goldens")
+    assert result.ret == 2
+    assert "CI is set" in result.stderr.str() + result.stdout.str()
+    assert not (project.path / "goldens").exists()
+
+
+def test_unused_goldens_are_listed(project):
+    project.runpytest("--update-goldens").assert_outcomes(passed=2)
+    (project.path / "scenarios" / "b.yaml").unlink()
+    result = project.runpytest()
+    result.assert_outcomes(passed=1)
+    result.stdout.fnmatch_lines(["*unused goldens*", "no scenario uses: b; remove them with*"])
+
+
+def test_no_scenarios_is_a_failure(project):
+    for p in (project.path / "scenarios").iterdir():
+        p.unlink()
+    result = project.runpytest()
+    result.assert_outcomes(failed=1)
+    result.stdout.fnmatch_lines(["*test_golden?no-scenarios?*", "*no scenario files in*"])
+
+
+def test_xdist_blesses_each_golden_once_and_checks(project):
+    for name in ("c", "d", "e"):
+        synthetic.write(project.path / "scenarios" / f"{name}.yaml", synthetic.spec(name=name))
+    result = project.runpytest_subprocess("-n", "2", "--update-goldens")
+    result.assert_outcomes(passed=5)
+    written = [ln for ln in result.stdout.lines if ln.startswith("created ")]
+    assert sorted(ln.split()[1] for ln in written) == ["a:", "b:", "c:", "d:", "e:"]
+    store = GoldenStore(project.path)
+    assert store.names() == ["a", "b", "c", "d", "e"]
+    for name in store.names():
+        store.read(name)
+    project.runpytest_subprocess("-n", "2").assert_outcomes(passed=5)

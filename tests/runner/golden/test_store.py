@@ -1,0 +1,237 @@
+"""Tests of runner/golden/store.py: whole reads, atomic writes, torn goldens, CI, finding the root."""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+
+from runner.golden import golden_files
+from runner.golden import serialize as ser
+from runner.golden import store as st
+from runner.golden.store import GoldenMissing, GoldenStore, GoldenUnreadable, WritesRefused
+
+from . import synthetic
+
+
+def _files(tmp_path, **changes):
+    scn = synthetic.load(synthetic.write(tmp_path / "scn.yaml", synthetic.spec(**changes)))
+    run = synthetic.simulate(scn, keep_frames=scn.golden.frames)
+    return golden_files(scn, run), run
+
+
+def _snapshot(folder):
+    return {
+        p.relative_to(folder).as_posix(): p.read_bytes()
+        for p in sorted(folder.rglob("*"))
+        if p.is_file()
+    }
+
+
+def test_write_then_read_gives_the_results_back(tmp_path):
+    files, run = _files(tmp_path)
+    store = GoldenStore(tmp_path)
+    written = store.write("demo", files)
+    assert written == sorted(files)
+    assert _snapshot(store.folder("demo")) == files
+    g = store.read("demo")
+    assert g.events == ser.event_dicts(run.events)
+    assert np.array_equal(g.final[:, :2], run.final_pos)
+    assert np.array_equal(g.final[:, 2:], run.final_vel)
+    assert sorted(g.frames) == [0, 4]
+    assert all(np.array_equal(g.frames[k], run.frames[k]) for k in (0, 4))
+
+
+def test_rewriting_the_same_files_changes_nothing(tmp_path):
+    files, _ = _files(tmp_path)
+    store = GoldenStore(tmp_path)
+    store.write("demo", files)
+    stamps = {p: p.stat().st_mtime_ns for p in store.folder("demo").rglob("*")}
+    assert store.write("demo", dict(files)) == []
+    assert {p: p.stat().st_mtime_ns for p in store.folder("demo").rglob("*")} == stamps
+
+
+class _FailOn:
+    """Wrap `func` so that its call number `n` raises OSError (the other calls go through)."""
+
+    def __init__(self, func, n):
+        self.func, self.n, self.calls = func, n, 0
+
+    def __call__(self, *args):
+        self.calls += 1
+        if self.calls == self.n:
+            raise OSError("disk full (simulated)")
+        return self.func(*args)
+
+
+def _old_and_new(tmp_path):
+    old, _ = _files(tmp_path)
+    new, _ = _files(
+        tmp_path,
+        events=[[2, 0.2, 0, 1, -1, 1, -1, -1]],
+        final=[[1.0, 2.0, 10.0, 0.0]],
+        pixels=[[0, 2, 2, 9, 9, 9], [4, 3, 3, 1, 2, 3]],
+    )
+    assert all(old[k] != new[k] for k in old)
+    return old, new
+
+
+@pytest.mark.parametrize("fail_at", [1, 2, 4, 5])
+def test_a_write_failing_midway_leaves_the_old_golden_whole(tmp_path, monkeypatch, fail_at):
+    old, new = _old_and_new(tmp_path)
+    store = GoldenStore(tmp_path)
+    store.write("demo", old)
+    monkeypatch.setattr(st, "_write_temp", _FailOn(st._write_temp, fail_at))
+    with pytest.raises(OSError, match="simulated"):
+        store.write("demo", new)
+    assert _snapshot(store.folder("demo")) == old  # byte for byte, and no temporary left
+    store.read("demo")
+
+
+@pytest.mark.parametrize("fail_at", [2, 5])
+def test_a_rename_failing_midway_puts_the_old_golden_back(tmp_path, monkeypatch, fail_at):
+    old, new = _old_and_new(tmp_path)
+    store = GoldenStore(tmp_path)
+    store.write("demo", old)
+    monkeypatch.setattr(st.os, "replace", _FailOn(os.replace, fail_at))
+    with pytest.raises(OSError, match="simulated"):
+        store.write("demo", new)
+    assert _snapshot(store.folder("demo")) == old
+    store.read("demo")
+
+
+def test_a_first_write_failing_leaves_no_golden(tmp_path, monkeypatch):
+    files, _ = _files(tmp_path)
+    store = GoldenStore(tmp_path)
+    monkeypatch.setattr(st, "_write_temp", _FailOn(st._write_temp, 3))
+    with pytest.raises(OSError):
+        store.write("demo", files)
+    with pytest.raises(GoldenMissing):
+        store.read("demo")
+
+
+def test_a_golden_torn_between_renames_is_unreadable(tmp_path):
+    old, new = _old_and_new(tmp_path)
+    store = GoldenStore(tmp_path)
+    store.write("demo", old)
+    (store.folder("demo") / ser.EVENTS_FILE).write_bytes(new[ser.EVENTS_FILE])
+    with pytest.raises(GoldenUnreadable, match=r"events\.jsonl does not match manifest\.json"):
+        store.read("demo")
+
+
+def test_png_pixels_are_checked_but_not_png_bytes(tmp_path):
+    files, run = _files(tmp_path)
+    store = GoldenStore(tmp_path)
+    store.write("demo", files)
+    png = store.folder("demo") / ser.frame_file(4)
+    from PIL import Image
+
+    Image.fromarray(run.frames[4]).save(png, format="PNG", compress_level=0)
+    assert png.read_bytes() != files[ser.frame_file(4)]
+    store.read("demo")  # the same pixels: still the golden
+    edited = run.frames[4].copy()
+    edited[0, 0] = (1, 1, 1)
+    Image.fromarray(edited).save(png, format="PNG")
+    with pytest.raises(GoldenUnreadable, match=r"frame_000004\.png does not match"):
+        store.read("demo")
+
+
+def test_missing_and_unreadable_goldens(tmp_path):
+    files, _ = _files(tmp_path)
+    store = GoldenStore(tmp_path)
+    with pytest.raises(GoldenMissing, match="no golden for demo"):
+        store.read("demo")
+    store.folder("demo").mkdir(parents=True)
+    with pytest.raises(GoldenMissing, match="has no manifest.json"):
+        store.read("demo")
+    store.write("demo", files)
+    (store.folder("demo") / ser.frame_file(0)).unlink()
+    with pytest.raises(GoldenUnreadable, match="frame_000000.png is missing"):
+        store.read("demo")
+    manifest = store.folder("demo") / ser.MANIFEST_FILE
+    manifest.write_text(manifest.read_text().replace('"format": 1', '"format": 99'))
+    with pytest.raises(GoldenUnreadable, match="format 99"):
+        store.read("demo")
+    manifest.write_text("{")
+    with pytest.raises(GoldenUnreadable, match="not JSON"):
+        store.read("demo")
+
+
+def test_stale_frames_and_leftover_temporaries_are_removed(tmp_path):
+    files, _ = _files(tmp_path)
+    store = GoldenStore(tmp_path)
+    store.write("demo", files)
+    folder = store.folder("demo")
+    leftover = folder / ser.FRAMES_DIR / ".frame_000004.png.999.tmp"
+    leftover.write_bytes(b"half")
+    fewer, _ = _files(tmp_path, golden={**synthetic.BASE["golden"], "frames": [4]})
+    store.write("demo", fewer)
+    assert not leftover.exists()
+    assert not (folder / ser.frame_file(0)).exists()
+    assert sorted(store.read("demo").frames) == [4]
+
+
+@pytest.mark.parametrize(
+    "value, active",
+    [(None, False), ("", False), ("0", False), ("false", False), ("No", False),
+     ("true", True), ("1", True), ("yes", True)],
+)
+def test_ci_truth_table(value, active):
+    env = {} if value is None else {"CI": value}
+    assert st.ci_active(env) is active
+
+
+def test_nothing_is_written_in_ci(tmp_path, monkeypatch):
+    files, _ = _files(tmp_path)
+    store = GoldenStore(tmp_path)
+    store.write("keep", files)
+    monkeypatch.setenv("CI", "true")
+    with pytest.raises(WritesRefused, match="CI is set"):
+        store.write("demo", files)
+    with pytest.raises(WritesRefused):
+        store.remove("keep")
+    assert store.names() == ["keep"]
+
+
+def test_names_unused_and_remove(tmp_path):
+    files, _ = _files(tmp_path)
+    store = GoldenStore(tmp_path)
+    assert store.names() == []
+    for name in ("b", "a", "c"):
+        store.write(name, files)
+    (store.dir / ".hidden").mkdir()
+    assert store.names() == ["a", "b", "c"]
+    assert store.unused(["b", "zzz"]) == ["a", "c"]
+    store.remove("a")
+    assert store.names() == ["b", "c"]
+
+
+@pytest.mark.parametrize("name", ["../x", ".hidden", "A", "a/b", "", ".."])
+def test_names_cannot_leave_goldens(tmp_path, name):
+    with pytest.raises(st.GoldenError):
+        GoldenStore(tmp_path).folder(name)
+
+
+def test_file_paths_cannot_leave_the_golden(tmp_path):
+    files, _ = _files(tmp_path)
+    with pytest.raises(ValueError):
+        GoldenStore(tmp_path).write("demo", {**files, "../escape.txt": b"x"})
+    assert not (tmp_path / "goldens" / "escape.txt").exists()
+
+
+def test_find_root_walks_up_to_scenarios(tmp_path):
+    (tmp_path / "scenarios").mkdir()
+    deep = tmp_path / "a" / "b"
+    deep.mkdir(parents=True)
+    assert st.find_root(deep) == tmp_path.resolve()
+    with pytest.raises(st.GoldenError, match="no scenarios/ folder"):
+        st.find_root(tmp_path.parent / "nowhere-with-scenarios")
+
+
+def test_scenario_files_are_sorted_yaml(tmp_path):
+    folder = tmp_path / "scenarios"
+    folder.mkdir()
+    for name in ("b.yaml", "a.yml", "c.txt", "a.yaml"):
+        (folder / name).write_text("{}")
+    assert [p.name for p in st.scenario_files(tmp_path)] == ["a.yaml", "a.yml", "b.yaml"]
