@@ -95,11 +95,11 @@ def box_penetration(qx, qy, wa, ha, wb, hb):
 
 @njit(cache=True)
 def box_overlap_axis(qx, qy, wa, ha, wb, hb):
-    """The stepped model's box contact (SPEC 3.2): (depth_x, depth_y, code, sx, sy).
+    """The stepped model's box contact (SPEC 3.2): (depth, depth_y, code, nx, ny).
 
-    The axis is that of the smaller overlap width (the paper's xdiff/ydiff; both on a tie); the
-    depths are the pushes along ±x and ±y that part the boxes, the signs point from A to B.
-    xdiff or ydiff <= 0 means no overlap and gives depth 0.
+    The axis is that of the smaller overlap width (the paper's xdiff/ydiff; both on a tie, AXIS_XY).
+    depth is the push along the normal that parts the boxes (for AXIS_XY the push along x, and
+    depth_y the push along y); the normal points from A to B. depth 0 when they do not overlap.
     """
     xdiff = min(wa, qx + wb) - max(0.0, qx)
     ydiff = min(ha, qy + hb) - max(0.0, qy)
@@ -114,7 +114,7 @@ def box_overlap_axis(qx, qy, wa, ha, wb, hb):
     if xdiff < ydiff:
         return dx, 0.0, AXIS_X, sx, 0.0
     if ydiff < xdiff:
-        return 0.0, dy, AXIS_Y, 0.0, sy
+        return dy, 0.0, AXIS_Y, 0.0, sy
     return dx, dy, AXIS_XY, sx, sy
 
 

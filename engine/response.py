@@ -85,11 +85,11 @@ def _separate_axis(pos, a, b, wa, wb, axis, push, span_a, span_b):
 
 
 @njit(cache=True)
-def separate(pos, size, a, b, wa, wb, code, nx, ny, depth_x, depth_y, width, height):
+def separate(pos, size, a, b, wa, wb, code, nx, ny, depth, depth_y, width, height):
     """Push an overlapping pair apart along the contact normal, shared by inverse mass, in place.
 
-    pos/size (n, 2) px; the pair moves apart by depth_x along x (sign nx) and depth_y along y
-    (sign ny) for AXIS_XY, else by depth_x along the unit normal (nx, ny). No object is pushed out
+    pos/size (n, 2) px; the pair moves apart by depth (px) along the unit normal (nx, ny), or for
+    AXIS_XY by depth along x (sign nx) and depth_y along y (sign ny). No object is pushed out
     of the world [0, width) × [0, height); when one side is blocked the other takes the rest.
     """
     span_ax = width - size[a, 0]
@@ -97,13 +97,13 @@ def separate(pos, size, a, b, wa, wb, code, nx, ny, depth_x, depth_y, width, hei
     span_bx = width - size[b, 0]
     span_by = height - size[b, 1]
     if code == AXIS_XY:
-        _separate_axis(pos, a, b, wa, wb, 0, depth_x * nx, span_ax, span_bx)
+        _separate_axis(pos, a, b, wa, wb, 0, depth * nx, span_ax, span_bx)
         _separate_axis(pos, a, b, wa, wb, 1, depth_y * ny, span_ay, span_by)
     else:
         if nx != 0.0:
-            _separate_axis(pos, a, b, wa, wb, 0, depth_x * nx, span_ax, span_bx)
+            _separate_axis(pos, a, b, wa, wb, 0, depth * nx, span_ax, span_bx)
         if ny != 0.0:
-            _separate_axis(pos, a, b, wa, wb, 1, depth_x * ny, span_ay, span_by)
+            _separate_axis(pos, a, b, wa, wb, 1, depth * ny, span_ay, span_by)
 
 
 @njit(cache=True)

@@ -313,8 +313,18 @@ class Model:
         """Run `ticks` ticks; the events they made (EVENT_DTYPE, in order; empty if not log)."""
         cands = (self._order, self._anchor, self._keys, self._list_state, self._margin)
         ev, n_ev, self._keys = _run(
-            self.pos, self.size, self.step, self.period, self.count, self.movable, self.limit,
-            self.tick, int(ticks), bool(log), cands, self._ev,
+            self.pos,
+            self.size,
+            self.step,
+            self.period,
+            self.count,
+            self.movable,
+            self.limit,
+            self.tick,
+            int(ticks),
+            bool(log),
+            cands,
+            self._ev,
         )
         self._ev = ev
         self.tick += int(ticks)

@@ -36,7 +36,16 @@ EXIT_USAGE = 2
 
 
 class _Usage(Exception):
-    """Bad input: the message goes to stderr and the command exits with EXIT_USAGE."""
+    """Bad input: the message goes to stderr and the command exits with EXIT_USAGE. `located`
+    messages (a refused scenario's `FILE:LINE:COL: error: ...`) are printed as they are."""
+
+    def __init__(self, message: str, *, located: bool = False):
+        super().__init__(message)
+        self.located = located
+
+    def exit(self) -> int:
+        print(str(self) if self.located else f"collide2d: error: {self}", file=sys.stderr)
+        return EXIT_USAGE
 
 
 def default_load(path):
@@ -108,8 +117,7 @@ def check_command(args, *, load=default_load, simulate=default_simulate) -> int:
         # Unused goldens are only known when every scenario is checked.
         used = None if args.scenarios else [scn.name for _p, scn in scenarios]
     except _Usage as exc:
-        print(f"collide2d: error: {exc}", file=sys.stderr)
-        return EXIT_USAGE
+        return exc.exit()
     outcomes = []
     for i, (path, scn) in enumerate(scenarios, start=1):
         _progress(args, f"[{i}/{len(scenarios)}] checking {scn.name}")
@@ -141,8 +149,7 @@ def bless_command(args, *, load=default_load, simulate=default_simulate) -> int:
         store = GoldenStore(root)
         used = _all_names(root, scenarios, load) if args.prune else []
     except _Usage as exc:
-        print(f"collide2d: error: {exc}", file=sys.stderr)
-        return EXIT_USAGE
+        return exc.exit()
     for i, (_path, scn) in enumerate(scenarios, start=1):
         _progress(args, f"[{i}/{len(scenarios)}] running {scn.name}")
         result = run_scenario(scn, simulate, progress=_show_progress(args))
@@ -187,9 +194,9 @@ def _load_all(paths, load):
     out = []
     for path in paths:
         try:
-            out.append((path, load(str(path))))
+            out.append((path, load(shown_path(path))))
         except errors as exc:
-            raise _Usage(str(exc)) from None
+            raise _Usage(str(exc), located=True) from None
     return out
 
 
@@ -197,7 +204,7 @@ def scenario_errors() -> tuple:
     """The exception types that mean "this scenario file is refused"."""
     from runner.scenario import ScenarioError
 
-    return (ScenarioError, GoldenError)
+    return (ScenarioError,)
 
 
 def _resolve(arg: str, root: Path) -> Path:

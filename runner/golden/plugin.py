@@ -55,9 +55,11 @@ def pytest_addoption(parser) -> None:
 
 
 def pytest_configure(config) -> None:
+    if not config.getoption("update_goldens"):
+        return
     from runner.golden.store import ci_active
 
-    if config.getoption("update_goldens") and ci_active():
+    if ci_active():
         pytest.exit(
             "--update-goldens: CI is set: goldens are never written in CI; "
             "bless locally and commit goldens/",
@@ -115,7 +117,7 @@ def golden_simulate():
 def golden_check(request, golden_root, golden_load, golden_simulate, tmp_path_factory):
     """check(path): run the scenario file `path` and compare it with its golden (or, with
     --update-goldens, bless it); fails the test with the text `collide2d check` prints."""
-    from runner.golden import bless_run, check_run
+    from runner.golden import bless_run, check_run, shown_path
     from runner.golden.cli import run_scenario, scenario_errors
     from runner.golden.store import SCENARIOS_DIR, GoldenStore
 
@@ -125,7 +127,7 @@ def golden_check(request, golden_root, golden_load, golden_simulate, tmp_path_fa
         if path is None:
             pytest.fail(f"no scenario files in {golden_root / SCENARIOS_DIR}", pytrace=False)
         try:
-            scenario = golden_load(str(path))
+            scenario = golden_load(shown_path(path))
         except scenario_errors() as exc:
             pytest.fail(str(exc), pytrace=False)
         request.node.user_properties.append((PROP_NAME, scenario.name))

@@ -65,7 +65,7 @@ def load(path, *, overrides=None, limits=None):
     if "error" in data:
         from runner.scenario import ScenarioError
 
-        raise ScenarioError(f"{path}:1:1: error: {data['error']}")
+        raise ScenarioError(path, 1, 1, data["error"])
     g = data["golden"]
     return SimpleNamespace(
         path=str(path),
@@ -87,8 +87,8 @@ def simulate(scenario, *, keep_frames=(), log_events=True, progress=False):
     """A RunResult-like record with the results the synthetic file states."""
     data = scenario.data
     events = np.zeros(len(data["events"]) if log_events else 0, dtype=EVENT_DTYPE)
-    for rec, row in zip(events, data["events"]):
-        for field, value in zip(EVENT_DTYPE.names, row):
+    for rec, row in zip(events, data["events"], strict=True):
+        for field, value in zip(EVENT_DTYPE.names, row, strict=True):
             rec[field] = value
     final = np.array(data["final"], dtype=np.float64).reshape(-1, 4)
     frames = {}

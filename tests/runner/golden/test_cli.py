@@ -16,7 +16,8 @@ def _run(*argv):
 
 
 def _write(tree, name, **changes):
-    return synthetic.write(tree / "scenarios" / f"{name}.yaml", synthetic.spec(name=name, **changes))
+    path = tree / "scenarios" / f"{name}.yaml"
+    return synthetic.write(path, synthetic.spec(name=name, **changes))
 
 
 def _changed_pixel():
@@ -120,6 +121,18 @@ def test_ci_refuses_bless_and_check_writes_nothing_to_goldens(tree, monkeypatch,
 def test_bad_input_exits_2(tree, capsys, argv, error):
     assert _run(*argv) == 2
     assert error in capsys.readouterr().err
+    assert not (tree / "goldens").exists()
+
+
+def test_a_refused_scenario_exits_2_before_anything_runs(tree, capsys):
+    _write(tree, "bad", error="unknown key 'tiks' (did you mean 'ticks'?)")
+    for command in ("bless", "check"):
+        assert _run(command) == 2
+        captured = capsys.readouterr()
+        assert captured.err.strip() == (
+            "scenarios/bad.yaml:1:1: error: unknown key 'tiks' (did you mean 'ticks'?)"
+        )
+        assert captured.out == ""
     assert not (tree / "goldens").exists()
 
 

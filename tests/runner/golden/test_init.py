@@ -97,13 +97,14 @@ def test_a_frame_of_another_size_fails_on_its_own(tree):
 def test_golden_frames_added_or_dropped_fail(tree):
     store = _blessed(tree)
     more = {**synthetic.BASE["golden"], "frames": [0, 2, 4]}
-    assert "frame 2: not in the golden (its frames are [0, 4])" in _check(
-        tree, store, golden=more
-    ).message()
+    assert (
+        "frame 2: not in the golden (its frames are [0, 4])"
+        in _check(tree, store, golden=more).message()
+    )
     fewer = {**synthetic.BASE["golden"], "frames": [0]}
-    assert "frame 4: in the golden, but no longer among" in _check(
-        tree, store, golden=fewer
-    ).message()
+    assert (
+        "frame 4: in the golden, but no longer among" in _check(tree, store, golden=fewer).message()
+    )
 
 
 def test_a_missing_golden_fails_and_names_the_command(tree):

@@ -103,6 +103,14 @@ def test_unused_goldens_are_listed(project):
     result.stdout.fnmatch_lines(["*unused goldens*", "no scenario uses: b; remove them with*"])
 
 
+def test_a_refused_scenario_fails_its_own_test(project):
+    synthetic.write(project.path / "scenarios" / "b.yaml", synthetic.spec(error="bad value"))
+    result = project.runpytest("--update-goldens")
+    result.assert_outcomes(passed=1, failed=1)
+    result.stdout.fnmatch_lines(["*scenarios/b.yaml:1:1: error: bad value*"])
+    assert GoldenStore(project.path).names() == ["a"]
+
+
 def test_no_scenarios_is_a_failure(project):
     for p in (project.path / "scenarios").iterdir():
         p.unlink()

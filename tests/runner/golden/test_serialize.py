@@ -1,4 +1,4 @@
-"""Tests of runner/golden/serialize.py: fixed texts that read back exactly, pixel hashes, manifest."""
+"""Tests of runner/golden/serialize.py: texts that read back exactly, pixel hashes, manifest."""
 
 from __future__ import annotations
 
@@ -33,7 +33,8 @@ def test_events_jsonl_is_the_events_log_and_reads_back():
     assert data.decode().splitlines() == [format_event(r) for r in ev]
     assert data.endswith(b"\n")
     assert data.decode().splitlines()[0] == (
-        '{"tick": 6, "t": 0.6, "type": "pair", "a": 0, "b": 1, "axis": "x", "xdiff": 2, "ydiff": 10}'
+        '{"tick": 6, "t": 0.6, "type": "pair", "a": 0, "b": 1, "axis": "x", '
+        '"xdiff": 2, "ydiff": 10}'
     )
     assert ser.parse_events(data) == [event_dict(r) for r in ev] == ser.event_dicts(ev)
     assert ser.events_jsonl(np.zeros(0, EVENT_DTYPE)) == b""

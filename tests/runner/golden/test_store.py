@@ -1,4 +1,4 @@
-"""Tests of runner/golden/store.py: whole reads, atomic writes, torn goldens, CI, finding the root."""
+"""Tests of runner/golden/store.py: whole reads, atomic writes, torn goldens, CI, the root."""
 
 from __future__ import annotations
 
@@ -174,8 +174,16 @@ def test_stale_frames_and_leftover_temporaries_are_removed(tmp_path):
 
 @pytest.mark.parametrize(
     "value, active",
-    [(None, False), ("", False), ("0", False), ("false", False), ("No", False),
-     ("true", True), ("1", True), ("yes", True)],
+    [
+        (None, False),
+        ("", False),
+        ("0", False),
+        ("false", False),
+        ("No", False),
+        ("true", True),
+        ("1", True),
+        ("yes", True),
+    ],
 )
 def test_ci_truth_table(value, active):
     env = {} if value is None else {"CI": value}
