@@ -60,6 +60,7 @@ DEFAULT_MASS = 1.0  # mass units
 MAX_SPEED = 1e9  # px/s, largest velocity component (a larger one crosses any world in a tick)
 MAX_SUBSTEPS = 10_000  # substeps per tick of the stepped model
 MAX_YAML_DEPTH = 64  # nesting levels of YAML collections
+MAX_POINT_OFFSET = 2**24  # px, largest |coordinate| of a polygon point relative to its position
 MAX_NAME_LENGTH = 100  # characters in a scenario name (it names a folder)
 PALETTE_SIZE = 256  # palette rows: the background and up to 255 object colours
 NAME_PATTERN = r"[a-z0-9_-][a-z0-9._-]*"  # scenario names; never "." or "..", never a path
@@ -249,11 +250,9 @@ def _yaml_error(exc: yaml.YAMLError, path: str, text: str) -> ScenarioError:
         return ScenarioError(path, line, col, f"invalid character U+{char:04X} in YAML text")
     if isinstance(exc, yaml.MarkedYAMLError):
         mark = exc.problem_mark or exc.context_mark
-        problem = exc.problem or "invalid YAML"
-        message = f"invalid YAML ({exc.context}): {problem}" if exc.context else problem
-        if not exc.context and exc.problem:
-            message = f"invalid YAML: {problem}"
-        return _mark_error(path, mark, message)
+        problem = exc.problem or "unexpected text"
+        context = f" ({exc.context})" if exc.context else ""
+        return _mark_error(path, mark, f"invalid YAML{context}: {problem}")
     return ScenarioError(path, 1, 1, f"invalid YAML: {exc}")
 
 
@@ -400,21 +399,24 @@ def polygon_problem(points: np.ndarray) -> str | None:
     p = np.asarray(points, np.int64)
     keep = np.any(p != np.roll(p, 1, axis=0), axis=1)
     p = p[keep] if keep.any() else p[:1]
-    area2 = int(np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1]))
-    if p.shape[0] < 3 or area2 == 0:
+    d = p - p[0]
+    if not np.any(d[:, 0] * np.roll(d[:, 1], -1) - np.roll(d[:, 0], -1) * d[:, 1]):
         return "it has zero area (its points lie on one line)"
+    area2 = int(np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1]))
+    if area2 == 0:
+        return "it is not convex: it crosses itself"
     e = np.roll(p, -1, axis=0) - p
     f = np.roll(e, -1, axis=0)
     cross = e[:, 0] * f[:, 1] - e[:, 1] * f[:, 0]
     dot = e[:, 0] * f[:, 0] + e[:, 1] * f[:, 1]
     back = np.nonzero((cross == 0) & (dot < 0))[0]
     if back.shape[0]:
-        return "it turns back along its own edge"
+        return "it is not convex: it turns back along its own edge"
     if np.any(cross > 0) and np.any(cross < 0):
-        return "it is not convex (it turns both ways)"
+        return "it is not convex: it turns both ways"
     turning = float(np.sum(np.arctan2(cross.astype(np.float64), dot.astype(np.float64))))
     if abs(turning) > 3.0 * math.pi:
-        return "it is not convex (it winds around more than once)"
+        return "it is not convex: it winds around more than once"
     return None
 
 
@@ -553,13 +555,16 @@ class _Reader:
             raise self.error(node, f"{what} must be at most {_fmt(hi)}{unit}, not {_fmt(v)}")
         return v
 
-    def integer(self, node, what: str, *, lo=None, hi=None, unit="") -> int:
-        """A whole number (a float with no fraction counts) in [lo, hi]."""
+    def integer(self, node, what: str, *, lo=None, hi=None, of="", unit="") -> int:
+        """A whole number (a float with no fraction counts) in [lo, hi].
+
+        `of` completes "a whole number" in messages (" of pixels"), `unit` follows the bounds.
+        """
         v = self.scalar(node, what)
         if isinstance(v, float) and math.isfinite(v) and v.is_integer():
             v = int(v)
         if not _is_number(v) or not isinstance(v, int):
-            raise self.error(node, f"{what} must be a whole number{unit}, not {_describe(node)}")
+            raise self.error(node, f"{what} must be a whole number{of}, not {_describe(node)}")
         if lo is not None and v < lo:
             raise self.error(node, f"{what} must be at least {lo}{unit}, not {v}")
         if hi is not None and v > hi:
@@ -684,7 +689,7 @@ class _Reader:
                 side[key] = default
                 continue
             node = m[key][1]
-            v = self.integer(node, f"world.{key}", lo=1, unit=" of pixels")
+            v = self.integer(node, f"world.{key}", lo=1, of=" of pixels", unit=" px")
             if v > self.limits.max_side:
                 raise self.error(
                     node,
@@ -696,16 +701,17 @@ class _Reader:
         fps_node = m["fps"][1] if "fps" in m else None
         fps = DEFAULT_FPS
         if fps_node is not None:
-            fps = self.integer(fps_node, "world.fps", lo=1, hi=MAX_FPS, unit=" of ticks per second")
+            fps = self.integer(fps_node, "world.fps", lo=1, hi=MAX_FPS, of=" of ticks per second")
         if "fps" in self.overrides:
             v = self.overrides["fps"]
-            self.fps_from = f"--fps {v}"
+            origin = f"--fps {v}"
             if isinstance(v, bool) or not isinstance(v, int) or not 1 <= v <= MAX_FPS:
                 raise self.error(
                     fps_node,
-                    f"{self.fps_from}: fps must be a whole number of ticks "
-                    f"per second from 1 to {MAX_FPS}",
+                    f"{origin}: fps must be a whole number of ticks per second from 1 to {MAX_FPS}",
                 )
+            if v != fps:
+                self.fps_from = origin
             fps = v
         background = DEFAULT_BACKGROUND
         if "background" in m:
@@ -742,54 +748,52 @@ class _Reader:
                 kind = self.choice(node, "model", MODEL_NAMES)
         if "model" in self.overrides:
             v = self.overrides["model"]
-            self.model_from = f"--model {v}"
+            origin = f"--model {v}"
             if not isinstance(v, str) or v not in MODEL_NAMES:
                 near = difflib.get_close_matches(str(v), MODEL_NAMES, n=1)
                 hint = (
                     f"did you mean '{near[0]}'?" if near else "expected " + " | ".join(MODEL_NAMES)
                 )
-                raise self.error(None, f"{self.model_from}: unknown model {v!r}; {hint}")
+                raise self.error(None, f"{origin}: unknown model {v!r}; {hint}")
             if v != kind:
+                self.model_from = origin
                 kind, substeps, geometry = v, 1, None
         if geometry is None:
             geometry = "exact" if kind == "exact" else "box"
         return kind, substeps, geometry
 
     def ticks(self, top: dict, fps: int) -> int:
+        """Ticks from `ticks`, `duration` (at the fps in force) or the default, then --ticks."""
         limit = self.limits.max_ticks
         raise_it = "raise it with --max-ticks"
+        overridden = "ticks" in self.overrides
         if "ticks" in top and "duration" in top:
             raise self.error(top["duration"][0], "give either 'ticks' or 'duration', not both")
+        ticks = 0
         if "ticks" in top:
             node = top["ticks"][1]
             ticks = self.integer(node, "ticks", lo=0)
-            if ticks > limit:
+            if ticks > limit and not overridden:
                 raise self.error(
                     node, f"ticks {ticks} is past the limit of {limit} ticks; {raise_it}"
                 )
         else:
             node = top["duration"][1] if "duration" in top else None
+            seconds = DEFAULT_DURATION
             if node is not None:
                 seconds = self.number(node, "duration", lo=0, unit=" s")
-            else:
-                seconds = DEFAULT_DURATION
             exact = Fraction(seconds) if isinstance(seconds, int) else Fraction(repr(seconds))
             ticks_exact = math.floor(exact * fps + Fraction(1, 2))
-            if ticks_exact > limit:
-                said = (
-                    f"duration {_fmt(seconds)} s"
-                    if node is not None
-                    else (f"the default duration of {DEFAULT_DURATION} s")
-                )
+            said = f"duration {_fmt(seconds)} s" if node is not None else "the default duration"
+            if ticks_exact > limit and not overridden:
                 raise self.error(
                     node,
-                    f"{self.prefix(self.fps_from)}{said} at {fps} fps is "
-                    f"{ticks_exact} ticks, past the limit of {limit} ticks; "
-                    f"{raise_it}",
+                    f"{self.prefix(self.fps_from)}{said} at {fps} fps is {ticks_exact} ticks, "
+                    f"past the limit of {limit} ticks; {raise_it}",
                 )
-            ticks = int(ticks_exact)
+            ticks = int(ticks_exact) if not overridden else 0
             self.ticks_from = self.fps_from
-        if "ticks" in self.overrides:
+        if overridden:
             v = self.overrides["ticks"]
             self.ticks_from = f"--ticks {v}"
             where = top["ticks"][1] if "ticks" in top else None
@@ -824,9 +828,9 @@ class _Reader:
             raise self.error(node, f"{self.prefix(self.model_from, self.fps_from)}{exc}") from None
 
     def size_of(self, shape: str, node, what: str) -> tuple[int, int]:
-        unit = " of pixels"
+        px = {"of": " of pixels", "unit": " px"}
         if shape == "circle":
-            d = self.integer(node, f"{what}.diameter", lo=1, unit=unit)
+            d = self.integer(node, f"{what}.diameter", lo=1, **px)
             return d, d
         if isinstance(node, yaml.SequenceNode):
             if len(node.value) != 2:
@@ -834,10 +838,10 @@ class _Reader:
                     node,
                     f"{what}.size must be one number or [w, h], not a list of {len(node.value)}",
                 )
-            w = self.integer(node.value[0], f"{what}.size w", lo=1, unit=unit)
-            h = self.integer(node.value[1], f"{what}.size h", lo=1, unit=unit)
+            w = self.integer(node.value[0], f"{what}.size w", lo=1, **px)
+            h = self.integer(node.value[1], f"{what}.size h", lo=1, **px)
             return w, h
-        s = self.integer(node, f"{what}.size", lo=1, unit=unit)
+        s = self.integer(node, f"{what}.size", lo=1, **px)
         return s, s
 
     def shape_of(self, m: dict, node, what: str, shapes: tuple[str, ...]) -> str:
@@ -901,7 +905,14 @@ class _Reader:
                     )
                 pts.append(
                     [
-                        self.integer(n, f"{what}.points[{k}] {axis}", unit=" of pixels")
+                        self.integer(
+                            n,
+                            f"{what}.points[{k}] {axis}",
+                            lo=-MAX_POINT_OFFSET,
+                            hi=MAX_POINT_OFFSET,
+                            of=" of pixels",
+                            unit=" px",
+                        )
                         for n, axis in zip(pair, "xy", strict=True)
                     ]
                 )
@@ -915,8 +926,8 @@ class _Reader:
                 if problem is not None:
                     raise self.error(
                         pnode,
-                        f"{self.prefix(self.model_from)}{what}: with geometry "
-                        f"'exact' a polygon must be convex, and {problem}",
+                        f"{self.prefix(self.model_from)}{what}.points: under geometry "
+                        f"'exact' a polygon must be convex with some area, but {problem}",
                     )
         else:
             size = self.size_of(shape, m[_SIZE_KEY[shape]][1], what)
@@ -1110,7 +1121,7 @@ class _Reader:
             m = self.mapping(node, what, EVERY_KEYS)
             if "every" not in m:
                 raise self.error(node, f"{what} as a mapping must be {{every: k}}")
-            k = self.integer(m["every"][1], f"{what}.every", lo=1, unit=" of ticks")
+            k = self.integer(m["every"][1], f"{what}.every", lo=1, of=" of ticks")
             n = ticks // k + 1
             if n > self.limits.max_frames:
                 raise self.error(node, too_many.format(n=n))

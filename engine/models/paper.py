@@ -98,19 +98,23 @@ def _record(ev, n_ev, tick, kind, a, b, code, xdiff, ydiff):
 
 
 @njit(cache=True, inline="always")
-def _move(pos, step, period, count, disp):
-    """Counters rise by one; a component whose counter reaches its period moves by its step."""
+def _move(pos, step, period, count, disp, anchor):
+    """Counters rise by one; a component whose counter reaches its period moves by its step.
+
+    Returns how far (px, largest over objects and axes) anything now is from `anchor`.
+    """
+    drift = 0
     for i in range(pos.shape[0]):
         for ax in range(2):
             c = count[i, ax] + 1
-            if c >= period[i, ax]:
-                count[i, ax] = 0
-                d = step[i, ax]
-                pos[i, ax] += d
-                disp[i, ax] = d
-            else:
-                count[i, ax] = c
-                disp[i, ax] = 0
+            fire = c >= period[i, ax]
+            count[i, ax] = 0 if fire else c
+            d = step[i, ax] if fire else 0
+            p = pos[i, ax] + d
+            pos[i, ax] = p
+            disp[i, ax] = d
+            drift = max(drift, abs(p - anchor[i, ax]))
+    return drift
 
 
 @njit(cache=True, inline="always")
@@ -213,15 +217,6 @@ def _sort_keys(keys):
 
 
 @njit(cache=True, inline="always")
-def _drifted(pos, anchor, margin):
-    """True when some object is `margin` px or more from where the candidate list was made."""
-    for i in range(pos.shape[0]):
-        if abs(pos[i, 0] - anchor[i, 0]) >= margin or abs(pos[i, 1] - anchor[i, 1]) >= margin:
-            return True
-    return False
-
-
-@njit(cache=True, inline="always")
 def _pairs(pos, size, step, disp, cand, n_cand, tick, log, ev, n_ev):
     """The flip rule on every overlapping candidate pair, in (a, b) order (SPEC 3.1)."""
     for c in range(n_cand):
@@ -266,14 +261,15 @@ def _run(pos, size, step, period, count, movable, limit, tick0, nticks, log, can
     for k in range(nticks):
         tick = tick0 + k + 1
         # move: counters fire, this tick's displacement is kept to be taken back
-        _move(pos, step, period, count, disp)
+        drift = _move(pos, step, period, count, disp, anchor)
         # walls: reverse and take back what left the world moving outward
         if log and n_ev + 2 * n > ev.shape[0]:
             ev = _grow(ev, n_ev + 2 * n)
         n_ev = _walls(pos, size, step, disp, limit, tick, log, ev, n_ev)
-        # pairs: the candidate list (made anew once anything drifted a margin), then the flip
+        # pairs: the candidate list (made anew once anything drifted a margin from where it was
+        # made; drift measured before the walls took steps back, which only errs early), then the flip
         # rule on every overlapping pair in (a, b) order
-        if state[0] < 0 or _drifted(pos, anchor, margin):
+        if state[0] < 0 or drift >= margin:
             state[0] = _candidates(pos, size, disp, movable, margin, order, lo, hi, keys)
             if state[0] > keys.shape[0]:
                 keys = np.empty(2 * state[0], np.int64)
