@@ -1,0 +1,196 @@
+"""The `collide2d` command line: one test per option of `run`, exit codes, located errors, and
+nothing written for a refused scenario."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import imageio.v3 as iio
+import numpy as np
+import pytest
+
+from runner.cli import demo_path, main
+
+ROOT = Path(__file__).resolve().parents[2]
+SCENARIOS = ROOT / "scenarios"
+TUNNEL = str(SCENARIOS / "tunnelling_10fps.yaml")
+
+
+def run(args):
+    return main(["run", *map(str, args)])
+
+
+def files(folder: Path) -> set[str]:
+    return {str(p.relative_to(folder)) for p in folder.rglob("*") if p.is_file()}
+
+
+def test_no_argument_runs_the_bundled_demo_and_writes_its_gif(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert run([]) == 0
+    folder = tmp_path / "out" / "paper_fifty_boxes"
+    gif = iio.imread(folder / "animation.gif", index=None)
+    assert gif.shape[0] == 101  # frames 0..100 at 10 fps
+    assert "paper_fifty_boxes" in capsys.readouterr().out
+
+
+def test_the_bundled_demo_is_the_scenario_in_the_corpus():
+    assert Path(demo_path()).read_bytes() == (SCENARIOS / "paper_fifty_boxes.yaml").read_bytes()
+
+
+def test_out_names_the_folder(tmp_path):
+    assert run([TUNNEL, "--out", tmp_path / "elsewhere", "--quiet"]) == 0
+    assert (tmp_path / "elsewhere" / "tunnelling_10fps" / "final.csv").is_file()
+
+
+def test_gif_and_no_gif(tmp_path):
+    run([TUNNEL, "--out", tmp_path, "--no-gif", "--quiet"])
+    assert not (tmp_path / "tunnelling_10fps" / "animation.gif").exists()
+    run([TUNNEL, "--out", tmp_path, "--gif", "--quiet"])
+    assert (tmp_path / "tunnelling_10fps" / "animation.gif").is_file()
+
+
+def test_png_writes_the_scenarios_frames_and_no_png_none(tmp_path):
+    run([TUNNEL, "--out", tmp_path, "--png", "--quiet"])
+    frames = sorted(p.name for p in (tmp_path / "tunnelling_10fps" / "frames").iterdir())
+    assert frames == [f"frame_{k:06d}.png" for k in range(0, 121, 10)]  # output.frames every 10
+    run([TUNNEL, "--out", tmp_path, "--no-png", "--quiet"])
+    assert list((tmp_path / "tunnelling_10fps" / "frames").glob("*.png")) == []
+
+
+def test_png_on_a_scenario_that_asks_for_no_frames_writes_them_all(tmp_path):
+    src = (SCENARIOS / "tunnelling_1fps.yaml").read_text().replace("frames: all", "frames: none")
+    path = tmp_path / "t1.yaml"
+    path.write_text(src)
+    run([path, "--out", tmp_path, "--png", "--quiet"])
+    assert len(list((tmp_path / "tunnelling_1fps" / "frames").glob("*.png"))) == 13
+
+
+def test_events_and_no_events(tmp_path):
+    run([TUNNEL, "--out", tmp_path, "--no-events", "--quiet"])
+    assert not (tmp_path / "tunnelling_10fps" / "events.jsonl").exists()
+    run([TUNNEL, "--out", tmp_path, "--events", "--quiet"])
+    lines = (tmp_path / "tunnelling_10fps" / "events.jsonl").read_text().splitlines()
+    first = json.loads(lines[0])
+    assert first == {"tick": 51, "t": 5.1, "type": "pair", "a": 0, "b": 1, "axis": "x",
+                     "xdiff": 2, "ydiff": 10}
+
+
+def test_fps_changes_the_outcome_tunnelling_at_1_fps(tmp_path):
+    run([TUNNEL, "--out", tmp_path, "--fps", "1", "--ticks", "12", "--quiet"])
+    summary = json.loads((tmp_path / "tunnelling_10fps" / "summary.json").read_text())
+    assert summary["fps"] == 1 and summary["ticks"] == 12
+    assert summary["events"]["pair"] == 0
+
+
+def test_ticks_sets_the_length(tmp_path):
+    run([TUNNEL, "--out", tmp_path, "--ticks", "30", "--quiet"])
+    summary = json.loads((tmp_path / "tunnelling_10fps" / "summary.json").read_text())
+    assert summary["ticks"] == 30
+    rows = (tmp_path / "tunnelling_10fps" / "final.csv").read_text().splitlines()
+    assert rows[0] == "id,x,y,vx,vy"
+    assert rows[1].split(",")[:2] == ["130", "115"]  # 100 + 30 px
+
+
+def test_model_is_checked_again_under_the_new_model(tmp_path, capsys):
+    code = run([TUNNEL, "--out", tmp_path, "--model", "paper", "--fps", "3", "--quiet"])
+    assert code == 2
+    err = capsys.readouterr().err
+    assert "tunnelling_10fps.yaml:" in err and "error:" in err and "--fps 3" in err
+
+
+def test_scale_enlarges_png_and_gif(tmp_path):
+    run([TUNNEL, "--out", tmp_path, "--png", "--scale", "3", "--quiet"])
+    png = iio.imread(tmp_path / "tunnelling_10fps" / "frames" / "frame_000000.png")
+    assert png.shape == (720, 960, 3)
+    gif = iio.imread(tmp_path / "tunnelling_10fps" / "animation.gif", index=0)
+    assert gif.shape[:2] == (720, 960)
+
+
+def test_quiet_prints_nothing(tmp_path, capsys):
+    run([TUNNEL, "--out", tmp_path, "--quiet"])
+    captured = capsys.readouterr()
+    assert captured.out == "" and captured.err == ""
+
+
+@pytest.mark.parametrize(
+    "flag, value, needle",
+    [("--max-objects", 1, "objects"), ("--max-ticks", 10, "ticks"), ("--max-side", 100, "side"),
+     ("--max-output-bytes", 1000, "output")],
+)
+def test_limits_refuse_with_exit_2_and_write_nothing(tmp_path, capsys, flag, value, needle):
+    code = run([TUNNEL, "--out", tmp_path, flag, value, "--quiet"])
+    assert code == 2
+    err = capsys.readouterr().err
+    assert "error:" in err and needle in err
+    assert files(tmp_path) == set()
+
+
+def test_a_bad_scenario_is_refused_with_its_location_and_nothing_written(tmp_path, capsys):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("version: 1\nworld: {width: 100, height: 100}\nobjects:\n"
+                   "  - {shape: box, size: 10, position: [0, 0], velocty: [1, 0]}\n")
+    out = tmp_path / "out"
+    assert run([bad, "--out", out]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"{bad}:4:")
+    assert "velocity" in err  # the near spelling
+    assert not out.exists()
+
+
+def test_unknown_option_is_a_usage_error():
+    with pytest.raises(SystemExit) as exc:
+        main(["run", "--frobnicate"])
+    assert exc.value.code == 2
+
+
+def test_same_scenario_same_bytes(tmp_path):
+    for name in ("a", "b"):
+        run([SCENARIOS / "shapes_showcase.yaml", "--out", tmp_path / name, "--png", "--quiet"])
+    a, b = tmp_path / "a" / "shapes_showcase", tmp_path / "b" / "shapes_showcase"
+    assert files(a) == files(b)
+    for rel in files(a) - {"summary.json"}:
+        assert (a / rel).read_bytes() == (b / rel).read_bytes(), rel
+    sa, sb = (json.loads((d / "summary.json").read_text()) for d in (a, b))
+    sa.pop("run_time_s"), sb.pop("run_time_s")
+    assert sa == sb
+
+
+def test_python_dash_m_runner_is_the_same_command(tmp_path):
+    proc = subprocess.run(
+        [sys.executable, "-m", "runner", "run", TUNNEL, "--out", str(tmp_path), "--quiet",
+         "--no-gif"],
+        capture_output=True, text=True, cwd=ROOT,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert (tmp_path / "tunnelling_10fps" / "final.csv").is_file()
+
+
+def test_a_rerun_with_fewer_outputs_leaves_only_its_own(tmp_path):
+    run([TUNNEL, "--out", tmp_path, "--png", "--quiet"])
+    run([TUNNEL, "--out", tmp_path, "--no-png", "--no-gif", "--no-events", "--quiet"])
+    assert files(tmp_path / "tunnelling_10fps") == {"final.csv", "summary.json"}
+
+
+def test_output_folder_that_is_a_link_is_refused(tmp_path, capsys):
+    target = tmp_path / "outside"
+    target.mkdir()
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "tunnelling_10fps").symlink_to(target, target_is_directory=True)
+    assert run([TUNNEL, "--out", out, "--quiet"]) == 2
+    assert "symbolic link" in capsys.readouterr().err
+    assert list(target.iterdir()) == []
+
+
+@pytest.mark.parametrize("path", sorted(SCENARIOS.glob("*.yaml")), ids=lambda p: p.stem)
+def test_every_scenario_runs_end_to_end(tmp_path, path):
+    assert run([path, "--out", tmp_path, "--png", "--quiet"]) == 0
+    folder = next(tmp_path.iterdir())
+    summary = json.loads((folder / "summary.json").read_text())
+    final = np.loadtxt(folder / "final.csv", delimiter=",", skiprows=1, ndmin=2)
+    assert final.shape[0] == summary["objects"]
+    assert np.isfinite(final).all()
+    assert (folder / "animation.gif").is_file() and list((folder / "frames").glob("*.png"))
