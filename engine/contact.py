@@ -396,58 +396,48 @@ def rounded_penetration(core, cnorm, s, cx, cy, r, qx, qy):
 
 
 # --- any pair ---------------------------------------------------------------------------------
+# A pair's shapes are passed as (kind, w, h, r, core, cnorm) for each object: the shape kind from
+# shapes.Cores, the box size (px), the radius (px) and the core's vertices and unit normals
+# (relative to the object's top-left corner). Box pairs need no arrays: see box_next_contact.
 
 
 @njit(cache=True)
-def _rounded_frame(a, b, shape, radius, start, verts):
-    """For a pair with at least one circle: M = c + s·core ⊕ disc(r). Returns (k, s, cx, cy, r),
-    k the object whose core is P's (the non-circle, or B for two circles)."""
-    if shape[a] == KIND_CIRCLE:
+def _rounded_frame(ka, ra, va, na, rb, vb, nb):
+    """For a pair with at least one circle: M = c + s·core ⊕ disc(r). Returns
+    (core, cnorm, s, cx, cy, r): P's core is the non-circle's (or B's for two circles)."""
+    if ka == KIND_CIRCLE:
         # M = {centre_A} ⊕ (-core_B) ⊕ disc(r_A + r_B)
-        ca = start[a]
-        return b, -1.0, verts[ca, 0], verts[ca, 1], radius[a] + radius[b]
-    cb = start[b]
-    return a, 1.0, -verts[cb, 0], -verts[cb, 1], radius[b]
+        return vb, nb, -1.0, va[0, 0], va[0, 1], ra + rb
+    # M = core_A ⊕ {-centre_B} ⊕ disc(r_B)
+    return va, na, 1.0, -vb[0, 0], -vb[0, 1], rb
 
 
 @njit(cache=True)
-def sweep(a, b, qx, qy, ux, uy, shape, size, radius, start, verts, normals):
-    """Objects a and b (Cores arrays) on the line q + u t: (t_enter, t_exit, code, nx, ny).
+def sweep(qx, qy, ux, uy, ka, wa, ha, ra, va, na, kb, wb, hb, rb, vb, nb):
+    """A and B on the line q + u t: (t_enter, t_exit, code, nx, ny).
 
     Overlap of positive area exactly for t_enter < t < t_exit (relative seconds); the contact at
-    t_enter has normal n from a to b.
+    t_enter has normal n from A to B.
     """
-    if shape[a] == KIND_BOX and shape[b] == KIND_BOX:
-        return box_sweep(qx, qy, ux, uy, size[a, 0], size[a, 1], size[b, 0], size[b, 1])
-    if shape[a] == KIND_CIRCLE or shape[b] == KIND_CIRCLE:
-        k, s, cx, cy, r = _rounded_frame(a, b, shape, radius, start, verts)
-        core = verts[start[k] : start[k + 1]]
-        cnorm = normals[start[k] : start[k + 1]]
+    if ka == KIND_BOX and kb == KIND_BOX:
+        return box_sweep(qx, qy, ux, uy, wa, ha, wb, hb)
+    if ka == KIND_CIRCLE or kb == KIND_CIRCLE:
+        core, cnorm, s, cx, cy, r = _rounded_frame(ka, ra, va, na, rb, vb, nb)
         return rounded_sweep(core, cnorm, s, cx, cy, r, qx, qy, ux, uy)
-    va = verts[start[a] : start[a + 1]]
-    na = normals[start[a] : start[a + 1]]
-    vb = verts[start[b] : start[b + 1]]
-    nb = normals[start[b] : start[b + 1]]
     return polygon_sweep(va, na, vb, nb, qx, qy, ux, uy)
 
 
 @njit(cache=True)
-def penetration(a, b, qx, qy, shape, size, radius, start, verts, normals):
-    """Minimum-penetration contact of objects a and b at offset q: (depth, code, nx, ny).
+def penetration(qx, qy, ka, wa, ha, ra, va, na, kb, wb, hb, rb, vb, nb):
+    """Minimum-penetration contact of A and B at offset q: (depth, code, nx, ny).
 
-    depth > 0 exactly when their shapes overlap with positive area; the normal runs from a to b.
+    depth > 0 exactly when their shapes overlap with positive area; the normal runs from A to B.
     """
-    if shape[a] == KIND_BOX and shape[b] == KIND_BOX:
-        return box_penetration(qx, qy, size[a, 0], size[a, 1], size[b, 0], size[b, 1])
-    if shape[a] == KIND_CIRCLE or shape[b] == KIND_CIRCLE:
-        k, s, cx, cy, r = _rounded_frame(a, b, shape, radius, start, verts)
-        core = verts[start[k] : start[k + 1]]
-        cnorm = normals[start[k] : start[k + 1]]
+    if ka == KIND_BOX and kb == KIND_BOX:
+        return box_penetration(qx, qy, wa, ha, wb, hb)
+    if ka == KIND_CIRCLE or kb == KIND_CIRCLE:
+        core, cnorm, s, cx, cy, r = _rounded_frame(ka, ra, va, na, rb, vb, nb)
         return rounded_penetration(core, cnorm, s, cx, cy, r, qx, qy)
-    va = verts[start[a] : start[a + 1]]
-    na = normals[start[a] : start[a + 1]]
-    vb = verts[start[b] : start[b + 1]]
-    nb = normals[start[b] : start[b + 1]]
     return polygon_penetration(va, na, vb, nb, qx, qy)
 
 
@@ -460,21 +450,46 @@ def approaching(code, nx, ny, ux, uy):
     return ux * nx + uy * ny < 0.0
 
 
+@njit(cache=True, inline="always")
+def _decide(t_enter, t_exit):
+    """The exact model's rules on a sweep: 1 = contact at t_enter (>= 0, touching now included),
+    0 = none (never, or already leaving), -1 = overlapping now: ask whether they approach."""
+    if not t_enter < t_exit or t_exit <= 0.0:
+        return 0
+    if t_enter >= 0.0:
+        return 1
+    return -1
+
+
+@njit(cache=True, inline="always")
+def box_next_contact(qx, qy, ux, uy, wa, ha, wb, hb):
+    """next_contact for two boxes, on scalars alone."""
+    t_enter, t_exit, code, nx, ny = box_sweep(qx, qy, ux, uy, wa, ha, wb, hb)
+    rule = _decide(t_enter, t_exit)
+    if rule == 1:
+        return t_enter, code, nx, ny
+    if rule == -1:
+        depth, code, nx, ny = box_penetration(qx, qy, wa, ha, wb, hb)
+        if approaching(code, nx, ny, ux, uy):
+            return 0.0, code, nx, ny
+    return INF, code, nx, ny
+
+
 @njit(cache=True)
-def next_contact(a, b, qx, qy, ux, uy, shape, size, radius, start, verts, normals):
-    """The exact model's next contact of a and b: (t, code, nx, ny), t in seconds from now, inf
+def next_contact(qx, qy, ux, uy, ka, wa, ha, ra, va, na, kb, wb, hb, rb, vb, nb):
+    """The exact model's next contact of A and B: (t, code, nx, ny), t in seconds from now, inf
     when none. Robust rules: touching or overlapping and approaching collide now (t = 0);
     overlapping and separating give nothing (the line leaves M and, M being convex, never comes
     back); a contact is never in the past.
     """
     t_enter, t_exit, code, nx, ny = sweep(
-        a, b, qx, qy, ux, uy, shape, size, radius, start, verts, normals
+        qx, qy, ux, uy, ka, wa, ha, ra, va, na, kb, wb, hb, rb, vb, nb
     )
-    if not t_enter < t_exit or t_exit <= 0.0:
-        return INF, code, nx, ny
-    if t_enter >= 0.0:
+    rule = _decide(t_enter, t_exit)
+    if rule == 1:
         return t_enter, code, nx, ny
-    depth, code, nx, ny = penetration(a, b, qx, qy, shape, size, radius, start, verts, normals)
-    if approaching(code, nx, ny, ux, uy):
-        return 0.0, code, nx, ny
+    if rule == -1:
+        depth, code, nx, ny = penetration(qx, qy, ka, wa, ha, ra, va, na, kb, wb, hb, rb, vb, nb)
+        if approaching(code, nx, ny, ux, uy):
+            return 0.0, code, nx, ny
     return INF, code, nx, ny

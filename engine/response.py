@@ -27,39 +27,33 @@ from engine.events import AXIS_XY
 MAX_FOLDS_PER_STEP = 1000
 
 
-@njit(cache=True)
-def exchange_along(vel, a, b, wa, wb, nx, ny):
-    """Elastic exchange of a and b along the unit normal n (from a to b), in place.
+@njit(cache=True, inline="always")
+def exchange_along(vax, vay, vbx, vby, wa, wb, nx, ny):
+    """Elastic exchange of a and b along the unit normal n (from a to b).
 
-    vel (n, 2) px/s; wa, wb inverse masses (not both 0). Returns True when they were approaching
-    along n and the exchange was made, False (and no change) otherwise.
+    v* px/s; wa, wb inverse masses (not both 0). Returns (vax, vay, vbx, vby, changed): the new
+    velocities, and changed = True when they were approaching along n (otherwise no change).
     """
-    u = (vel[b, 0] - vel[a, 0]) * nx + (vel[b, 1] - vel[a, 1]) * ny
+    u = (vbx - vax) * nx + (vby - vay) * ny
     if not u < 0.0:
-        return False
-    ra = wa / (wa + wb)
-    rb = wb / (wa + wb)
-    ja = 2.0 * u * ra
-    jb = 2.0 * u * rb
-    vel[a, 0] += ja * nx
-    vel[a, 1] += ja * ny
-    vel[b, 0] -= jb * nx
-    vel[b, 1] -= jb * ny
-    return True
+        return vax, vay, vbx, vby, False
+    ja = 2.0 * u * (wa / (wa + wb))
+    jb = 2.0 * u * (wb / (wa + wb))
+    return vax + ja * nx, vay + ja * ny, vbx - jb * nx, vby - jb * ny, True
 
 
-@njit(cache=True)
-def exchange(vel, a, b, wa, wb, code, nx, ny):
-    """The elastic response to a contact (code, nx, ny) from contact.py, in place.
+@njit(cache=True, inline="always")
+def exchange(vax, vay, vbx, vby, wa, wb, code, nx, ny):
+    """The elastic response to a contact (code, nx, ny) from contact.py.
 
     AXIS_XY: a 1-D exchange on x (sign nx) and on y (sign ny), each where approaching. Otherwise
-    one exchange along the unit normal. Returns True when any velocity changed.
+    one exchange along the unit normal. Returns (vax, vay, vbx, vby, changed).
     """
     if code == AXIS_XY:
-        done_x = exchange_along(vel, a, b, wa, wb, nx, 0.0)
-        done_y = exchange_along(vel, a, b, wa, wb, 0.0, ny)
-        return done_x or done_y
-    return exchange_along(vel, a, b, wa, wb, nx, ny)
+        vax, vay, vbx, vby, done_x = exchange_along(vax, vay, vbx, vby, wa, wb, nx, 0.0)
+        vax, vay, vbx, vby, done_y = exchange_along(vax, vay, vbx, vby, wa, wb, 0.0, ny)
+        return vax, vay, vbx, vby, done_x or done_y
+    return exchange_along(vax, vay, vbx, vby, wa, wb, nx, ny)
 
 
 @njit(cache=True)

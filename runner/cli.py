@@ -12,11 +12,18 @@ import argparse
 import sys
 from importlib import resources
 
-from engine.models import MODEL_NAMES, ModelUnavailable
+from engine.models import ModelUnavailable
 from runner import validate
 from runner.golden import cli as golden_cli
+from runner.options import (
+    add_limit_arguments,
+    add_override_arguments,
+    limits_from_args,
+    overrides_from_args,
+    positive_int,
+)
 from runner.run import RunOptions, run_to_dir
-from runner.scenario import Limits, ScenarioError, load
+from runner.scenario import ScenarioError, load
 
 EXIT_OK = 0
 EXIT_DIFFERENCE = 1
@@ -26,48 +33,6 @@ EXIT_BAD_INPUT = 2
 def demo_path() -> str:
     """The bundled scenario of the paper's section IV: 50 boxes, 10x10, 10 px/s, 10 fps."""
     return str(resources.files("runner") / "data" / "paper_fifty_boxes.yaml")
-
-
-def add_limit_options(parser: argparse.ArgumentParser) -> None:
-    """--max-objects, --max-ticks, --max-side, --max-output-bytes (SPEC section 8)."""
-    defaults = Limits()
-    group = parser.add_argument_group("limits")
-    group.add_argument("--max-objects", type=_positive_int, default=defaults.max_objects,
-                       metavar="N", help=f"most objects allowed (default {defaults.max_objects:,})")
-    group.add_argument("--max-ticks", type=_positive_int, default=defaults.max_ticks,
-                       metavar="N", help=f"most ticks allowed (default {defaults.max_ticks:,})")
-    group.add_argument("--max-side", type=_positive_int, default=defaults.max_side, metavar="PX",
-                       help=f"largest world side in px (default {defaults.max_side:,})")
-    group.add_argument("--max-output-bytes", type=_positive_int,
-                       default=defaults.max_output_bytes, metavar="BYTES",
-                       help=f"bound on frame output (default {defaults.max_output_bytes:,})")
-
-
-def limits_from(args: argparse.Namespace) -> Limits:
-    return Limits(
-        max_objects=args.max_objects, max_ticks=args.max_ticks, max_side=args.max_side,
-        max_output_bytes=args.max_output_bytes,
-    )
-
-
-def _positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {value}")
-    return value
-
-
-def _count(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got {value}")
-    return value
 
 
 def register_run(subparsers) -> None:
@@ -86,22 +51,18 @@ def register_run(subparsers) -> None:
                    "none (default: only if output.frames asks for some)")
     p.add_argument("--events", action=argparse.BooleanOptionalAction, default=None,
                    help="write events.jsonl (default: the scenario's output.events)")
-    p.add_argument("--model", choices=MODEL_NAMES, help="run under this model instead")
-    p.add_argument("--fps", type=_positive_int, help="ticks per second instead of world.fps")
-    p.add_argument("--ticks", type=_count, help="run this many ticks instead")
-    p.add_argument("--scale", type=_positive_int, default=1, metavar="K",
+    add_override_arguments(p)
+    p.add_argument("--scale", type=positive_int, default=1, metavar="K",
                    help="enlarge PNG and GIF frames K times, nearest neighbour (default 1)")
     p.add_argument("--quiet", action="store_true", help="no progress bar, no notes")
-    add_limit_options(p)
+    add_limit_arguments(p, output=True)
     p.set_defaults(func=cmd_run)
 
 
 def cmd_run(args: argparse.Namespace) -> int:
     path = args.scenario or demo_path()
-    overrides = {k: getattr(args, k) for k in ("model", "fps", "ticks") if getattr(args, k)
-                 is not None}
-    limits = limits_from(args)
-    scenario = load(path, overrides=overrides, limits=limits)
+    limits = limits_from_args(args)
+    scenario = load(path, overrides=overrides_from_args(args), limits=limits)
     out = scenario.output
     options = RunOptions(
         png=bool(out.frames) if args.png is None else args.png,

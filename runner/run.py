@@ -179,7 +179,7 @@ def check_output_size(scenario: Scenario, options: RunOptions, limits: Limits) -
 
 
 def png_frames(scenario: Scenario) -> tuple[int, ...]:
-    """The frames written as PNG when PNGs are on: the scenario's choice, or all if it chose none."""
+    """The frames written as PNG when PNGs are on: the scenario's choice, or all if none."""
     if scenario.output.frames:
         return scenario.output.frames
     return tuple(range(scenario.ticks + 1))

@@ -20,6 +20,12 @@ addition: an unquoted number in exponent form such as `1e3` or `1.5E-7`, a strin
 read as the number YAML 1.2 and JSON make of it. `<<` merge keys work as in YAML 1.1. A whole number
 may be written as a float (`10.0`) wherever an integer is asked for, as in JSON Schema.
 
+Time is counted in ticks: `world.fps` is a whole number of ticks per simulated second (1 to
+`MAX_FPS`), `ticks` is given outright, or `duration` (seconds) becomes `duration * fps` ticks,
+rounded to the nearest whole tick with halves up and computed exactly from the decimal as written
+(`0.05` s at 10 fps is 1 tick); with neither, `DEFAULT_DURATION` seconds. A scenario without a
+`name` takes its file's stem (text read by `loads` without a path is named `NAME_FOR_TEXT`).
+
 Every value in the file must be valid on its own. The overrides then replace values (`model`
 replaces the file's whole `model` entry unless it names the same kind, whose settings are kept;
 `fps` replaces `world.fps`, so a `duration` is counted again in ticks; `ticks` replaces `ticks` and
@@ -1058,7 +1064,7 @@ class _Reader:
                     raise self.error(
                         vnode,
                         f"{what}.velocity: min {'xy'[axis]} "
-                        f"{_fmt(ends[0][axis])} is more than max "
+                        f"{_fmt(ends[0][axis])} is more than max {'xy'[axis]} "
                         f"{_fmt(ends[1][axis])}",
                     )
             velocity_range = (ends[0], ends[1])
@@ -1106,6 +1112,8 @@ class _Reader:
             given = []
             for item in node.value:
                 f = self.integer(item, f"{what} item", lo=0)
+                if f > ticks and self.ticks_from:
+                    continue  # the run was shortened from the command line: past its end
                 if f > ticks:
                     raise self.error(
                         item,

@@ -6,9 +6,6 @@ overrides a run would use and prints `PATH: ok (N objects, model M, T ticks)` on
 good file and the located error `PATH:LINE:COL: error: MESSAGE` on stderr for each bad one; the
 exit status is 2 when any file is bad, else 0. `schema` prints the scenario format's JSON Schema
 (draft 2020-12, indent 2) on stdout.
-
-The option helpers (`add_limit_arguments` / `limits_from_args`, `add_override_arguments` /
-`overrides_from_args`) let other commands take the same options the same way.
 """
 
 from __future__ import annotations
@@ -17,62 +14,16 @@ import argparse
 import json
 import sys
 
-from engine.models import MODEL_NAMES
-from runner.scenario import Limits, ScenarioError, json_schema, load
+from runner.options import (
+    add_limit_arguments,
+    add_override_arguments,
+    limits_from_args,
+    overrides_from_args,
+)
+from runner.scenario import ScenarioError, json_schema, load
 
 EXIT_OK = 0
 EXIT_BAD_INPUT = 2
-
-_LIMIT_OPTIONS = (
-    ("--max-objects", "max_objects", "objects in a scenario"),
-    ("--max-ticks", "max_ticks", "ticks of a run"),
-    ("--max-side", "max_side", "pixels per world side"),
-    ("--max-frames", "max_frames", "frame numbers one `frames` entry may ask for"),
-)
-
-
-def _positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{value} must be at least 1")
-    return value
-
-
-def add_limit_arguments(parser: argparse.ArgumentParser) -> None:
-    """Add --max-objects, --max-ticks, --max-side and --max-frames (defaults from Limits)."""
-    defaults = Limits()
-    for flag, field, what in _LIMIT_OPTIONS:
-        parser.add_argument(
-            flag,
-            dest=field,
-            type=_positive_int,
-            default=getattr(defaults, field),
-            metavar="N",
-            help=f"largest number of {what} (default {getattr(defaults, field)})",
-        )
-
-
-def limits_from_args(args: argparse.Namespace) -> Limits:
-    """The Limits asked for on the command line (defaults for options not present)."""
-    given = {f: getattr(args, f) for _, f, _ in _LIMIT_OPTIONS if getattr(args, f, None)}
-    return Limits(**given)
-
-
-def add_override_arguments(parser: argparse.ArgumentParser) -> None:
-    """Add --model, --fps and --ticks, which override the scenario file."""
-    parser.add_argument("--model", choices=MODEL_NAMES, help="model to use instead of the file's")
-    parser.add_argument(
-        "--fps", type=int, metavar="F", help="ticks per second instead of the file's"
-    )
-    parser.add_argument("--ticks", type=int, metavar="N", help="ticks to run instead of the file's")
-
-
-def overrides_from_args(args: argparse.Namespace) -> dict:
-    """{"model", "fps", "ticks"} from the command line; None where not given."""
-    return {key: getattr(args, key, None) for key in ("model", "fps", "ticks")}
 
 
 def run_validate(args: argparse.Namespace) -> int:

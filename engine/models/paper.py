@@ -169,11 +169,12 @@ def _sort_order(order, key, sorted_key):
 
 @njit(cache=True)
 def _candidates(pos, size, disp, movable, margin, order, lo, hi, cand):
-    """Pairs (a < b, as keys a << _KEY_SHIFT | b, ascending) whose reach boxes, grown by `margin` px on every
-    side, overlap; pairs of two immovable objects are left out.
+    """Pairs (a < b, as keys a << _KEY_SHIFT | b, ascending) whose reach boxes, grown by
+    `margin` px on every side, overlap; pairs of two immovable objects are left out.
 
-    lo: (3, n) and hi: (2, n) scratch for the reach boxes and the sorted x starts. Returns how many
-    candidates there are; only as many as `cand` holds are written (the caller grows and asks again).
+    lo: (3, n) and hi: (2, n) scratch for the reach boxes and the sorted x starts. Returns how
+    many candidates there are; only as many as `cand` holds are written (the caller grows the
+    buffer and asks again).
     """
     n = pos.shape[0]
     for i in range(n):
@@ -266,9 +267,9 @@ def _run(pos, size, step, period, count, movable, limit, tick0, nticks, log, can
         if log and n_ev + 2 * n > ev.shape[0]:
             ev = _grow(ev, n_ev + 2 * n)
         n_ev = _walls(pos, size, step, disp, limit, tick, log, ev, n_ev)
-        # pairs: the candidate list (made anew once anything drifted a margin from where it was
-        # made; drift measured before the walls took steps back, which only errs early), then the flip
-        # rule on every overlapping pair in (a, b) order
+        # pairs: the candidate list (made anew once anything drifted a margin from where it
+        # was made; drift is measured before the walls take steps back, which only errs early),
+        # then the flip rule on every overlapping pair in (a, b) order
         if state[0] < 0 or drift >= margin:
             state[0] = _candidates(pos, size, disp, movable, margin, order, lo, hi, keys)
             if state[0] > keys.shape[0]:

@@ -138,7 +138,13 @@ def _contact(a, b, pos, size, exact, shape, radius, start, verts, normals):
     qy = pos[b, 1] - pos[a, 1]
     if not exact:
         return box_overlap_axis(qx, qy, size[a, 0], size[a, 1], size[b, 0], size[b, 1])
-    depth, code, nx, ny = penetration(a, b, qx, qy, shape, size, radius, start, verts, normals)
+    depth, code, nx, ny = penetration(
+        qx, qy,
+        shape[a], size[a, 0], size[a, 1], radius[a],
+        verts[start[a] : start[a + 1]], normals[start[a] : start[a + 1]],
+        shape[b], size[b, 0], size[b, 1], radius[b],
+        verts[start[b] : start[b + 1]], normals[start[b] : start[b + 1]],
+    )  # fmt: skip
     return depth, depth, code, nx, ny
 
 
@@ -157,8 +163,12 @@ def _pairs(
         )
         if depth <= 0.0:
             continue
-        if not exchange(vel, a, b, inv_mass[a], inv_mass[b], code, nx, ny):
+        vax, vay, vbx, vby, changed = exchange(
+            vel[a, 0], vel[a, 1], vel[b, 0], vel[b, 1], inv_mass[a], inv_mass[b], code, nx, ny
+        )
+        if not changed:
             continue
+        vel[a, 0], vel[a, 1], vel[b, 0], vel[b, 1] = vax, vay, vbx, vby
         separate(
             pos, size, a, b, inv_mass[a], inv_mass[b], code, nx, ny, depth, depth_y, width, height
         )

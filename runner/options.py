@@ -1,0 +1,71 @@
+"""Command-line options shared by the commands that read scenarios (run, validate, check, bless).
+
+`add_limit_arguments` / `limits_from_args` carry SPEC section 8's bounds (`--max-objects`,
+`--max-ticks`, `--max-side`, `--max-frames`, and `--max-output-bytes` where frames are written);
+`add_override_arguments` / `overrides_from_args` carry `--model`, `--fps`, `--ticks`, which override
+the scenario file (the loader checks the result again).
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from engine.models import MODEL_NAMES
+from runner.scenario import Limits
+
+_LIMIT_OPTIONS = (
+    ("--max-objects", "max_objects", "objects in a scenario"),
+    ("--max-ticks", "max_ticks", "ticks of a run"),
+    ("--max-side", "max_side", "pixels per world side"),
+    ("--max-frames", "max_frames", "frame numbers one `frames` entry may ask for"),
+)
+_OUTPUT_OPTION = ("--max-output-bytes", "max_output_bytes", "bytes of frame output")
+
+
+def positive_int(text: str) -> int:
+    """argparse type: a whole number >= 1."""
+    value = whole(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{value} must be at least 1")
+    return value
+
+
+def whole(text: str) -> int:
+    """argparse type: a whole number (any sign; the loader judges the range)."""
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+
+
+def add_limit_arguments(parser: argparse.ArgumentParser, *, output: bool = False) -> None:
+    """Add the limit options (defaults from Limits); `output` adds --max-output-bytes too."""
+    defaults = Limits()
+    group = parser.add_argument_group("limits")
+    for flag, field, what in _LIMIT_OPTIONS + ((_OUTPUT_OPTION,) if output else ()):
+        group.add_argument(
+            flag,
+            dest=field,
+            type=positive_int,
+            default=getattr(defaults, field),
+            metavar="N",
+            help=f"largest number of {what} (default {getattr(defaults, field):,})",
+        )
+
+
+def limits_from_args(args: argparse.Namespace) -> Limits:
+    """The Limits asked for on the command line (defaults for options not present)."""
+    fields = [f for _, f, _ in _LIMIT_OPTIONS + (_OUTPUT_OPTION,)]
+    return Limits(**{f: getattr(args, f) for f in fields if getattr(args, f, None)})
+
+
+def add_override_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add --model, --fps and --ticks, which override the scenario file."""
+    parser.add_argument("--model", choices=MODEL_NAMES, help="model to use instead of the file's")
+    parser.add_argument("--fps", type=whole, metavar="F", help="ticks per second instead")
+    parser.add_argument("--ticks", type=whole, metavar="N", help="ticks to run instead")
+
+
+def overrides_from_args(args: argparse.Namespace) -> dict:
+    """{"model", "fps", "ticks"} from the command line; None where not given."""
+    return {key: getattr(args, key, None) for key in ("model", "fps", "ticks")}

@@ -1,0 +1,1377 @@
+"""Scenario loading: every refusal of SPEC sections 2 and 8 at its FILE:LINE:COL, and what loads."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import pickle
+import re
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from engine import motion
+from engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON
+from runner.scenario import (
+    TOP_KEYS,
+    Limits,
+    ScenarioError,
+    json_schema,
+    load,
+    loads,
+    polygon_problem,
+)
+
+DATA = Path(__file__).parent / "data"
+BASE = "version: 1\nworld: {width: 100, height: 80, fps: 10}\n"
+
+
+def at(text: str, needle: str, nth: int = 0) -> tuple[int, int]:
+    """1-based (line, column) of the nth occurrence of needle in text."""
+    index = -1
+    for _ in range(nth + 1):
+        index = text.index(needle, index + 1)
+    line = text.count("\n", 0, index) + 1
+    col = index - (text.rfind("\n", 0, index) + 1) + 1
+    return line, col
+
+
+def refused(text: str, **kw) -> ScenarioError:
+    with pytest.raises(ScenarioError) as info:
+        loads(text, **kw)
+    return info.value
+
+
+def check_refused(text: str, needle: str, fragment: str, nth: int = 0, **kw) -> ScenarioError:
+    """The text is refused at the nth occurrence of needle, with fragment in the message."""
+    err = refused(text, **kw)
+    assert (err.line, err.col) == at(text, needle, nth), str(err)
+    assert fragment in err.message, str(err)
+    assert str(err) == f"<string>:{err.line}:{err.col}: error: {err.message}"
+    return err
+
+
+def objects(*lines: str, head: str = BASE) -> str:
+    return head + "objects:\n" + "".join(f"  - {line}\n" for line in lines)
+
+
+# ----------------------------------------------------------------------------- the error type
+
+
+def test_error_text_and_fields():
+    err = ScenarioError("a/b.yaml", 3, 7, "boom")
+    assert str(err) == "a/b.yaml:3:7: error: boom"
+    assert (err.path, err.line, err.col, err.message) == ("a/b.yaml", 3, 7, "boom")
+    again = pickle.loads(pickle.dumps(err))
+    assert str(again) == str(err)
+
+
+# ----------------------------------------------------------------------------- what loads
+
+
+def test_spec_example_loads_as_written():
+    path = DATA / "spec_example.yaml"
+    sc = load(path)
+    assert sc.path == str(path)
+    assert sc.text_sha256 == hashlib.sha256(path.read_bytes()).hexdigest()
+    assert sc.name == "tunnelling-1fps"
+    assert sc.description == "Two boxes pass through each other at 1 fps."
+    assert (sc.world.width, sc.world.height, sc.world.fps) == (320, 240, 1)
+    assert (sc.model, sc.substeps, sc.geometry, sc.ticks) == ("paper", 1, "box", 12)
+    b = sc.bodies
+    assert b.n == 4 + 50
+    assert list(b.kind[:4]) == [KIND_BOX, KIND_BOX, KIND_CIRCLE, KIND_POLYGON]
+    assert np.all(b.kind[4:] == KIND_BOX)
+    assert b.pos[:4].tolist() == [[100, 115], [200, 115], [40, 40], [60, 60]]
+    # polygon [[0, 9], [5, 0], [10, 9]]: pixels 0..10 by 0..9, an 11 x 10 box
+    assert b.size[:4].tolist() == [[10, 10], [10, 10], [12, 12], [11, 10]]
+    assert b.vel[:4].tolist() == [[10, 0], [-10, 0], [5, -5], [0, 0]]
+    assert b.mass[:3].tolist() == [1, 2, 1] and b.mass[3] == math.inf
+    assert b.static.tolist()[:4] == [False, False, False, True]
+    # palette: background black, then red, #00ff00, white (the circle's default, then generated)
+    assert sc.palette.tolist() == [[0, 0, 0], [255, 0, 0], [0, 255, 0], [255, 255, 255]]
+    assert sc.palette.dtype == np.uint8
+    assert b.color.tolist() == [1, 2, 3, 3] + [3] * 50
+    assert b.vert_start.tolist()[:6] == [0, 0, 0, 0, 3, 3]
+    assert b.vert_start[-1] == 3
+    assert b.verts.tolist() == [[0, 9], [5, 0], [10, 9]]
+    assert sc.lines[:4] == (8, 9, 10, 11) and set(sc.lines[4:]) == {13}
+    assert sc.names == (None,) * 54
+    assert sc.output.frames == tuple(range(13)) and sc.output.frames_spec == "all"
+    assert sc.output.gif and sc.output.events
+    assert sc.golden.frames == (0, 6, 12)
+    assert sc.golden.time_tolerance == 0.0 and sc.golden.max_diff_pixels == 0
+    # speed 10: every generated component is +-10
+    assert np.all(np.abs(b.vel[4:]) == 10)
+
+
+def test_defaults():
+    sc = loads("version: 1\n")
+    assert sc.path is None and sc.name == "scenario" and sc.description == ""
+    assert (sc.world.width, sc.world.height, sc.world.fps) == (320, 240, 10)
+    assert sc.background == (0, 0, 0)
+    assert (sc.model, sc.substeps, sc.geometry) == ("paper", 1, "box")
+    assert sc.ticks == 100  # 10 s at 10 fps
+    assert sc.output.frames == () and sc.output.frames_spec == "none"
+    assert sc.output.gif is True and sc.output.events is True
+    assert sc.golden.frames == (0, 50, 100)
+    assert (sc.golden.time_tolerance, sc.golden.max_diff_pixels, sc.golden.color_threshold) == (
+        0.0,
+        0,
+        0,
+    )
+    assert sc.bodies.n == 0 and sc.bodies.pos.shape == (0, 2)
+    assert sc.bodies.vert_start.tolist() == [0] and sc.bodies.verts.shape == (0, 2)
+    assert sc.palette.tolist() == [[0, 0, 0]]
+    assert sc.text_sha256 == hashlib.sha256(b"version: 1\n").hexdigest()
+
+
+def test_object_defaults():
+    sc = loads(objects("{shape: box, size: 10, position: [1, 2]}"))
+    b = sc.bodies
+    assert b.vel.tolist() == [[0, 0]] and b.mass.tolist() == [1.0]
+    assert b.static.tolist() == [False] and b.fill.tolist() == [False]
+    assert sc.palette[b.color[0]].tolist() == [255, 255, 255]
+    assert sc.names == (None,)
+
+
+def test_object_fields():
+    sc = loads(
+        objects(
+            "{shape: circle, diameter: 7, position: [1, 2], velocity: [3, -4], "
+            "mass: 2.5, fill: true, name: ball, color: [1, 2, 3]}"
+        )
+    )
+    b = sc.bodies
+    assert b.kind.tolist() == [KIND_CIRCLE] and b.size.tolist() == [[7, 7]]
+    assert b.vel.tolist() == [[3, -4]] and b.mass.tolist() == [2.5] and b.fill.tolist() == [True]
+    assert sc.names == ("ball",) and sc.palette[b.color[0]].tolist() == [1, 2, 3]
+    for arr, dtype in (
+        (b.pos, np.float64),
+        (b.vel, np.float64),
+        (b.size, np.float64),
+        (b.kind, np.int8),
+        (b.color, np.uint8),
+        (b.verts, np.int64),
+    ):
+        assert arr.dtype == dtype
+
+
+@pytest.mark.parametrize(
+    ("model", "geometry"),
+    [
+        ("paper", "box"),
+        ("stepped", "box"),
+        ("exact", "exact"),
+        ("{kind: stepped, geometry: exact}", "exact"),
+        ("{kind: exact, geometry: box}", "box"),
+    ],
+)
+def test_geometry_defaults(model, geometry):
+    assert loads(BASE + f"model: {model}\n").geometry == geometry
+
+
+def test_model_mapping():
+    sc = loads(BASE + "model: {kind: stepped, substeps: 8}\n")
+    assert (sc.model, sc.substeps, sc.geometry) == ("stepped", 8, "box")
+
+
+@pytest.mark.parametrize(
+    ("duration", "fps", "ticks"),
+    [("2.5", 10, 25), ("12", 1, 12), ("0", 10, 0), ("0.05", 10, 1), ("0.04", 10, 0)],
+)
+def test_duration_counts_ticks(duration, fps, ticks):
+    # ticks = duration * fps rounded to the nearest whole tick, halves up (0.05 s * 10 = 0.5 -> 1)
+    sc = loads(f"version: 1\nworld: {{fps: {fps}}}\nduration: {duration}\n")
+    assert sc.ticks == ticks
+
+
+def test_whole_floats_count_as_integers_and_exponents_as_numbers():
+    sc = loads(objects("{shape: box, size: [10.0, 4], position: [2.0, 0], velocity: [1.5e1, 0]}"))
+    assert sc.bodies.size.tolist() == [[10, 4]] and sc.bodies.vel.tolist() == [[15, 0]]
+    text = objects("{shape: box, size: 10, position: [0, 0], velocity: ['1e3', 0]}")
+    check_refused(text, "'1e3'", "must be a number, not the text '1e3'")
+
+
+def test_polygon_box_of_pixels_and_normalised_vertices():
+    sc = loads(objects("{shape: polygon, points: [[-2, 3], [4, -1], [6, 5]], position: [20, 20]}"))
+    b = sc.bodies
+    # minimum point (-2, -1), maximum (6, 5): box top-left (18, 19), size (9, 7)
+    assert b.pos.tolist() == [[18, 19]] and b.size.tolist() == [[9, 7]]
+    assert b.verts.tolist() == [[0, 4], [6, 0], [8, 6]]
+    assert b.vert_start.tolist() == [0, 3]
+
+
+def test_several_polygons_share_the_vertex_array():
+    sc = loads(
+        objects(
+            "{shape: polygon, points: [[0, 0], [4, 0], [0, 4]], position: [0, 0]}",
+            "{shape: box, size: 3, position: [10, 10]}",
+            "{shape: polygon, points: [[1, 1], [5, 1], [5, 5], [1, 5]], position: [30, 30]}",
+        )
+    )
+    b = sc.bodies
+    assert b.vert_start.tolist() == [0, 3, 3, 7]
+    assert b.verts[3:].tolist() == [[0, 0], [4, 0], [4, 4], [0, 4]]
+    assert b.pos[2].tolist() == [31, 31] and b.size[2].tolist() == [5, 5]
+
+
+def test_names_and_lines(tmp_path):
+    text = objects(
+        "{shape: box, size: 5, position: [0, 0], name: a}",
+        "{shape: box, size: 5, position: [10, 0]}",
+    ) + ("generate:\n  - {count: 3, shape: circle, diameter: 3, name: dot, seed: 1}\n")
+    sc = loads(text)
+    assert sc.names == ("a", None, "dot-0", "dot-1", "dot-2")
+    line_a = at(text, "{shape: box, size: 5, position: [0, 0]")[0]
+    block = at(text, "{count: 3")[0]
+    assert sc.lines == (line_a, line_a + 1, block, block, block)
+    assert sc.bodies.kind.tolist() == [KIND_BOX, KIND_BOX] + [KIND_CIRCLE] * 3
+
+
+def test_name_defaults_to_the_file_stem(tmp_path):
+    path = tmp_path / "my-scene.v2.yaml"
+    path.write_text("version: 1\n")
+    assert load(path).name == "my-scene.v2"
+    bad = tmp_path / "My Scene.yaml"
+    bad.write_text("version: 1\n")
+    with pytest.raises(ScenarioError) as info:
+        load(bad)
+    err = info.value
+    assert (err.path, err.line, err.col) == (str(bad), 1, 1)
+    assert "add a 'name:'" in err.message
+
+
+def test_loads_takes_its_default_name_from_a_given_path():
+    assert loads("version: 1\n", path="dir/wall-test.yaml").name == "wall-test"
+
+
+# ----------------------------------------------------------------------------- reading the file
+
+
+def test_non_utf8_bytes_are_located(tmp_path):
+    path = tmp_path / "bad.yaml"
+    path.write_bytes(b"version: 1\ndescription: caf\xe9 ok\n")
+    with pytest.raises(ScenarioError) as info:
+        load(path)
+    assert (info.value.line, info.value.col) == (2, 17)
+    assert "not UTF-8" in info.value.message
+
+
+def test_a_byte_order_mark_is_fine(tmp_path):
+    path = tmp_path / "bom.yaml"
+    path.write_bytes(b"\xef\xbb\xbfversion: 1\nname: bom\n")
+    assert load(path).name == "bom"
+
+
+def test_missing_file_is_a_located_error(tmp_path):
+    with pytest.raises(ScenarioError) as info:
+        load(tmp_path / "nope.yaml")
+    assert (info.value.line, info.value.col) == (1, 1) and "cannot read" in info.value.message
+
+
+@pytest.mark.parametrize("text", ["", "\n\n", "# just a comment\n"])
+def test_empty_file(text):
+    err = refused(text)
+    assert (err.line, err.col) == (1, 1) and "empty" in err.message
+
+
+@pytest.mark.parametrize("text", ["- 1\n- 2\n", "just words\n", "12\n"])
+def test_top_level_must_be_a_mapping(text):
+    err = refused(text)
+    assert (err.line, err.col) == (1, 1) and "must be a mapping" in err.message
+
+
+def test_yaml_syntax_errors_are_located():
+    # the tab cannot start a token: it is the first character of line 3
+    check_refused("version: 1\nobjects:\n\t- x\n", "\t", "invalid YAML")
+    # the flow mapping is never closed; the parser notices at the next line's key
+    check_refused("version: 1\nworld: {width: 10\nticks: 5\n", ": 5", "invalid YAML")
+
+
+def test_control_character_is_located():
+    check_refused("version: 1\nname: a\x07b\n", "\x07", "invalid character U+0007")
+
+
+def test_second_document_refused():
+    check_refused("version: 1\n---\nversion: 1\n", "---", "one YAML document")
+
+
+def test_python_tags_are_refused_at_their_place():
+    text = BASE + "description: !!python/object/apply:os.system ['echo hi']\n"
+    check_refused(text, "!!python", "YAML tag '!!python/object/apply:os.system' is not allowed")
+    check_refused(
+        BASE + "objects: !!python/object:collections.OrderedDict {}\n", "!!python", "not allowed"
+    )
+    check_refused(BASE + "ticks: !custom 3\n", "!custom", "YAML tag '!custom' is not allowed")
+
+
+def test_safe_tags_are_fine():
+    assert loads(BASE + "ticks: !!int '7'\n").ticks == 7
+
+
+def test_deep_nesting_refused_without_exhausting_the_stack():
+    depth = 100_000
+    text = "version: 1\ndescription: " + "[" * depth + "]" * depth + "\n"
+    err = refused(text)
+    # the top mapping is level 1, so the 64th bracket opens level 65
+    assert (err.line, err.col) == (2, len("description: ") + 64)
+    assert "nested more than 64 levels" in err.message
+
+
+def test_billion_laughs_refused_fast_at_the_alias():
+    text = (DATA / "billion_laughs.yaml").read_text()
+    start = time.perf_counter()
+    err = refused(text)
+    assert time.perf_counter() - start < 1.0
+    # Aliases repeat 9 * 1 (lol1) + 9 * 10 (lol2) + 9 * 91 (lol3) + 9 * 820 (lol4) = 8298 nodes;
+    # the first *lol4 inside lol5 repeats 7381 more, passing the bound of 10000 there.
+    assert (err.line, err.col) == at(text, "*lol4")
+    assert "aliases repeat more than 10000 YAML nodes" in err.message
+
+
+def test_alias_bound_is_a_limit():
+    text = objects("&a {shape: box, size: 10, position: [0, 0]}", "{<<: *a, position: [20, 0]}")
+    assert loads(text).bodies.n == 2
+    # the alias repeats the 7-node mapping {shape, size, position: [x, y]} and its values
+    err = refused(text, limits=Limits(max_alias_nodes=5))
+    assert (err.line, err.col) == at(text, "*a")
+
+
+def test_recursive_alias_refused():
+    check_refused(BASE + "objects: &a [*a]\n", "*a", "refers to a node that contains it")
+
+
+def test_merge_keys_and_explicit_keys_win():
+    text = objects(
+        "&base {shape: box, size: 10, position: [0, 0], color: red}",
+        "{<<: *base, position: [20, 0], color: blue}",
+    )
+    sc = loads(text)
+    assert sc.bodies.size.tolist() == [[10, 10], [10, 10]]
+    assert sc.bodies.pos.tolist() == [[0, 0], [20, 0]]
+    assert sc.palette[sc.bodies.color].tolist() == [[255, 0, 0], [0, 0, 255]]
+
+
+def test_duplicate_key_refused():
+    text = BASE + "ticks: 3\nticks: 4\n"
+    err = check_refused(text, "ticks", "duplicate key 'ticks'", nth=1)
+    assert f"first on line {at(text, 'ticks')[0]}" in err.message
+
+
+# ----------------------------------------------------------------------------- keys
+
+
+@pytest.mark.parametrize(
+    ("text", "bad", "message"),
+    [
+        (BASE + "nmae: x\n", "nmae", "unknown key 'nmae' in the scenario; did you mean 'name'?"),
+        (
+            "version: 1\nworld: {widht: 10}\n",
+            "widht",
+            "unknown key 'widht' in world; did you mean 'width'?",
+        ),
+        (
+            BASE + "model: {kind: stepped, substep: 2}\n",
+            "substep",
+            "unknown key 'substep' in model; did you mean 'substeps'?",
+        ),
+        (
+            objects("{shape: box, size: 10, position: [0, 0], velocty: [1, 0]}"),
+            "velocty",
+            "unknown key 'velocty' in object; did you mean 'velocity'?",
+        ),
+        (
+            objects("{shape: box, size: 10, position: [0, 0], colour: red}"),
+            "colour",
+            "unknown key 'colour' in object; did you mean 'color'?",
+        ),
+        (
+            BASE + "generate:\n  - {cont: 3, shape: box, size: 2}\n",
+            "cont",
+            "unknown key 'cont' in generate block; did you mean 'count'?",
+        ),
+        (
+            BASE + "generate:\n  - {count: 3, shape: box, size: 2, speed: {mn: 1, max: 2}}\n",
+            "mn",
+            "unknown key 'mn' in speed; did you mean 'min'?",
+        ),
+        (
+            BASE + "output: {frame: all}\n",
+            "frame",
+            "unknown key 'frame' in output; did you mean 'frames'?",
+        ),
+        (
+            BASE + "golden: {time_tolerence: 0.1}\n",
+            "time_tolerence",
+            "unknown key 'time_tolerence' in golden; did you mean 'time_tolerance'?",
+        ),
+        (
+            BASE + "output: {frames: {evry: 2}}\n",
+            "evry",
+            "unknown key 'evry' in output.frames; did you mean 'every'?",
+        ),
+    ],
+)
+def test_unknown_keys_suggest_the_near_spelling(text, bad, message):
+    check_refused(text, bad, message)
+
+
+def test_unknown_key_with_nothing_near_lists_the_keys():
+    err = check_refused(BASE + "zzzzzz: 1\n", "zzzzzz", "unknown key 'zzzzzz' in the scenario")
+    assert "expected one of version, name" in err.message
+
+
+def test_keys_must_be_names():
+    check_refused(BASE + "3: x\n", "3:", "keys in the scenario must be names")
+
+
+# ----------------------------------------------------------------------------- types and values
+
+
+@pytest.mark.parametrize(
+    ("text", "bad", "message"),
+    [
+        ("version: 2\n", "2", "version must be 1"),
+        ("version: '1'\n", "'1'", "version must be 1"),
+        ("name: x\n", "name", "missing 'version: 1'"),
+        (
+            "version: 1\nworld: {width: abc}\n",
+            "abc",
+            "world.width must be a whole number of pixels, not the text 'abc'",
+        ),
+        ("version: 1\nworld: {width: 0}\n", "0}", "world.width must be at least 1 px"),
+        ("version: 1\nworld: {height: -5}\n", "-5", "world.height must be at least 1 px"),
+        (
+            "version: 1\nworld: {fps: 2.5}\n",
+            "2.5",
+            "world.fps must be a whole number of ticks per second",
+        ),
+        ("version: 1\nworld: {fps: 0}\n", "0}", "world.fps must be at least 1"),
+        ("version: 1\nworld: {fps: 10001}\n", "10001", "world.fps must be at most 10000"),
+        ("version: 1\nworld: [1, 2]\n", "[1", "world must be a mapping"),
+        ("version: 1\nworld: {background: blurple}\n", "blurple", "unknown colour 'blurple'"),
+        (BASE + "ticks: true\n", "true", "ticks must be a whole number, not the boolean true"),
+        (BASE + "ticks: -1\n", "-1", "ticks must be at least 0"),
+        (BASE + "ticks: 1.5\n", "1.5", "ticks must be a whole number"),
+        (BASE + "duration: -2\n", "-2", "duration must be at least 0 s"),
+        (BASE + "duration: .inf\n", ".inf", "duration must be a finite number"),
+        (BASE + "duration: ten\n", "ten", "duration must be a number, not the text 'ten'"),
+        (BASE + "description: 12\n", "12", "description must be text"),
+        (BASE + "name: 12\n", "12", "name must be text"),
+        (BASE + "model: stepd\n", "stepd", "unknown model 'stepd'; did you mean 'stepped'?"),
+        (BASE + "model: 3\n", "3", "unknown model 3"),
+        (BASE + "model: {substeps: 2}\n", "{", "model is missing 'kind'"),
+        (BASE + "model: {kind: stepped, substeps: 0}\n", "0}", "model.substeps must be at least 1"),
+        (
+            BASE + "model: {kind: exact, substeps: 2}\n",
+            "2}",
+            "substeps applies to the stepped model",
+        ),
+        (
+            BASE + "model: {kind: paper, geometry: exact}\n",
+            "exact}",
+            "geometry 'exact' is not available with the paper model",
+        ),
+        (BASE + "model: {kind: stepped, geometry: round}\n", "round", "unknown geometry 'round'"),
+        (BASE + "objects: {shape: box}\n", "{", "objects must be a list, not a mapping"),
+        (BASE + "objects:\n  - 3\n", "3", "object must be a mapping"),
+        (BASE + "output: {gif: 1}\n", "1}", "output.gif must be true or false"),
+        (BASE + "output: {events: 'yes'}\n", "'yes'", "output.events must be true or false"),
+        (BASE + "output: {frames: al}\n", "al}", "did you mean 'all'?"),
+        (BASE + "output: {frames: 3}\n", "3}", "must be all, none, last, a list of frame numbers"),
+        (BASE + "output: {frames: {every: 0}}\n", "0}", "output.frames.every must be at least 1"),
+        (BASE + "output: {frames: [0, -1]}\n", "-1", "output.frames item must be at least 0"),
+        (
+            BASE + "golden: {time_tolerance: -0.5}\n",
+            "-0.5",
+            "golden.time_tolerance must be at least 0 s",
+        ),
+        (BASE + "golden: {max_diff_pixels: -1}\n", "-1", "golden.max_diff_pixels must be at least"),
+        (
+            BASE + "golden: {color_threshold: 256}\n",
+            "256",
+            "golden.color_threshold must be at most 255",
+        ),
+        (
+            BASE + "golden: {frames: [0, 101]}\n",
+            "101",
+            "golden.frames: frame 101 is past the last frame, 100",
+        ),
+    ],
+)
+def test_bad_values_at_their_place(text, bad, message):
+    skip = text.count(bad, 0, len(BASE)) if text.startswith(BASE) else 0
+    check_refused(text, bad, message, nth=skip)
+
+
+def test_ticks_and_duration_together():
+    check_refused(BASE + "ticks: 10\nduration: 2\n", "duration", "either 'ticks' or 'duration'")
+
+
+@pytest.mark.parametrize(
+    ("obj", "bad", "message"),
+    [
+        (
+            "{shape: box, size: 10, position: [0, 0], mass: .inf}",
+            ".inf",
+            "objects[0].mass must be a finite number",
+        ),
+        (
+            "{shape: box, size: 10, position: [0, 0], mass: true}",
+            "true",
+            "objects[0].mass must be a number, not the boolean true",
+        ),
+        (
+            "{shape: box, size: 10, position: [0, 0], mass: 0}",
+            "0}",
+            "objects[0].mass must be more than 0",
+        ),
+        (
+            "{shape: box, size: 10, position: [0, 0], mass: -1}",
+            "-1",
+            "objects[0].mass must be more than 0",
+        ),
+        (
+            "{shape: box, size: 10, position: [0, 0], velocity: [.nan, 0]}",
+            ".nan",
+            "objects[0].velocity x must be a finite number",
+        ),
+        (
+            "{shape: box, size: 10, position: [0, 0], velocity: [1, a]}",
+            "a]",
+            "objects[0].velocity y must be a number, not the text 'a'",
+        ),
+        (
+            "{shape: box, size: 10, position: [0, 0], velocity: [1, 2, 3]}",
+            "[1, 2, 3]",
+            "objects[0].velocity must be a list of 2 numbers",
+        ),
+        ("{shape: box, size: 10, position: here}", "here", "objects[0].position must be a list"),
+        (
+            "{shape: box, size: 10, position: [0, 0], velocity: [2e9, 0]}",
+            "2e9",
+            "objects[0].velocity x must be at most 1000000000 px/s",
+        ),
+        ("{shape: box, size: 0, position: [0, 0]}", "0,", "objects[0].size must be at least 1 px"),
+        (
+            "{shape: box, size: [4, -1], position: [0, 0]}",
+            "-1",
+            "objects[0].size h must be at least",
+        ),
+        (
+            "{shape: box, size: [1, 2, 3], position: [0, 0]}",
+            "[1, 2, 3]",
+            "objects[0].size must be one number or [w, h]",
+        ),
+        (
+            "{shape: box, size: 10.5, position: [0, 0]}",
+            "10.5",
+            "objects[0].size must be a whole number of pixels",
+        ),
+        (
+            "{shape: circle, diameter: 0, position: [0, 0]}",
+            "0,",
+            "objects[0].diameter must be at least 1 px",
+        ),
+        (
+            "{shape: circle, diameter: 2.5, position: [0, 0]}",
+            "2.5",
+            "objects[0].diameter must be a whole number of pixels",
+        ),
+        (
+            "{shape: polygon, points: [[0, 0], [1, 1]], position: [0, 0]}",
+            "[[0",
+            "objects[0].points needs at least 3 items, not 2",
+        ),
+        (
+            "{shape: polygon, points: [[0, 0], [1, 1], [2.5, 0]], position: [0, 0]}",
+            "2.5",
+            "objects[0].points[2] x must be a whole number of pixels",
+        ),
+        (
+            "{shape: polygon, points: [[0, 0], [1, 1], [2]], position: [0, 0]}",
+            "[2]",
+            "objects[0].points[2] must be [x, y]",
+        ),
+        ("{size: 10, position: [0, 0]}", "{", "objects[0] is missing 'shape'"),
+        (
+            "{shape: crcle, diameter: 3, position: [0, 0]}",
+            "crcle",
+            "unknown shape 'crcle'; did you mean 'circle'?",
+        ),
+        (
+            "{shape: circle, size: 10, position: [0, 0]}",
+            "size",
+            "'size' does not apply to a circle; a circle takes 'diameter'",
+        ),
+        (
+            "{shape: box, points: [[0, 0], [1, 0], [0, 1]], position: [0, 0]}",
+            "points",
+            "'points' does not apply to a box",
+        ),
+        ("{shape: box, position: [0, 0]}", "{", "objects[0] (box) is missing 'size'"),
+        ("{shape: box, size: 3}", "{", "objects[0] is missing 'position'"),
+        (
+            "{shape: box, size: 3, position: [0, 0], fill: 'no'}",
+            "'no'",
+            "objects[0].fill must be true or false",
+        ),
+        (
+            "{shape: box, size: 3, position: [0, 0], name: [a]}",
+            "[a]",
+            "objects[0].name must be a single value",
+        ),
+        (
+            "{shape: box, size: 3, position: [0, 0], static: true, velocity: [1, 0]}",
+            "[1, 0]",
+            "objects[0] is static, so it cannot move: its velocity must be [0, 0] or absent",
+        ),
+        (
+            "{shape: box, size: 3, position: [0, 0], static: true, mass: 3}",
+            "mass",
+            "objects[0] is static, so its mass is infinite",
+        ),
+    ],
+)
+def test_bad_objects_at_their_place(obj, bad, message):
+    text = objects(obj)
+    # the needle is searched after the "objects:" line, inside the object
+    skip = text.count(bad, 0, text.index("objects:"))
+    check_refused(text, bad, message, nth=skip)
+
+
+@pytest.mark.parametrize(
+    ("color", "rgb"),
+    [
+        ("red", (255, 0, 0)),
+        ("Navy", (0, 0, 128)),
+        ("'#0a0B0c'", (10, 11, 12)),
+        ("[1, 2, 3]", (1, 2, 3)),
+        ("darkslategray", (47, 79, 79)),
+    ],
+)
+def test_colours(color, rgb):
+    sc = loads(objects(f"{{shape: box, size: 3, position: [0, 0], color: {color}}}"))
+    assert tuple(sc.palette[sc.bodies.color[0]]) == rgb
+
+
+@pytest.mark.parametrize(
+    ("color", "bad", "message"),
+    [
+        ("gren", "gren", "unknown colour 'gren'; did you mean 'green'?"),
+        ("'#12345'", "'#12345'", "is not of the form #rrggbb"),
+        ("[1, 2, 300]", "300", "objects[0].color component must be at most 255"),
+        ("[1, 2]", "[1, 2]", "needs 3 values [r, g, b], not 2"),
+        ("[1, 2, 3.5]", "3.5", "objects[0].color component must be a whole number"),
+        ("12", "12}", "objects[0].color must be a colour name, #rrggbb or [r, g, b]"),
+    ],
+)
+def test_bad_colours(color, bad, message):
+    text = objects(f"{{shape: box, size: 3, position: [0, 0], color: {color}}}")
+    check_refused(text, bad, message, nth=text.count(bad, 0, text.index("color:")))
+
+
+@pytest.mark.parametrize(
+    ("name", "ok"),
+    [
+        ("ok.name_1-2", True),
+        ("a", True),
+        ("_x", True),
+        ("-x", True),
+        (".", False),
+        ("..", False),
+        (".hidden", False),
+        ("../evil", False),
+        ("a/b", False),
+        ("Caps", False),
+        ("with space", False),
+        ("x" * 100, True),
+        ("x" * 101, False),
+        ("''", False),
+    ],
+)
+def test_scenario_names(name, ok):
+    text = BASE + f"name: {name}\n"
+    if ok:
+        assert loads(text).name == name
+    else:
+        check_refused(text, name, "is not a valid scenario name")
+
+
+# ----------------------------------------------------------------------------- limits
+
+
+def test_world_side_limit():
+    text = "version: 1\nworld: {width: 16385}\n"
+    check_refused(text, "16385", "past the limit of 16384 px per side; raise it with --max-side")
+    assert loads(text, limits=Limits(max_side=20000)).world.width == 16385
+
+
+def test_tick_limit():
+    check_refused(
+        BASE + "ticks: 1000000001\n",
+        "1000000001",
+        "past the limit of 1000000000 ticks; raise it with --max-ticks",
+    )
+    check_refused(BASE + "ticks: 6\n", "6", "past the limit of 5 ticks", limits=Limits(max_ticks=5))
+    check_refused(
+        BASE + "duration: 1\n",
+        "1\n",
+        nth=1,
+        fragment="duration 1 s at 10 fps is 10 ticks, past the limit of 5 ticks",
+        limits=Limits(max_ticks=5),
+    )
+    err = refused("version: 1\n", limits=Limits(max_ticks=5))
+    assert (err.line, err.col) == (1, 1) and "default duration" in err.message
+
+
+def test_object_limit_for_listed_objects():
+    text = objects(
+        "{shape: box, size: 1, position: [0, 0]}", "{shape: box, size: 1, position: [2, 0]}"
+    )
+    err = refused(text, limits=Limits(max_objects=1))
+    # the list starts at its first dash
+    assert (err.line, err.col) == at(text, "- {shape") and "--max-objects" in err.message
+    assert "2 objects are past the limit of 1 objects" in err.message
+
+
+def test_object_limit_counts_generated_objects_before_making_them():
+    text = objects("{shape: box, size: 1, position: [0, 0]}") + (
+        "generate:\n  - {count: 2, shape: box, size: 1}\n  - {count: 1000000000, shape: box, "
+        "size: 1}\n"
+    )
+    start = time.perf_counter()
+    err = check_refused(
+        text,
+        "1000000000",
+        "generate[1].count 1000000000 makes 1000000003 "
+        "objects, past the limit of 1000000 objects; raise it with --max-objects",
+    )
+    assert time.perf_counter() - start < 0.5
+    assert err.line == 7
+    check_refused(
+        text.replace("1000000000", "5"),
+        "2, shape",
+        "past the limit of 2 objects",
+        limits=Limits(max_objects=2),
+    )
+
+
+def test_frame_count_limit():
+    text = BASE + "ticks: 20\noutput: {frames: all}\n"
+    check_refused(
+        text,
+        "all",
+        "asks for 21 frames, past the limit of 10 frames; raise it with --max-frames",
+        limits=Limits(max_frames=10),
+    )
+    text = BASE + "ticks: 20\noutput: {frames: {every: 2}}\n"
+    check_refused(text, "{every", "asks for 11 frames", limits=Limits(max_frames=10))
+    assert len(loads(text).output.frames) == 11
+
+
+# ----------------------------------------------------------------------------- frames
+
+
+@pytest.mark.parametrize(
+    ("frames", "expected", "spec"),
+    [
+        ("all", tuple(range(13)), "all"),
+        ("none", (), "none"),
+        ("last", (12,), "last"),
+        ("[6, 0, 6, 12]", (0, 6, 12), [6, 0, 6, 12]),
+        ("[]", (), []),
+        ("{every: 5}", (0, 5, 10), {"every": 5}),
+        ("{every: 12}", (0, 12), {"every": 12}),
+        ("{every: 50}", (0,), {"every": 50}),
+    ],
+)
+def test_output_frames(frames, expected, spec):
+    sc = loads(BASE + f"ticks: 12\noutput: {{frames: {frames}, gif: false, events: false}}\n")
+    assert sc.output.frames == expected and sc.output.frames_spec == spec
+    assert sc.output.gif is False and sc.output.events is False
+
+
+def test_frame_past_the_end():
+    text = BASE + "ticks: 12\noutput: {frames: [0, 13]}\n"
+    check_refused(text, "13]", "output.frames: frame 13 is past the last frame, 12 (ticks: 12)")
+
+
+@pytest.mark.parametrize(("ticks", "frames"), [(0, (0,)), (1, (0, 1)), (7, (0, 3, 7))])
+def test_golden_frames_default(ticks, frames):
+    assert loads(BASE + f"ticks: {ticks}\n").golden.frames == frames
+
+
+def test_golden_settings():
+    g = loads(
+        BASE + "ticks: 9\ngolden: {frames: last, time_tolerance: 0.25, max_diff_pixels: 4, "
+        "color_threshold: 3}\n"
+    ).golden
+    assert (g.frames, g.time_tolerance, g.max_diff_pixels, g.color_threshold) == ((9,), 0.25, 4, 3)
+
+
+# ----------------------------------------------------------------------------- paper model
+
+
+def test_paper_positions_must_be_whole():
+    text = objects("{shape: box, size: 3, position: [1.5, 0]}")
+    check_refused(
+        text,
+        "1.5",
+        "objects[0].position x must be a whole number of pixels under the paper model, not 1.5",
+    )
+    sc = loads(text.replace("version: 1\n", "version: 1\nmodel: stepped\n"))
+    assert sc.bodies.pos.tolist() == [[1.5, 0]]
+
+
+def test_paper_velocity_refused_with_the_engine_message():
+    # 1e-7 px/s at 10 fps needs 1 px per 10^8 ticks, past motion.MAX_PERIOD_TICKS
+    text = objects("{shape: box, size: 3, position: [0, 0], velocity: [0, 0.0000001]}")
+    with pytest.raises(ValueError) as expected:
+        motion.paper_rate(0.0000001, 10)
+    err = check_refused(text, "0.0000001", str(expected.value))
+    assert err.message == str(expected.value)
+
+
+def test_paper_velocities_that_are_fine():
+    sc = loads(objects("{shape: box, size: 3, position: [0, 0], velocity: [7.5, -0.25]}"))
+    assert sc.bodies.vel.tolist() == [[7.5, -0.25]]
+
+
+def test_non_paper_models_take_any_finite_velocity():
+    text = objects("{shape: box, size: 3, position: [0, 0], velocity: [0, 0.0000001]}")
+    for model in ("stepped", "exact"):
+        assert loads(text.replace("version: 1\n", f"version: 1\nmodel: {model}\n")).bodies.n == 1
+
+
+# ----------------------------------------------------------------------------- polygons
+
+
+@pytest.mark.parametrize(
+    ("points", "problem"),
+    [
+        ([[0, 0], [10, 0], [10, 10], [0, 10]], None),
+        ([[0, 0], [5, 0], [10, 0], [10, 10], [0, 10]], None),  # a collinear point on an edge
+        ([[0, 0], [10, 0], [10, 0], [0, 10]], None),  # a repeated point
+        ([[0, 10], [10, 10], [10, 0], [0, 0]], None),  # the other winding
+        ([[0, 0], [5, 5], [10, 10]], "zero area"),
+        ([[3, 3], [3, 3], [3, 3]], "zero area"),
+        ([[0, 0], [10, 0], [5, 3], [10, 10], [0, 10]], "turns both ways"),  # a notch
+        ([[0, 0], [10, 10], [10, 0], [0, 10]], "crosses itself"),  # a bow tie
+        ([[0, 0], [10, 0], [5, 0], [5, 5]], "turns back"),
+        # a five-pointed star drawn point to point: turns one way but winds twice
+        ([[50, 0], [79, 90], [2, 35], [98, 35], [21, 90]], "winds around more than once"),
+    ],
+)
+def test_polygon_problem(points, problem):
+    found = polygon_problem(np.array(points))
+    if problem is None:
+        assert found is None
+    else:
+        assert found is not None and problem in found
+
+
+def test_exact_geometry_refuses_non_convex_polygons_at_their_points():
+    obj = "{shape: polygon, points: [[0, 0], [10, 0], [5, 3], [10, 10], [0, 10]], position: [0, 0]}"
+    text = objects(obj, head=BASE + "model: exact\n")
+    err = check_refused(
+        text, "[[0, 0]", "objects[0].points: under geometry 'exact' a polygon must be convex"
+    )
+    assert "turns both ways" in err.message
+    assert loads(objects(obj)).bodies.n == 1  # box geometry takes any polygon
+    assert loads(objects(obj, head=BASE + "model: {kind: exact, geometry: box}\n")).bodies.n == 1
+
+
+# ----------------------------------------------------------------------------- placement
+
+
+def test_object_outside_the_world():
+    text = objects(
+        "{shape: box, size: 10, position: [0, 0]}", "{shape: box, size: 10, position: [91, 0]}"
+    )
+    err = check_refused(text, "{shape", "objects[1] lies outside the world", nth=1)
+    assert "[91, 101) x [0, 10)" in err.message and "[0, 100) x [0, 80)" in err.message
+    text = objects("{shape: box, size: 10, position: [0, -1]}")
+    check_refused(text, "{shape", "objects[0] lies outside the world")
+    # touching the far walls is inside
+    assert loads(objects("{shape: box, size: 10, position: [90, 70]}")).bodies.n == 1
+
+
+def test_polygon_outside_the_world_by_its_pixels():
+    # points reach x = -1 from position 0
+    text = objects("{shape: polygon, points: [[-1, 0], [5, 0], [0, 5]], position: [0, 0]}")
+    check_refused(text, "{shape", "objects[0] lies outside the world")
+
+
+def test_overlap_names_the_pair_and_both_lines():
+    text = objects(
+        "{shape: box, size: 10, position: [0, 0]}",
+        "{shape: box, size: 10, position: [50, 50]}",
+        "{shape: box, size: 10, position: [5, 5]}",
+    )
+    err = check_refused(text, "{shape", "objects[2] (line 6) overlaps objects[0] (line 4)", nth=2)
+    assert "[5, 15) x [5, 15)" in err.message and "[0, 10) x [0, 10)" in err.message
+
+
+def test_touching_boxes_do_not_overlap():
+    sc = loads(
+        objects(
+            "{shape: box, size: 10, position: [0, 0]}",
+            "{shape: box, size: 10, position: [10, 0]}",
+            "{shape: box, size: 10, position: [0, 10]}",
+            "{shape: circle, diameter: 10, position: [10, 10]}",
+        )
+    )
+    assert sc.bodies.n == 4
+
+
+def test_shapes_overlap_as_their_boxes():
+    # a triangle's box [0, 10) x [0, 10) covers a box in the corner its outline never reaches
+    text = objects(
+        "{shape: polygon, points: [[0, 0], [9, 0], [0, 9]], position: [0, 0]}",
+        "{shape: box, size: 2, position: [8, 8]}",
+    )
+    check_refused(text, "{shape", "objects[1] (line 5) overlaps objects[0] (line 4)", nth=1)
+
+
+def test_stepped_float_positions_overlap_exactly():
+    head = BASE + "model: stepped\n"
+    ok = objects(
+        "{shape: box, size: 10, position: [0.5, 0]}",
+        "{shape: box, size: 10, position: [10.5, 0]}",
+        head=head,
+    )
+    assert loads(ok).bodies.n == 2
+    bad = ok.replace("10.5", "10.25")
+    check_refused(bad, "{shape", "overlaps", nth=1)
+
+
+# ----------------------------------------------------------------------------- palette
+
+
+def test_palette_in_order_of_first_appearance():
+    text = (
+        objects(
+            "{shape: box, size: 2, position: [0, 0], color: blue}",
+            "{shape: box, size: 2, position: [4, 0], color: red}",
+            "{shape: box, size: 2, position: [8, 0], color: [0, 0, 255]}",
+            "{shape: box, size: 2, position: [12, 0], color: black}",
+            head="version: 1\nworld: {width: 100, height: 80, background: '#101010'}\n",
+        )
+        + "generate:\n  - {count: 2, shape: box, size: 2, color: red}\n"
+        + ("  - {count: 1, shape: box, size: 2, color: lime}\n")
+    )
+    sc = loads(text)
+    assert sc.palette.tolist() == [[16, 16, 16], [0, 0, 255], [255, 0, 0], [0, 0, 0], [0, 255, 0]]
+    # an object drawn in the background's colour still has its own row: row 0 is the background
+    assert sc.bodies.color.tolist() == [1, 2, 1, 3, 2, 2, 4]
+
+
+def test_palette_holds_256_rows():
+    def text(k: int) -> str:
+        lines = [
+            f"{{shape: box, size: 1, position: [{i % 64}, {i // 64}], color: [{i % 256}, "
+            f"{i // 256}, 7]}}"
+            for i in range(k)
+        ]
+        return objects(*lines, head="version: 1\nworld: {width: 64, height: 64}\n")
+
+    assert loads(text(255)).palette.shape == (256, 3)
+    big = text(256)
+    check_refused(big, "[255, 0, 7]", "too many colours: the palette holds 256")
+
+
+# ----------------------------------------------------------------------------- generate
+
+
+GEN_HEAD = "version: 1\nworld: {width: 320, height: 240, fps: 10}\n"
+
+
+def test_generated_objects_fill_the_arrays():
+    text = GEN_HEAD + "objects:\n  - {shape: box, size: 40, position: [100, 100], static: true}\n"
+    text += (
+        "generate:\n  - {count: 30, shape: circle, diameter: 6, speed: 10, seed: 3, "
+        "color: yellow, mass: 2, fill: true}\n"
+    )
+    sc = loads(text)
+    b = sc.bodies
+    assert b.n == 31
+    assert np.all(b.kind[1:] == KIND_CIRCLE) and np.all(b.size[1:] == 6)
+    assert np.all(b.mass[1:] == 2) and np.all(b.fill[1:]) and not b.fill[0]
+    assert np.all(np.abs(b.vel[1:]) == 10)
+    assert np.all(b.pos == np.floor(b.pos))  # whole pixels
+    assert np.all(b.pos >= 0) and np.all(b.pos + b.size <= [320, 240])
+    # nothing overlaps: compare every pair
+    lo, hi = b.pos, b.pos + b.size
+    over = (
+        (lo[:, None, 0] < hi[None, :, 0])
+        & (lo[None, :, 0] < hi[:, None, 0])
+        & (lo[:, None, 1] < hi[None, :, 1])
+        & (lo[None, :, 1] < hi[:, None, 1])
+    )
+    np.fill_diagonal(over, False)
+    assert not over.any()
+
+
+def test_generate_is_deterministic_and_seeded():
+    text = (
+        GEN_HEAD + "generate:\n  - {count: 40, shape: box, size: 5, speed: {min: 2, max: 9}, "
+        "seed: 11}\n"
+    )
+    a, b = loads(text).bodies, loads(text).bodies
+    assert np.array_equal(a.pos, b.pos) and np.array_equal(a.vel, b.vel)
+    c = loads(text.replace("seed: 11", "seed: 12")).bodies
+    assert not np.array_equal(a.pos, c.pos)
+
+
+def test_generate_seed_defaults_to_zero():
+    text = GEN_HEAD + "generate:\n  - {count: 5, shape: box, size: 5}\n"
+    assert np.array_equal(
+        loads(text).bodies.pos, loads(text.replace("size: 5}", "size: 5, seed: 0}")).bodies.pos
+    )
+
+
+def test_generate_under_paper_draws_whole_velocities():
+    text = GEN_HEAD + "generate:\n  - {count: 50, shape: box, size: 3, speed: {min: 2, max: 9}}\n"
+    vel = loads(text).bodies.vel
+    assert np.all(vel == np.round(vel))
+    speed = np.hypot(vel[:, 0], vel[:, 1])
+    # components rounded by at most 1/2 each: the magnitude moves by at most sqrt(2)/2
+    assert np.all(speed >= 2 - 0.71) and np.all(speed <= 9 + 0.71)
+    stepped = loads(text.replace("version: 1\n", "version: 1\nmodel: stepped\n")).bodies.vel
+    assert np.all(np.hypot(stepped[:, 0], stepped[:, 1]) >= 2 - 1e-9)
+    assert not np.all(stepped == np.round(stepped))
+
+
+def test_generate_velocity_ranges():
+    text = (
+        GEN_HEAD + "generate:\n  - {count: 60, shape: box, size: 3, velocity: {min: [-2, 3], "
+        "max: [2, 5]}}\n"
+    )
+    vel = loads(text).bodies.vel
+    assert set(np.unique(vel[:, 0])) <= {-2, -1, 0, 1, 2} and set(np.unique(vel[:, 1])) <= {3, 4, 5}
+    assert np.all(vel == np.round(vel))
+
+
+def test_generate_static_block():
+    text = GEN_HEAD + "generate:\n  - {count: 4, shape: box, size: 3, static: true}\n"
+    b = loads(text).bodies
+    assert np.all(b.static) and np.all(b.mass == np.inf) and np.all(b.vel == 0)
+
+
+@pytest.mark.parametrize(
+    ("block", "bad", "message"),
+    [
+        ("{shape: box, size: 3}", "{shape", "generate[0] is missing 'count'"),
+        ("{count: -1, shape: box, size: 3}", "-1", "generate[0].count must be at least 0"),
+        ("{count: 2, shape: polygon, size: 3}", "polygon", "unknown shape 'polygon'"),
+        ("{count: 2, shape: box}", "{count", "generate[0] (box) is missing 'size'"),
+        ("{count: 2, shape: box, size: 3, seed: -1}", "-1", "generate[0].seed must be at least 0"),
+        (
+            "{count: 2, shape: box, size: 3, speed: -1}",
+            "-1",
+            "generate[0].speed must be at least 0",
+        ),
+        (
+            "{count: 2, shape: box, size: 3, speed: {min: 5, max: 1}}",
+            "{min",
+            "generate[0].speed: min 5 is more than max 1",
+        ),
+        (
+            "{count: 2, shape: box, size: 3, speed: {min: 1}}",
+            "{min",
+            "generate[0].speed is missing 'max'",
+        ),
+        (
+            "{count: 2, shape: box, size: 3, speed: 1, velocity: {min: [0, 0], max: [1, 1]}}",
+            "velocity",
+            "give either 'speed' or 'velocity', not both",
+        ),
+        (
+            "{count: 2, shape: box, size: 3, velocity: [1, 1]}",
+            "[1, 1]",
+            "generate[0].velocity must be {min: [vx, vy], max: [vx, vy]}",
+        ),
+        (
+            "{count: 2, shape: box, size: 3, velocity: {min: [0, 0]}}",
+            "{min",
+            "generate[0].velocity is missing 'max'",
+        ),
+        (
+            "{count: 2, shape: box, size: 3, velocity: {min: [0, 3], max: [1, 1]}}",
+            "{min",
+            "generate[0].velocity: min y 3 is more than max y 1",
+        ),
+        (
+            "{count: 2, shape: box, size: 3, velocity: {min: [0, 0.5], max: [1, 1]}}",
+            "0.5",
+            "generate[0].velocity min y must be a whole number under the paper model",
+        ),
+        (
+            "{count: 2, shape: box, size: 3, speed: 0.0000001}",
+            "0.0000001",
+            "is not a whole number of pixels per whole number of ticks",
+        ),
+        (
+            "{count: 2, shape: box, size: 3, speed: 3, static: true}",
+            "3, static",
+            "generate[0] is static, so its objects cannot move",
+        ),
+        (
+            "{count: 2, shape: box, size: 3, static: true, mass: 2}",
+            "mass",
+            "generate[0] is static, so its mass is infinite",
+        ),
+    ],
+)
+def test_bad_generate_blocks(block, bad, message):
+    text = GEN_HEAD + f"generate:\n  - {block}\n"
+    check_refused(text, bad, message, nth=text.count(bad, 0, text.index("generate:")))
+
+
+def test_generate_cannot_place():
+    text = GEN_HEAD + "generate:\n  - {count: 5000, shape: box, size: 10}\n"
+    err = check_refused(
+        text, "{count", "generate[0]: cannot place 5000 boxes of 10x10 without overlap in 320x240"
+    )
+    assert err.line == 4
+    # 700 boxes of 10x10 cover less than the world's 76800 px^2 but jam long before
+    text = GEN_HEAD + "generate:\n  - {count: 700, shape: box, size: 10}\n"
+    check_refused(text, "{count", "cannot place 700 boxes of 10x10 without overlap in 320x240")
+
+
+def test_generated_objects_avoid_listed_ones():
+    text = (
+        "version: 1\nworld: {width: 60, height: 60}\nobjects:\n"
+        + "".join(
+            f"  - {{shape: box, size: 10, position: [{x}, {y}], static: true}}\n"
+            for x in range(0, 60, 20)
+            for y in range(0, 60, 20)
+        )
+        + "generate:\n  - {count: 20, shape: box, size: 4, seed: 5}\n"
+    )
+    b = loads(text).bodies
+    lo, hi = b.pos, b.pos + b.size
+    over = (
+        (lo[:, None, 0] < hi[None, :, 0])
+        & (lo[None, :, 0] < hi[:, None, 0])
+        & (lo[:, None, 1] < hi[None, :, 1])
+        & (lo[None, :, 1] < hi[:, None, 1])
+    )
+    np.fill_diagonal(over, False)
+    assert not over.any()
+
+
+# ----------------------------------------------------------------------------- overrides
+
+
+SLOW = "{shape: box, size: 3, position: [0, 0], velocity: [0.000001, 0]}"
+
+
+def test_fps_override_rechecks_paper_velocities():
+    # 1e-6 px/s is 1 px per 10^6 ticks at 1 fps (allowed) but per 3 * 10^6 ticks at 3 fps
+    text = objects(SLOW, head="version: 1\nworld: {fps: 1}\n")
+    assert loads(text).world.fps == 1
+    err = check_refused(
+        text, "0.000001", "--fps 3: velocity 1e-06 px/s at 3 fps", overrides={"fps": 3}
+    )
+    assert err.message.startswith("--fps 3: ")
+
+
+def test_model_override_rechecks_paper_rules():
+    text = objects("{shape: box, size: 3, position: [0.5, 0]}", head=BASE + "model: stepped\n")
+    assert loads(text).bodies.pos[0, 0] == 0.5
+    err = check_refused(
+        text,
+        "0.5",
+        "must be a whole number of pixels under the paper model",
+        overrides={"model": "paper"},
+    )
+    assert err.message.startswith("--model paper: ")
+
+
+def test_model_override_replaces_the_model_entry():
+    text = BASE + "model: {kind: exact, geometry: exact}\n"
+    sc = loads(text, overrides={"model": "paper"})
+    assert (sc.model, sc.geometry, sc.substeps) == ("paper", "box", 1)
+    text = BASE + "model: {kind: stepped, substeps: 4, geometry: exact}\n"
+    sc = loads(text, overrides={"model": "stepped"})  # the same kind keeps its settings
+    assert (sc.model, sc.geometry, sc.substeps) == ("stepped", "exact", 4)
+    sc = loads(text, overrides={"model": "exact"})
+    assert (sc.model, sc.geometry, sc.substeps) == ("exact", "exact", 1)
+
+
+def test_ticks_override_resolves_frames():
+    text = BASE + "ticks: 12\noutput: {frames: {every: 4}}\n"
+    sc = loads(text, overrides={"ticks": 8})
+    assert sc.ticks == 8 and sc.output.frames == (0, 4, 8) and sc.golden.frames == (0, 4, 8)
+    text = BASE + "ticks: 12\noutput: {frames: [0, 10]}\n"
+    err = check_refused(text, "10]", "frame 10 is past the last frame, 8", overrides={"ticks": 8})
+    assert err.message.startswith("--ticks 8: ")
+
+
+def test_fps_override_counts_duration_again():
+    sc = loads(BASE + "duration: 2\n", overrides={"fps": 30})
+    assert (sc.world.fps, sc.ticks) == (30, 60)
+    sc = loads(BASE + "duration: 2\n", overrides={"fps": 30, "ticks": 5})
+    assert sc.ticks == 5
+
+
+def test_ticks_override_replaces_a_file_value_past_the_limit():
+    text = BASE + "ticks: 50\n"
+    assert loads(text, overrides={"ticks": 4}, limits=Limits(max_ticks=10)).ticks == 4
+    err = refused("version: 1\n", overrides={"ticks": 11}, limits=Limits(max_ticks=10))
+    assert (err.line, err.col) == (1, 1) and err.message.startswith("--ticks 11: ")
+    assert "--max-ticks" in err.message
+
+
+@pytest.mark.parametrize(
+    ("overrides", "fragment"),
+    [
+        ({"fps": 0}, "--fps 0: fps must be a whole number of ticks per second from 1 to 10000"),
+        ({"fps": 2.5}, "--fps 2.5: "),
+        ({"model": "bogus"}, "--model bogus: unknown model 'bogus'"),
+        ({"model": "exat"}, "did you mean 'exact'?"),
+        ({"ticks": -1}, "--ticks -1: ticks must be a whole number >= 0"),
+    ],
+)
+def test_bad_override_values(overrides, fragment):
+    err = refused(BASE, overrides=overrides)
+    assert fragment in err.message
+    if "fps" in overrides:  # points at the file's fps
+        assert (err.line, err.col) == at(BASE, "10}")
+    else:
+        assert (err.line, err.col) == (1, 1)
+
+
+def test_override_none_means_not_given_and_unknown_keys_are_a_programming_error():
+    assert loads(BASE, overrides={"model": None, "fps": None, "ticks": None}).world.fps == 10
+    with pytest.raises(ValueError):
+        loads(BASE, overrides={"speed": 3})
+
+
+def test_file_values_must_be_valid_even_when_overridden():
+    text = "version: 1\nworld: {fps: 0}\n"
+    check_refused(text, "0}", "world.fps must be at least 1", overrides={"fps": 5})
+
+
+# ----------------------------------------------------------------------------- JSON Schema
+
+
+def _validate(doc, schema, root=None) -> list[str]:
+    """Errors of doc against the subset of JSON Schema 2020-12 that json_schema() uses."""
+    root = schema if root is None else root
+    if schema is True:
+        return []
+    if schema is False:
+        return ["false schema"]
+    if "$ref" in schema:
+        target = root
+        for part in schema["$ref"].removeprefix("#/").split("/"):
+            target = target[part]
+        return _validate(doc, target, root)
+    errors: list[str] = []
+    kinds = {"object": dict, "array": list, "string": str, "boolean": bool}
+    t = schema.get("type")
+    if t in kinds and not isinstance(doc, kinds[t]):
+        return [f"not {t}: {doc!r}"]
+    if t == "integer" and (
+        isinstance(doc, bool)
+        or not (isinstance(doc, int) or (isinstance(doc, float) and doc.is_integer()))
+    ):
+        return [f"not integer: {doc!r}"]
+    if t == "number" and (isinstance(doc, bool) or not isinstance(doc, (int, float))):
+        return [f"not number: {doc!r}"]
+    if "const" in schema and doc != schema["const"]:
+        errors.append(f"not {schema['const']!r}")
+    if "enum" in schema and doc not in schema["enum"]:
+        errors.append(f"{doc!r} not in enum")
+    if "minimum" in schema and doc < schema["minimum"]:
+        errors.append("below minimum")
+    if "maximum" in schema and doc > schema["maximum"]:
+        errors.append("above maximum")
+    if "exclusiveMinimum" in schema and doc <= schema["exclusiveMinimum"]:
+        errors.append("not above exclusiveMinimum")
+    if "pattern" in schema and not re.search(schema["pattern"], doc):
+        errors.append("pattern")
+    if "maxLength" in schema and len(doc) > schema["maxLength"]:
+        errors.append("too long")
+    if isinstance(doc, list):
+        if len(doc) < schema.get("minItems", 0) or len(doc) > schema.get("maxItems", len(doc)):
+            errors.append("item count")
+        if "items" in schema:
+            for item in doc:
+                errors += _validate(item, schema["items"], root)
+    if isinstance(doc, dict):
+        props = schema.get("properties", {})
+        for key in schema.get("required", []):
+            if key not in doc:
+                errors.append(f"missing {key}")
+        for key, value in doc.items():
+            if key in props:
+                errors += _validate(value, props[key], root)
+            elif schema.get("additionalProperties") is False:
+                errors.append(f"extra key {key}")
+    if "anyOf" in schema and not any(not _validate(doc, s, root) for s in schema["anyOf"]):
+        errors.append("anyOf")
+    if "oneOf" in schema and sum(not _validate(doc, s, root) for s in schema["oneOf"]) != 1:
+        errors.append("oneOf")
+    if "not" in schema and not _validate(doc, schema["not"], root):
+        errors.append("not")
+    return errors
+
+
+def test_schema_is_json_and_describes_every_top_level_key():
+    schema = json_schema()
+    assert json.loads(json.dumps(schema)) == schema
+    assert schema["$schema"] == "https://json-schema.org/draft/2020-12/schema"
+    assert set(schema["properties"]) == set(TOP_KEYS)
+    assert schema["additionalProperties"] is False and schema["required"] == ["version"]
+
+
+GOOD_DOCS = [
+    "version: 1\n",
+    (DATA / "spec_example.yaml").read_text(),
+    BASE + "model: {kind: stepped, substeps: 4}\nduration: 2.5\noutput: {frames: {every: 3}}\n",
+    objects(
+        "{shape: polygon, points: [[0, 0], [4, 0], [0, 4]], position: [1, 1], color: '#aabbcc',"
+        " fill: true, name: tri}"
+    ),
+    BASE + "generate:\n  - {count: 3, shape: circle, diameter: 4, velocity: {min: [-1, -1], "
+    "max: [1, 1]}, seed: 2}\n",
+]
+
+
+@pytest.mark.parametrize("text", GOOD_DOCS)
+def test_schema_accepts_good_documents(text):
+    loads(text)  # the loader takes it
+    assert _validate(yaml.safe_load(text), json_schema()) == []
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        "version: 2\n",
+        "name: x\n",
+        BASE + "nmae: x\n",
+        BASE + "ticks: 3\nduration: 1\n",
+        objects("{shape: circle, size: 3, position: [0, 0]}"),
+        objects("{shape: box, size: 3, position: [0, 0], velocty: [1, 0]}"),
+        objects("{shape: box, size: 0, position: [0, 0]}"),
+        objects("{shape: box, size: 3}"),
+        BASE + "model: {kind: paper, geometry: exact}\n",
+        BASE + "golden: {color_threshold: 300}\n",
+        BASE + "name: ../x\n",
+        BASE + "generate:\n  - {count: 3, shape: box, size: 3, speed: 1, velocity: {min: [0, 0], "
+        "max: [0, 0]}}\n",
+    ],
+)
+def test_schema_refuses_bad_documents(text):
+    with pytest.raises(ScenarioError):
+        loads(text)
+    assert _validate(yaml.safe_load(text), json_schema()) != []
