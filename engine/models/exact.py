@@ -353,19 +353,48 @@ def _predict_pair(i, j, t_now, F, N, C, heap, st):
     return heap
 
 
+# A prediction job, one row of an int64 array: the object, the partner to leave out (-1: none),
+# the cells [x0, x1] × [y0, y1] to predict against, whether to predict its wall contact too (its
+# velocity changed) and whether to take only static objects and higher ids (the first prediction).
+J_OBJ, J_SKIP, J_X0, J_X1, J_Y0, J_Y1, J_WALL, J_HIGHER = range(8)
+
+
 @_hot
-def _predict_cells(i, skip, lower_only, x0, x1, y0, y1, t_now, F, N, C, G, heap, st, world):
-    """Predict i against the objects filed in cells [x0, x1] × [y0, y1] (clipped to the grid),
-    except `skip`; with lower_only, only against static objects and moving ones with a higher id."""
+def _job(jobs, k, i, skip, x0, x1, y0, y1, wall, higher):
+    jobs[k, J_OBJ], jobs[k, J_SKIP], jobs[k, J_WALL], jobs[k, J_HIGHER] = i, skip, wall, higher
+    jobs[k, J_X0], jobs[k, J_X1], jobs[k, J_Y0], jobs[k, J_Y1] = x0, x1, y0, y1
+
+
+@_hot
+def _job_around(jobs, k, i, skip, higher, N, world):
+    """Job k: everything about i after its velocity changed, against the 3×3 cells around it."""
+    gx = N[i, CELL] % world[4]
+    gy = N[i, CELL] // world[4]
+    _job(jobs, k, i, skip, gx - 1, gx + 1, gy - 1, gy + 1, 1, higher)
+
+
+@_hot
+def _predict(jobs, k, t_now, F, N, C, G, heap, st, world):
+    """Run prediction job k: push i's wall contact (if asked), its next cell crossing, and its
+    contacts with the objects filed in the job's cells (clipped to the grid)."""
+    i, skip, higher = jobs[k, J_OBJ], jobs[k, J_SKIP], jobs[k, J_HIGHER] != 0
+    if jobs[k, J_WALL] != 0:
+        t, side = _wall_time(i, F, world)
+        if t < INF:
+            key = _key(RANK_WALL, i, side, side)
+            heap = _push(heap, st, N, max(t, t_now), key, N[i, CNT], 0, 0.0, 0.0)
+    t, d = _cross_time(i, F, N, world)
+    if t < INF:
+        heap = _push(heap, st, N, max(t, t_now), _key(RANK_CROSS, i, d, d), N[i, CNT], 0, 0.0, 0.0)
     head, s_start, s_items = G
     gnx, gny = world[4], world[5]
     st[_STAMP] += 1
-    for cy in range(max(y0, 0), min(y1, gny - 1) + 1):
-        for cx in range(max(x0, 0), min(x1, gnx - 1) + 1):
+    for cy in range(max(jobs[k, J_Y0], 0), min(jobs[k, J_Y1], gny - 1) + 1):
+        for cx in range(max(jobs[k, J_X0], 0), min(jobs[k, J_X1], gnx - 1) + 1):
             c = cy * gnx + cx
             j = head[c]
             while j >= 0:
-                if j != i and j != skip and not (lower_only and j < i):
+                if j != i and j != skip and not (higher and j < i):
                     heap = _predict_pair(i, j, t_now, F, N, C, heap, st)
                 j = N[j, NEXT]
             for m in range(s_start[c], s_start[c + 1]):
@@ -376,26 +405,7 @@ def _predict_cells(i, skip, lower_only, x0, x1, y0, y1, t_now, F, N, C, G, heap,
     return heap
 
 
-@_hot
-def _predict(i, skip, lower_only, t_now, F, N, C, G, heap, st, world):
-    """Push every next event of moving object i: its wall, its cell crossing, its contacts with
-    the objects in the 3×3 cells around it (but not `skip`, the partner it has just left)."""
-    t, side = _wall_time(i, F, world)
-    if t < INF:
-        heap = _push(
-            heap, st, N, max(t, t_now), _key(RANK_WALL, i, side, side), N[i, CNT], 0, 0.0, 0.0
-        )
-    t, d = _cross_time(i, F, N, world)
-    if t < INF:
-        heap = _push(heap, st, N, max(t, t_now), _key(RANK_CROSS, i, d, d), N[i, CNT], 0, 0.0, 0.0)
-    gx = N[i, CELL] % world[4]
-    gy = N[i, CELL] // world[4]
-    return _predict_cells(
-        i, skip, lower_only, gx - 1, gx + 1, gy - 1, gy + 1, t_now, F, N, C, G, heap, st, world
-    )
-
-
-# --- events ------------------------------------------------------------------------------------
+# --- events: each changes the state and says what to predict next ------------------------------
 
 
 @_hot
@@ -408,27 +418,27 @@ def _move_to(i, t, F):
 
 
 @_hot
-def _on_cross(i, d, t, F, N, C, G, heap, st, world):
-    """i's centre enters the next cell: refile it, predict its next crossing and its contacts with
-    the row or column of cells that comes into reach."""
+def _on_cross(i, d, N, G, world, jobs):
+    """i's centre enters the next cell: refile it; predict its next crossing and its contacts with
+    the row or column of cells that comes into reach. Returns the number of jobs (1)."""
     gnx = world[4]
     gx = N[i, CELL] % gnx + (1 if d == DIR_RIGHT else -1 if d == DIR_LEFT else 0)
     gy = N[i, CELL] // gnx + (1 if d == DIR_DOWN else -1 if d == DIR_UP else 0)
     _cell_remove(N, G[0], i)
     _cell_insert(N, G[0], i, gy * gnx + gx)
-    tc, dc = _cross_time(i, F, N, world)
-    if tc < INF:
-        heap = _push(heap, st, N, max(tc, t), _key(RANK_CROSS, i, dc, dc), N[i, CNT], 0, 0.0, 0.0)
     if d == DIR_RIGHT or d == DIR_LEFT:
         x = gx + (1 if d == DIR_RIGHT else -1)
-        return _predict_cells(i, -1, False, x, x, gy - 1, gy + 1, t, F, N, C, G, heap, st, world)
-    y = gy + (1 if d == DIR_DOWN else -1)
-    return _predict_cells(i, -1, False, gx - 1, gx + 1, y, y, t, F, N, C, G, heap, st, world)
+        _job(jobs, 0, i, -1, x, x, gy - 1, gy + 1, 0, 0)
+    else:
+        y = gy + (1 if d == DIR_DOWN else -1)
+        _job(jobs, 0, i, -1, gx - 1, gx + 1, y, y, 0, 0)
+    return 1
 
 
 @_hot
-def _on_wall(i, side, t, F, N, C, G, heap, st, world):
-    """i's box touches a wall: reflect that velocity component, set it exactly on the wall line."""
+def _on_wall(i, side, t, F, N, world, jobs):
+    """i's box touches a wall: reflect that velocity component, set it exactly on the wall line.
+    Returns the number of jobs (1)."""
     _move_to(i, t, F)
     if side == SIDE_LEFT or side == SIDE_RIGHT:
         F[i, VX] = -F[i, VX]
@@ -437,29 +447,29 @@ def _on_wall(i, side, t, F, N, C, G, heap, st, world):
         F[i, VY] = -F[i, VY]
         F[i, Y] = 0.0 if side == SIDE_TOP else world[1] - F[i, SH]
     N[i, CNT] += 1
-    return _predict(i, -1, False, t, F, N, C, G, heap, st, world)
+    _job_around(jobs, 0, i, -1, 0, N, world)
+    return 1
 
 
 @_hot
-def _on_pair(a, b, code, nx, ny, t, F, N, C, G, heap, st, world):
-    """a and b touch: the elastic exchange, then each predicted again (not against the other).
-    Returns (heap, whether the velocities changed)."""
+def _on_pair(a, b, code, nx, ny, t, F, N, world, jobs):
+    """a and b touch: the elastic exchange; then each moving one is predicted again, but not
+    against the other. Returns the number of jobs (0: they were not approaching, no event)."""
     _move_to(a, t, F)
     _move_to(b, t, F)
     vax, vay, vbx, vby, changed = exchange(
         F[a, VX], F[a, VY], F[b, VX], F[b, VY], F[a, INV_MASS], F[b, INV_MASS], code, nx, ny
     )
     if not changed:
-        return heap, False
+        return 0
     F[a, VX], F[a, VY], F[b, VX], F[b, VY] = vax, vay, vbx, vby
-    for i in (a, b):
+    n_jobs = 0
+    for i, other in ((a, b), (b, a)):
         if N[i, STATIC] == 0:
             N[i, CNT] += 1
-    if N[a, STATIC] == 0:
-        heap = _predict(a, b, False, t, F, N, C, G, heap, st, world)
-    if N[b, STATIC] == 0:
-        heap = _predict(b, a, False, t, F, N, C, G, heap, st, world)
-    return heap, True
+            _job_around(jobs, n_jobs, i, other, 0, N, world)
+            n_jobs += 1
+    return n_jobs
 
 
 @_hot
@@ -480,23 +490,26 @@ def _sync(t, F, N, world):
 @njit(cache=True)
 def _predict_all(F, N, C, G, heap, st, world):
     """Initial predictions at time 0: every moving object, each pair once."""
+    jobs = np.zeros((1, 8), np.int64)
     for i in range(F.shape[0]):
         if N[i, STATIC] == 0:
-            heap = _predict(i, -1, True, 0.0, F, N, C, G, heap, st, world)
+            _job_around(jobs, 0, i, -1, 1, N, world)
+            heap = _predict(jobs, 0, 0.0, F, N, C, G, heap, st, world)
     return heap
 
 
 @njit(cache=True)
 def _run(tick_to, log, cap, F, N, C, G, heap, st, stf, world, rows, times):
-    """Run ticks until tick_to: pop events in order, handle each, sync at each tick's end.
+    """Run ticks until tick_to: pop due events in order, apply each, predict again for the objects
+    it touched; move everything to each tick's end.
 
     Returns (status, heap, rows, times, events logged); STATUS_CAP stops mid-tick.
     """
-    fps = world[2]
+    jobs = np.zeros((2, 8), np.int64)
     n_ev = 0
     while st[_TICK] < tick_to:
         tick = st[_TICK] + 1
-        t_end = tick / fps
+        t_end = tick / world[2]
         while st[_HEAP_N] > 0 and heap[0][0, HT] <= t_end:
             t, key, ca, cb, nx, ny = _pop(heap, st)
             if not _valid(key, ca, cb, N):
@@ -504,20 +517,22 @@ def _run(tick_to, log, cap, F, N, C, G, heap, st, stf, world, rows, times):
             stf[_T_NOW] = t
             rank, a, b, code = _unkey(key)
             if rank == RANK_CROSS:
-                heap = _on_cross(a, b, t, F, N, C, G, heap, st, world)
-                continue
-            st[_TICK_EVENTS] += 1
-            if st[_TICK_EVENTS] > cap:
-                return STATUS_CAP, heap, rows, times, n_ev
-            if rank == RANK_WALL:
-                heap = _on_wall(a, b, t, F, N, C, G, heap, st, world)
-                kind, b, happened = EV_WALL, -1, True
+                n_jobs = _on_cross(a, b, N, G, world, jobs)
             else:
-                heap, happened = _on_pair(a, b, code, nx, ny, t, F, N, C, G, heap, st, world)
-                kind = EV_PAIR
-            if log and happened:
-                rows, times = log_event(rows, times, n_ev, tick, t, kind, a, b, code)
-                n_ev += 1
+                st[_TICK_EVENTS] += 1
+                if st[_TICK_EVENTS] > cap:
+                    return STATUS_CAP, heap, rows, times, n_ev
+                if rank == RANK_WALL:
+                    n_jobs = _on_wall(a, b, t, F, N, world, jobs)
+                    kind, b = EV_WALL, -1
+                else:
+                    n_jobs = _on_pair(a, b, code, nx, ny, t, F, N, world, jobs)
+                    kind = EV_PAIR
+                if log and n_jobs > 0:  # a pair that was not approaching is no event
+                    rows, times = log_event(rows, times, n_ev, tick, t, kind, a, b, code)
+                    n_ev += 1
+            for k in range(n_jobs):
+                heap = _predict(jobs, k, t, F, N, C, G, heap, st, world)
         _sync(t_end, F, N, world)
         stf[_T_NOW] = t_end
         st[_TICK] = tick
