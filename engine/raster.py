@@ -7,10 +7,10 @@ background and `Bodies.color[i]` the colour of object i; the RGB picture is `pal
 (`to_rgb`).
 
 Rules, all in exact integer arithmetic once positions are rounded as `floor(x + 0.5)`:
-- outlines are the paper's DDA lines (section II.B) with exact rounding (`_dda_coord`);
+- outlines are the paper's DDA lines (section II.B) with exact rounding (`_dda_start`);
 - a box w x h at (x, y) is the DDA outline through its corners (x, y), (x+w-1, y), (x+w-1, y+h-1),
   (x, y+h-1); a polygon is the closed DDA outline through `(x, y) + verts`;
-- a circle of diameter d fills the d x d box at (x, y) with the midpoint circle algorithm, worked in
+- a circle of diameter d fits the d x d box at (x, y) with the midpoint circle algorithm, worked in
   doubled coordinates so that even diameters are centred too (`_circle`);
 - `fill` paints whole boxes, circle rows between the outline's extremes, and polygon pixels whose
   centres are inside (even-odd rule);

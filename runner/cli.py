@@ -13,7 +13,7 @@ import sys
 from importlib import resources
 
 from engine.models import ModelUnavailable
-from runner import validate
+from runner import stress, validate
 from runner.golden import cli as golden_cli
 from runner.options import (
     add_limit_arguments,
@@ -89,6 +89,7 @@ def build_parser() -> argparse.ArgumentParser:
     register_run(subparsers)
     golden_cli.register(subparsers)
     validate.register(subparsers)
+    stress.register(subparsers)
     return parser
 
 

@@ -80,6 +80,7 @@ _NAME_RE = re.compile(NAME_PATTERN + r"\Z")
 _FLOAT12_RE = re.compile(r"[-+]?(\.[0-9]+|[0-9]+(\.[0-9]*)?)[eE][-+]?[0-9]+\Z")
 _CORE = "tag:yaml.org,2002:"
 _ALLOWED_TAGS = {_CORE + t for t in ("str", "int", "float", "bool", "null", "seq", "map")}
+_CONSTRUCTED_TAGS = {_CORE + t for t in ("int", "float", "bool")}  # a tagged text may not fit
 _KIND_OF_SHAPE = {"box": KIND_BOX, "circle": KIND_CIRCLE, "polygon": KIND_POLYGON}
 _SIZE_KEY = {"box": "size", "circle": "diameter", "polygon": "points"}
 _CONSTRUCTOR = yaml.constructor.SafeConstructor()
@@ -312,6 +313,8 @@ def _check_events(text: str, path: str, limits: Limits) -> None:
                         "allowed; a scenario holds plain values only",
                     )
                 if isinstance(ev, yaml.ScalarEvent):
+                    if tag in _CONSTRUCTED_TAGS:
+                        _check_tagged(ev, tag, path)
                     if ev.anchor is not None:
                         sizes[ev.anchor] = 1
                     add(1)
@@ -330,6 +333,16 @@ def _check_events(text: str, path: str, limits: Limits) -> None:
                 add(n)
     except yaml.YAMLError as exc:
         raise _yaml_error(exc, path, text) from None
+
+
+def _check_tagged(ev, tag: str, path: str) -> None:
+    """A scalar with an explicit `!!int`, `!!float` or `!!bool` tag must be such a value."""
+    try:
+        _value(yaml.ScalarNode(tag, ev.value, style=ev.style))
+    except (ValueError, KeyError, IndexError, TypeError):
+        raise _mark_error(
+            path, ev.start_mark, f"{ev.value!r} is not a valid {_tag_name(tag)} value"
+        ) from None
 
 
 def _compose(text: str, path: str, limits: Limits) -> yaml.Node:

@@ -8,6 +8,8 @@ failure naming the command that creates it. `pytest --update-goldens` blesses wh
 
 from __future__ import annotations
 
+import pytest
+
 # The whole goldens/ folder stays small enough to live in the repository (bytes).
 GOLDENS_BUDGET_BYTES = 5 * 1024 * 1024
 
@@ -27,9 +29,13 @@ def test_goldens_stay_small(golden_root):
 
 
 def _golden(root, name):
-    from runner.golden.store import GoldenStore
+    from runner.golden.store import GoldenError, GoldenStore
 
-    return GoldenStore(root).read(name)
+    try:
+        return GoldenStore(root).read(name)
+    except GoldenError as exc:
+        problem = str(exc)
+    pytest.fail(f"{problem}; create it with: collide2d bless scenarios/{name}.yaml", pytrace=False)
 
 
 def _pairs(golden):

@@ -34,7 +34,7 @@ from numba import njit
 from engine.broadphase import grid_cell, grid_dims, static_cells
 from engine.contact import box_next_contact, next_contact
 from engine.events import EV_PAIR, EV_WALL, SIDE_BOTTOM, SIDE_LEFT, SIDE_RIGHT, SIDE_TOP
-from engine.models.stepped import event_records, log_event, new_log
+from engine.models.stepped import event_records, new_log
 from engine.response import exchange
 from engine.shapes import GEOMETRIES, build_cores
 from engine.world import KIND_BOX, Bodies, WorldSpec
@@ -69,13 +69,16 @@ MAX_OBJECTS = 1 << _ID_BITS
 # Cell-crossing directions.
 DIR_LEFT, DIR_RIGHT, DIR_UP, DIR_DOWN = range(4)
 
-# Scalar state st (int64): heap size, ticks done, events in the current tick, query stamp.
-_HEAP_N, _TICK, _TICK_EVENTS, _STAMP = range(4)
+# Scalar state st (int64): heap size, ticks done, events in the current tick, query stamp, event
+# rows written in this `advance`.
+_HEAP_N, _TICK, _TICK_EVENTS, _STAMP, _LOGGED = range(5)
 # stf (float64): the current time, s.
 _T_NOW = 0
 
 STATUS_DONE = 0
 STATUS_CAP = 1
+STATUS_HEAP_FULL = 2
+STATUS_LOG_FULL = 3
 
 INF = np.inf
 _hot = njit(cache=True, inline="always")
@@ -113,7 +116,7 @@ def _valid(key, ca, cb, N):
     return rank != RANK_PAIR or N[b, CNT] == cb
 
 
-# --- the binary heap ---------------------------------------------------------------------------
+# --- the binary heap (HF, HI); the caller makes sure there is room before an event ---------------
 
 
 @_hot
@@ -168,44 +171,17 @@ def _sift_down(HF, HI, n, i, t, nx, ny, key, ca, cb):
     _put(HF, HI, i, t, nx, ny, key, ca, cb)
 
 
-@njit(cache=True)
-def _make_room(heap, st, N):
-    """Drop stale entries and rebuild the heap; double its arrays if still more than half full."""
-    HF, HI = heap
-    keep = 0
-    for i in range(st[_HEAP_N]):
-        if _valid(HI[i, HKEY], HI[i, HCA], HI[i, HCB], N):
-            _copy(HF, HI, keep, i)
-            keep += 1
-    if 2 * keep > HF.shape[0]:
-        grown_f = np.empty((2 * HF.shape[0], 3))
-        grown_i = np.empty((2 * HF.shape[0], 3), np.int64)
-        grown_f[:keep] = HF[:keep]
-        grown_i[:keep] = HI[:keep]
-        HF, HI = grown_f, grown_i
-    for i in range(keep // 2 - 1, -1, -1):
-        _sift_down(
-            HF, HI, keep, i, HF[i, HT], HF[i, HNX], HF[i, HNY], HI[i, HKEY], HI[i, HCA], HI[i, HCB]
-        )
-    st[_HEAP_N] = keep
-    return HF, HI
-
-
 @_hot
-def _push(heap, st, N, t, key, ca, cb, nx, ny):
-    """Add an entry; returns the heap arrays to use from now on (new ones if it had to grow)."""
-    if st[_HEAP_N] == heap[0].shape[0]:
-        heap = _make_room(heap, st, N)
+def _push(HF, HI, st, t, key, ca, cb, nx, ny):
+    """Add an entry (there is room)."""
     n = st[_HEAP_N]
     st[_HEAP_N] = n + 1
-    _sift_up(heap[0], heap[1], n, t, nx, ny, key, ca, cb)
-    return heap
+    _sift_up(HF, HI, n, t, nx, ny, key, ca, cb)
 
 
 @_hot
-def _pop(heap, st):
+def _pop(HF, HI, st):
     """Remove and return the earliest entry (t, key, ca, cb, nx, ny)."""
-    HF, HI = heap
     top = (HF[0, HT], HI[0, HKEY], HI[0, HCA], HI[0, HCB], HF[0, HNX], HF[0, HNY])
     n = st[_HEAP_N] - 1
     st[_HEAP_N] = n
@@ -216,33 +192,61 @@ def _pop(heap, st):
     return top
 
 
+@njit(cache=True)
+def _compact(HF, HI, st, N):
+    """Drop stale entries and rebuild the heap in place; returns the free room."""
+    keep = 0
+    for i in range(st[_HEAP_N]):
+        if _valid(HI[i, HKEY], HI[i, HCA], HI[i, HCB], N):
+            _copy(HF, HI, keep, i)
+            keep += 1
+    for i in range(keep // 2 - 1, -1, -1):
+        _sift_down(
+            HF, HI, keep, i, HF[i, HT], HF[i, HNX], HF[i, HNY], HI[i, HKEY], HI[i, HCA], HI[i, HCB]
+        )
+    st[_HEAP_N] = keep
+    return HF.shape[0] - keep
+
+
+def _grown(a: np.ndarray, rows: int) -> np.ndarray:
+    """a with at least `rows` rows (doubling), the old rows kept."""
+    out = np.empty((max(rows, 2 * a.shape[0]),) + a.shape[1:], a.dtype)
+    out[: a.shape[0]] = a
+    return out
+
+
 # --- grid cells: doubly linked lists of the moving objects in each cell -----------------------
+# cells (gnx·gny, 2) int64: the first object filed in the cell (-1: none) and how many there are.
+C_HEAD, C_COUNT = range(2)
 
 
 @_hot
-def _cell_insert(N, head, i, c):
+def _cell_insert(N, cells, i, c):
     N[i, CELL] = c
     N[i, PREV] = -1
-    N[i, NEXT] = head[c]
-    if head[c] >= 0:
-        N[head[c], PREV] = i
-    head[c] = i
+    N[i, NEXT] = cells[c, C_HEAD]
+    if cells[c, C_HEAD] >= 0:
+        N[cells[c, C_HEAD], PREV] = i
+    cells[c, C_HEAD] = i
+    cells[c, C_COUNT] += 1
 
 
 @_hot
-def _cell_remove(N, head, i):
+def _cell_remove(N, cells, i):
     if N[i, PREV] >= 0:
         N[N[i, PREV], NEXT] = N[i, NEXT]
     else:
-        head[N[i, CELL]] = N[i, NEXT]
+        cells[N[i, CELL], C_HEAD] = N[i, NEXT]
     if N[i, NEXT] >= 0:
         N[N[i, NEXT], PREV] = N[i, PREV]
+    cells[N[i, CELL], C_COUNT] -= 1
 
 
 @njit(cache=True)
 def _build_grid(F, N, cell, gnx, gny):
-    """Grid G = (head, static_start, static_items); moving objects filed by their box centre."""
-    head = np.full(gnx * gny, -1, np.int64)
+    """Grid G = (cells, static_start, static_items); moving objects filed by their box centre."""
+    cells = np.zeros((gnx * gny, 2), np.int64)
+    cells[:, C_HEAD] = -1
     static = N[:, STATIC] != 0
     s_start, s_items = static_cells(
         F[:, X : Y + 1].copy(), F[:, SW : SH + 1].copy(), static, cell, gnx, gny
@@ -252,8 +256,41 @@ def _build_grid(F, N, cell, gnx, gny):
         if not static[i]:
             cx = min(max(int((F[i, X] + 0.5 * F[i, SW]) // cell), 0), gnx - 1)
             cy = min(max(int((F[i, Y] + 0.5 * F[i, SH]) // cell), 0), gny - 1)
-            _cell_insert(N, head, i, cy * gnx + cx)
-    return head, s_start, s_items
+            _cell_insert(N, cells, i, cy * gnx + cx)
+    return cells, s_start, s_items
+
+
+@_hot
+def _population(x0, x1, y0, y1, cells, s_start, world):
+    """How many objects (moving and static) are filed in cells [x0, x1] × [y0, y1], clipped."""
+    gnx, gny = world[4], world[5]
+    total = 0
+    for cy in range(max(y0, 0), min(y1, gny - 1) + 1):
+        for cx in range(max(x0, 0), min(x1, gnx - 1) + 1):
+            c = cy * gnx + cx
+            total += cells[c, C_COUNT] + s_start[c + 1] - s_start[c]
+    return total
+
+
+@_hot
+def _room_needed(rank, a, b, N, cells, s_start, world):
+    """Heap entries the event (rank, a, b) may push at most: a wall and a crossing per object it
+    touches, and one contact per object in the cells predicted against."""
+    gnx = world[4]
+    gx = N[a, CELL] % gnx
+    gy = N[a, CELL] // gnx
+    if rank == RANK_CROSS:
+        if b == DIR_LEFT or b == DIR_RIGHT:
+            x = gx + (2 if b == DIR_RIGHT else -2)
+            return 1 + _population(x, x, gy - 1, gy + 1, cells, s_start, world)
+        y = gy + (2 if b == DIR_DOWN else -2)
+        return 1 + _population(gx - 1, gx + 1, y, y, cells, s_start, world)
+    room = 2 + _population(gx - 1, gx + 1, gy - 1, gy + 1, cells, s_start, world)
+    if rank == RANK_PAIR:
+        gx = N[b, CELL] % gnx
+        gy = N[b, CELL] // gnx
+        room += 2 + _population(gx - 1, gx + 1, gy - 1, gy + 1, cells, s_start, world)
+    return room
 
 
 # --- predictions -------------------------------------------------------------------------------
@@ -332,7 +369,7 @@ def _shape_contact(a, b, qx, qy, ux, uy, F, N, C):
 
 
 @_hot
-def _predict_pair(i, j, t_now, F, N, C, heap, st):
+def _predict_pair(i, j, t_now, F, N, C, HF, HI, st):
     """Push the next contact of i and j, if any."""
     a = min(i, j)
     b = max(i, j)
@@ -347,10 +384,7 @@ def _predict_pair(i, j, t_now, F, N, C, heap, st):
     else:
         t, code, nx, ny = _shape_contact(a, b, qx, qy, ux, uy, F, N, C)
     if t < INF:
-        heap = _push(
-            heap, st, N, t_now + t, _key(RANK_PAIR, a, b, code), N[a, CNT], N[b, CNT], nx, ny
-        )
-    return heap
+        _push(HF, HI, st, t_now + t, _key(RANK_PAIR, a, b, code), N[a, CNT], N[b, CNT], nx, ny)
 
 
 # A prediction job, one row of an int64 array: the object, the partner to leave out (-1: none),
@@ -374,35 +408,32 @@ def _job_around(jobs, k, i, skip, higher, N, world):
 
 
 @_hot
-def _predict(jobs, k, t_now, F, N, C, G, heap, st, world):
+def _predict(jobs, k, t_now, F, N, C, cells, s_start, s_items, HF, HI, st, world):
     """Run prediction job k: push i's wall contact (if asked), its next cell crossing, and its
     contacts with the objects filed in the job's cells (clipped to the grid)."""
     i, skip, higher = jobs[k, J_OBJ], jobs[k, J_SKIP], jobs[k, J_HIGHER] != 0
     if jobs[k, J_WALL] != 0:
         t, side = _wall_time(i, F, world)
         if t < INF:
-            key = _key(RANK_WALL, i, side, side)
-            heap = _push(heap, st, N, max(t, t_now), key, N[i, CNT], 0, 0.0, 0.0)
+            _push(HF, HI, st, max(t, t_now), _key(RANK_WALL, i, side, side), N[i, CNT], 0, 0.0, 0.0)
     t, d = _cross_time(i, F, N, world)
     if t < INF:
-        heap = _push(heap, st, N, max(t, t_now), _key(RANK_CROSS, i, d, d), N[i, CNT], 0, 0.0, 0.0)
-    head, s_start, s_items = G
+        _push(HF, HI, st, max(t, t_now), _key(RANK_CROSS, i, d, d), N[i, CNT], 0, 0.0, 0.0)
     gnx, gny = world[4], world[5]
     st[_STAMP] += 1
     for cy in range(max(jobs[k, J_Y0], 0), min(jobs[k, J_Y1], gny - 1) + 1):
         for cx in range(max(jobs[k, J_X0], 0), min(jobs[k, J_X1], gnx - 1) + 1):
             c = cy * gnx + cx
-            j = head[c]
+            j = cells[c, C_HEAD]
             while j >= 0:
                 if j != i and j != skip and not (higher and j < i):
-                    heap = _predict_pair(i, j, t_now, F, N, C, heap, st)
+                    _predict_pair(i, j, t_now, F, N, C, HF, HI, st)
                 j = N[j, NEXT]
             for m in range(s_start[c], s_start[c + 1]):
                 j = s_items[m]
                 if N[j, STAMP] != st[_STAMP] and j != skip:
                     N[j, STAMP] = st[_STAMP]
-                    heap = _predict_pair(i, j, t_now, F, N, C, heap, st)
-    return heap
+                    _predict_pair(i, j, t_now, F, N, C, HF, HI, st)
 
 
 # --- events: each changes the state and says what to predict next ------------------------------
@@ -418,14 +449,14 @@ def _move_to(i, t, F):
 
 
 @_hot
-def _on_cross(i, d, N, G, world, jobs):
+def _on_cross(i, d, N, cells, world, jobs):
     """i's centre enters the next cell: refile it; predict its next crossing and its contacts with
     the row or column of cells that comes into reach. Returns the number of jobs (1)."""
     gnx = world[4]
     gx = N[i, CELL] % gnx + (1 if d == DIR_RIGHT else -1 if d == DIR_LEFT else 0)
     gy = N[i, CELL] // gnx + (1 if d == DIR_DOWN else -1 if d == DIR_UP else 0)
-    _cell_remove(N, G[0], i)
-    _cell_insert(N, G[0], i, gy * gnx + gx)
+    _cell_remove(N, cells, i)
+    _cell_insert(N, cells, i, gy * gnx + gx)
     if d == DIR_RIGHT or d == DIR_LEFT:
         x = gx + (1 if d == DIR_RIGHT else -1)
         _job(jobs, 0, i, -1, x, x, gy - 1, gy + 1, 0, 0)
@@ -488,40 +519,54 @@ def _sync(t, F, N, world):
 
 
 @njit(cache=True)
-def _predict_all(F, N, C, G, heap, st, world):
-    """Initial predictions at time 0: every moving object, each pair once."""
+def _predict_all(first, F, N, C, cells, s_start, s_items, HF, HI, st, world):
+    """Initial predictions at time 0 for moving objects first, first+1, ..., each pair once.
+
+    Returns the object to resume from when the heap is full (n when done).
+    """
     jobs = np.zeros((1, 8), np.int64)
-    for i in range(F.shape[0]):
-        if N[i, STATIC] == 0:
-            _job_around(jobs, 0, i, -1, 1, N, world)
-            heap = _predict(jobs, 0, 0.0, F, N, C, G, heap, st, world)
-    return heap
+    for i in range(first, F.shape[0]):
+        if N[i, STATIC] != 0:
+            continue
+        _job_around(jobs, 0, i, -1, 1, N, world)
+        room = 2 + _population(
+            jobs[0, J_X0], jobs[0, J_X1], jobs[0, J_Y0], jobs[0, J_Y1], cells, s_start, world
+        )
+        if HF.shape[0] - st[_HEAP_N] < room and _compact(HF, HI, st, N) < room:
+            return i
+        _predict(jobs, 0, 0.0, F, N, C, cells, s_start, s_items, HF, HI, st, world)
+    return F.shape[0]
 
 
-@njit(cache=True)
-def _run(tick_to, log, cap, F, N, C, G, heap, st, stf, world, rows, times):
-    """Run ticks until tick_to: pop due events in order, apply each, predict again for the objects
+@njit(cache=True, _nrt=False)
+def _run(jobs, tick_to, log, cap, F, N, C, cells, s_start, s_items, HF, HI, st, stf, world, rows, times):
+    """Run ticks until tick_to: take due events in order, apply each, predict again for the objects
     it touched; move everything to each tick's end.
 
-    Returns (status, heap, rows, times, events logged); STATUS_CAP stops mid-tick.
+    Returns a status: STATUS_DONE; STATUS_HEAP_FULL / STATUS_LOG_FULL (grow, call again: nothing
+    was lost); STATUS_CAP (a runaway; stops mid-tick). st[_LOGGED] counts the rows written.
     """
-    jobs = np.zeros((2, 8), np.int64)
-    n_ev = 0
     while st[_TICK] < tick_to:
         tick = st[_TICK] + 1
         t_end = tick / world[2]
-        while st[_HEAP_N] > 0 and heap[0][0, HT] <= t_end:
-            t, key, ca, cb, nx, ny = _pop(heap, st)
-            if not _valid(key, ca, cb, N):
+        while st[_HEAP_N] > 0 and HF[0, HT] <= t_end:
+            if not _valid(HI[0, HKEY], HI[0, HCA], HI[0, HCB], N):
+                _pop(HF, HI, st)
                 continue
+            rank, a, b, code = _unkey(HI[0, HKEY])
+            room = _room_needed(rank, a, b, N, cells, s_start, world)
+            if HF.shape[0] - st[_HEAP_N] < room and _compact(HF, HI, st, N) < room:
+                return STATUS_HEAP_FULL
+            if log and st[_LOGGED] == rows.shape[0]:
+                return STATUS_LOG_FULL
+            t, key, ca, cb, nx, ny = _pop(HF, HI, st)
             stf[_T_NOW] = t
-            rank, a, b, code = _unkey(key)
             if rank == RANK_CROSS:
-                n_jobs = _on_cross(a, b, N, G, world, jobs)
+                n_jobs = _on_cross(a, b, N, cells, world, jobs)
             else:
                 st[_TICK_EVENTS] += 1
                 if st[_TICK_EVENTS] > cap:
-                    return STATUS_CAP, heap, rows, times, n_ev
+                    return STATUS_CAP
                 if rank == RANK_WALL:
                     n_jobs = _on_wall(a, b, t, F, N, world, jobs)
                     kind, b = EV_WALL, -1
@@ -529,15 +574,21 @@ def _run(tick_to, log, cap, F, N, C, G, heap, st, stf, world, rows, times):
                     n_jobs = _on_pair(a, b, code, nx, ny, t, F, N, world, jobs)
                     kind = EV_PAIR
                 if log and n_jobs > 0:  # a pair that was not approaching is no event
-                    rows, times = log_event(rows, times, n_ev, tick, t, kind, a, b, code)
-                    n_ev += 1
+                    _log_row(rows, times, st[_LOGGED], tick, t, kind, a, b, code)
+                    st[_LOGGED] += 1
             for k in range(n_jobs):
-                heap = _predict(jobs, k, t, F, N, C, G, heap, st, world)
+                _predict(jobs, k, t, F, N, C, cells, s_start, s_items, HF, HI, st, world)
         _sync(t_end, F, N, world)
         stf[_T_NOW] = t_end
         st[_TICK] = tick
         st[_TICK_EVENTS] = 0
-    return STATUS_DONE, heap, rows, times, n_ev
+    return STATUS_DONE
+
+
+@_hot
+def _log_row(rows, times, n, tick, t, kind, a, b, code):
+    rows[n, 0], rows[n, 1], rows[n, 2], rows[n, 3], rows[n, 4] = tick, kind, a, b, code
+    times[n] = t
 
 
 class Model:
@@ -575,9 +626,9 @@ class Model:
         self._F[:, VX : VY + 1] = np.where(static[:, None], 0.0, bodies.vel)
         self._F[:, SW : SH + 1] = bodies.size
         self._F[:, INV_MASS] = bodies.inv_mass
-        self._I = np.zeros((n, 7), np.int64)
-        self._I[:, STATIC] = static
-        self._I[:, SHAPE] = cores.shape
+        self._N = np.zeros((n, 7), np.int64)
+        self._N[:, STATIC] = static
+        self._N[:, SHAPE] = cores.shape
         self._C = (cores.radius, cores.start, cores.verts, cores.normals)
         if cell_size is None:
             cell_size = grid_cell(world.width, world.height, self._F[:, SW : SH + 1], static)
@@ -591,42 +642,68 @@ class Model:
             gnx,
             gny,
         )
-        self._G = _build_grid(self._F, self._I, self.cell_size, gnx, gny)
+        self._G = _build_grid(self._F, self._N, self.cell_size, gnx, gny)
         cap = max(64, HEAP_PER_OBJECT * n)
-        heap = (np.empty((cap, 3)), np.empty((cap, 3), np.int64))
-        self._st = np.zeros(4, np.int64)
+        self._HF = np.empty((cap, 3))
+        self._HI = np.empty((cap, 3), np.int64)
+        self._st = np.zeros(5, np.int64)
         self._stf = np.zeros(1)
-        self._H = _predict_all(self._F, self._I, self._C, self._G, heap, self._st, self._world)
+        first = 0
+        while first < n:
+            first = _predict_all(first, *self._kernel_state())
+            if first < n:
+                self._grow_heap()
+
+    def _kernel_state(self):
+        """The arrays the kernels share: F, N, cores, grid (3 arrays), heap (2), st, world."""
+        return (self._F, self._N, self._C, *self._G, self._HF, self._HI, self._st, self._world)
+
+    def _grow_heap(self):
+        self._HF = _grown(self._HF, 0)
+        self._HI = _grown(self._HI, 0)
 
     def advance(self, ticks: int, log: bool = True) -> np.ndarray:
         """Run `ticks` ticks; the events in the order they happened (empty when log is False)."""
         if self._broken:
             raise EventCapExceeded(self._broken)
         rows, times = new_log(log)
-        status, self._H, rows, times, n = _run(
-            self.tick + int(ticks),
-            bool(log),
-            self.max_events_per_tick,
-            self._F,
-            self._I,
-            self._C,
-            self._G,
-            self._H,
-            self._st,
-            self._stf,
-            self._world,
-            rows,
-            times,
-        )
-        if status == STATUS_CAP:
-            self._broken = (
-                f"tick {int(self._st[_TICK]) + 1} needed more than {self.max_events_per_tick} "
-                f"events (max_events_per_tick); stopped as a runaway at t = "
-                f"{float(self._stf[_T_NOW])!r} s"
+        self._st[_LOGGED] = 0
+        target = self.tick + int(ticks)
+        while True:
+            F, N, C, cells, s_start, s_items, HF, HI, st, world = self._kernel_state()
+            status = _run(
+                target,
+                bool(log),
+                self.max_events_per_tick,
+                F,
+                N,
+                C,
+                cells,
+                s_start,
+                s_items,
+                HF,
+                HI,
+                st,
+                self._stf,
+                world,
+                rows,
+                times,
             )
-            raise EventCapExceeded(self._broken)
+            if status == STATUS_HEAP_FULL:
+                self._grow_heap()
+            elif status == STATUS_LOG_FULL:
+                rows, times = _grown(rows, 0), _grown(times, 0)
+            elif status == STATUS_CAP:
+                self._broken = (
+                    f"tick {int(st[_TICK]) + 1} needed more than {self.max_events_per_tick} "
+                    f"events (max_events_per_tick); stopped as a runaway at t = "
+                    f"{float(self._stf[_T_NOW])!r} s"
+                )
+                raise EventCapExceeded(self._broken)
+            else:
+                break
         self.tick = int(self._st[_TICK])
-        return event_records(rows, times, n)
+        return event_records(rows, times, int(self._st[_LOGGED]))
 
     def positions(self) -> np.ndarray:
         """(n, 2) float64 top-left corners at the last tick's end, px."""

@@ -13,29 +13,17 @@ updated or unchanged, with a one-line summary of what changed).
 
 from __future__ import annotations
 
-import os
+import json
 import shlex
 from dataclasses import dataclass
-from pathlib import Path
 
 from runner.golden import compare, report
 from runner.golden import serialize as ser
-from runner.golden.store import GoldenMissing, GoldenStore, GoldenUnreadable
+from runner.golden.store import GoldenMissing, GoldenStore, GoldenUnreadable, shown_path
 
 CREATED = "created"
 UPDATED = "updated"
 UNCHANGED = "unchanged"
-
-
-def shown_path(path) -> str:
-    """A scenario path as the user would type it: relative to the current directory when inside it,
-    with forward slashes."""
-    path = Path(path)
-    try:
-        rel = Path(os.path.relpath(path.resolve()))
-    except ValueError:
-        return path.as_posix()
-    return path.as_posix() if rel.parts[:1] == ("..",) else rel.as_posix()
 
 
 def bless_command(path) -> str:
@@ -63,10 +51,11 @@ def check_run(scenario, result, store: GoldenStore, *, path=None, report_dir=Non
     except GoldenMissing as exc:
         outcome.status = report.STATUS_MISSING
         outcome.problems.append(str(exc))
-        outcome.problems.extend(
-            report.FrameReport(k, f"frame {k}: no golden yet (this run's frame)", None, rgb)
-            for k, rgb in sorted(run_frames.items())
-        )
+        if report_dir is not None:  # show what a bless would write
+            outcome.problems.extend(
+                report.FrameReport(k, f"frame {k}: no golden yet (this run's frame)", None, rgb)
+                for k, rgb in sorted(run_frames.items())
+            )
     except GoldenUnreadable as exc:
         outcome.status = report.STATUS_UNREADABLE
         outcome.problems.append(str(exc))
@@ -74,9 +63,21 @@ def check_run(scenario, result, store: GoldenStore, *, path=None, report_dir=Non
         _compare(scenario, result, golden, run_frames, outcome)
         if outcome.problems:
             outcome.status = report.STATUS_FAILED
+            outcome.problems[:0] = _setting_notes(scenario, golden.manifest)
     if report_dir is not None and not outcome.ok:
         report.write_scenario(report_dir, outcome)
     return outcome
+
+
+def _setting_notes(scenario, manifest) -> list[str]:
+    """Notes on what the scenario changed since its golden was blessed (model, world, ticks)."""
+    now = ser.manifest(scenario, b"", b"", {})
+    return [
+        f"note: the golden was blessed with {key} {json.dumps(manifest.get(key))}, "
+        f"the scenario now has {json.dumps(now[key])}"
+        for key in ("model", "world", "ticks")
+        if manifest.get(key) != now[key]
+    ]
 
 
 def _compare(scenario, result, golden, run_frames, outcome) -> None:
@@ -182,7 +183,8 @@ def bless_run(scenario, result, store: GoldenStore) -> Blessed:
 def _contents(result, files) -> str:
     n_frames = sum(1 for rel in files if rel.startswith(ser.FRAMES_DIR + "/"))
     n_obj = ser.final_state(result.final_pos, result.final_vel).shape[0]
-    return f"{len(result.events)} events, {n_frames} frames, {n_obj} objects"
+    counts = ((len(result.events), "event"), (n_frames, "frame"), (n_obj, "object"))
+    return ", ".join(f"{n} {word}{'' if n == 1 else 's'}" for n, word in counts)
 
 
 def _changes(scenario, result, old, changed) -> str:

@@ -19,7 +19,6 @@ folder can be zipped, kept as a CI artifact and opened anywhere.
 from __future__ import annotations
 
 import html
-import json
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -27,7 +26,8 @@ from pathlib import Path
 import numpy as np
 
 from runner.golden.compare import FrameDiff
-from runner.outputs import encode_png
+from runner.golden.store import shown_path
+from runner.outputs import atomic_write_bytes, encode_png, write_json
 
 REPORT_FORMAT = 1
 # Diff image colours (RGB) and how bright the grey copy of the frame under them is (0..1).
@@ -94,9 +94,9 @@ class Outcome:
             if isinstance(problem, FrameReport):
                 for kind in ("expected", "actual", "diff"):
                     if kind in problem.paths:
-                        lines.append(f"    {kind + ':':<9} {_show(problem.paths[kind])}")
+                        lines.append(f"    {kind + ':':<9} {shown_path(problem.paths[kind])}")
         if self.report is not None:
-            lines.append(f"  report: {_show(self.report)}")
+            lines.append(f"  report: {shown_path(self.report)}")
         elif self.status == STATUS_FAILED:
             lines.append("  (pass --report DIR for expected / actual / diff images)")
         verb = "create it" if self.status == STATUS_MISSING else "accept this run as the golden"
@@ -132,13 +132,13 @@ def _frame_summary(fr: FrameReport, base: Path | None) -> dict:
 
 
 def diff_image(fr: FrameReport) -> np.ndarray | None:
-    """(H, W, 3) uint8: the run's frame in dim grey, pixels changed within the colour threshold in
-    WITHIN_THRESHOLD_COLOR, differing pixels in DIFF_COLOR. None when there is nothing to overlay
-    (sizes differ or one side is missing)."""
+    """(H, W, 3) uint8: the run's frame in dim grey (its brightest channel times DIM_LEVEL),
+    pixels changed within the colour threshold in WITHIN_THRESHOLD_COLOR, differing pixels in
+    DIFF_COLOR. None when there is nothing to overlay (sizes differ or one side is missing)."""
     d = fr.diff
     if d is None or d.size_mismatch or d.mask is None:
         return None
-    grey = fr.actual.astype(np.float64).mean(axis=2) * DIM_LEVEL
+    grey = fr.actual.max(axis=2).astype(np.float64) * DIM_LEVEL
     out = np.repeat(grey.astype(np.uint8)[:, :, None], 3, axis=2)
     out[d.changed & ~d.mask] = WITHIN_THRESHOLD_COLOR
     out[d.mask] = DIFF_COLOR
@@ -156,13 +156,14 @@ def write_scenario(report_dir, outcome: Outcome) -> Path:
         for kind, rgb in images.items():
             if rgb is not None:
                 path = folder / f"{stem}_{kind}.png"
-                _write(path, encode_png(np.ascontiguousarray(rgb)))
+                atomic_write_bytes(path, encode_png(np.ascontiguousarray(rgb)))
                 fr.paths[kind] = path
     for fname, data in sorted(outcome.texts.items()):
-        _write(folder / fname, data)
+        atomic_write_bytes(folder / fname, data)
     outcome.report = folder / "index.html"
-    _write(folder / "summary.json", _json_bytes(outcome.summary(folder)))
-    _write(outcome.report, _page(f"collide2d golden: {outcome.name}", [outcome], folder, []))
+    write_json(folder / "summary.json", outcome.summary(folder))
+    page = _page(f"collide2d golden: {outcome.name}", [outcome], folder, [])
+    atomic_write_bytes(outcome.report, page)
     return outcome.report
 
 
@@ -179,33 +180,16 @@ def write_index(report_dir, outcomes, unused=()) -> Path:
         "scenarios": [o.summary(folder) for o in outcomes],
         "unused_goldens": list(unused),
     }
-    _write(folder / "summary.json", _json_bytes(summary))
+    write_json(folder / "summary.json", summary)
     index = folder / "index.html"
-    _write(index, _page("collide2d golden check", outcomes, folder, list(unused)))
+    atomic_write_bytes(index, _page("collide2d golden check", outcomes, folder, list(unused)))
     return index
-
-
-def _json_bytes(obj) -> bytes:
-    return (json.dumps(obj, indent=2) + "\n").encode("utf-8")
-
-
-def _write(path: Path, data: bytes) -> None:
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    tmp.write_bytes(data)
-    os.replace(tmp, path)
 
 
 def _rel(path, base: Path | None) -> str:
     if base is None:
         return Path(path).as_posix()
     return Path(os.path.relpath(path, base)).as_posix()
-
-
-def _show(path) -> str:
-    try:
-        return Path(os.path.relpath(path)).as_posix()
-    except ValueError:
-        return str(path)
 
 
 _CSS = """
@@ -218,8 +202,9 @@ pre { background: #fff; border: 1px solid #ddd; padding: .6em; overflow-x: auto;
 .views label { border: 1px solid #bbb; padding: .2em .7em; cursor: pointer; margin-right: .3em; }
 .views input:checked + label { background: #222; color: #fff; }
 .panel { display: none; margin-top: .8em; }
-.views input.side:checked ~ .side-panel, .views input.diff:checked ~ .diff-panel { display: flex; }
-figure { margin: 0 1em 0 0; } figcaption { font-size: .85em; color: #555; }
+.views input.side:checked ~ .side-panel, .views input.diff:checked ~ .diff-panel {
+  display: flex; flex-wrap: wrap; gap: .8em; }
+figure { margin: 0; } figcaption { font-size: .85em; color: #555; }
 img { image-rendering: pixelated; border: 1px solid #999; background: #000; }
 """
 

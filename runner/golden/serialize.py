@@ -7,7 +7,7 @@ change in a diff viewer and the same results always give the same bytes:
 
     manifest.json               format version, what was run, and a hash of every other file
     events.jsonl                one `engine.events.format_event` line per event
-    final.csv                   `id,x,y,vx,vy`, numbers by `engine.events.format_number`
+    final.csv                   `id,x,y,vx,vy` as `runner.outputs.final_csv_text` writes it
     frames/frame_000012.png     RGB PNG, deterministic encoding, no metadata
 
 A frame is identified by its decoded pixels, never by its PNG bytes (zlib builds differ across
@@ -25,8 +25,8 @@ import struct
 import numpy as np
 from PIL import Image
 
-from engine.events import event_dict, format_event, format_number
-from runner.outputs import encode_png
+from engine.events import event_dict, format_event
+from runner.outputs import encode_png, final_csv_text
 
 # The golden folder's layout version; a reader refuses other versions with a clear message.
 FORMAT_VERSION = 1
@@ -103,13 +103,10 @@ def parse_events(data: bytes) -> list[dict]:
 
 
 def final_csv(pos: np.ndarray, vel: np.ndarray) -> bytes:
-    """final.csv bytes: `id,x,y,vx,vy` then one row per object. pos, vel: (n, 2) float64, px and
-    px/s. Numbers are written by `format_number`, which reads back to the same float64."""
-    state = final_state(pos, vel)
-    rows = [FINAL_HEADER]
-    for i, row in enumerate(state):
-        rows.append(",".join([str(i), *(format_number(v) for v in row)]))
-    return ("\n".join(rows) + "\n").encode("utf-8")
+    """final.csv bytes, as `collide2d run` writes them: `id,x,y,vx,vy` then one row per object.
+    pos, vel: (n, 2) float64, px and px/s. Numbers are written by `format_number`, which reads
+    back to the same float64."""
+    return final_csv_text(pos, vel).encode("utf-8")
 
 
 def final_state(pos: np.ndarray, vel: np.ndarray) -> np.ndarray:

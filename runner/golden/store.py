@@ -136,17 +136,18 @@ class GoldenStore:
         folder = self.folder(name)
         mpath = folder / ser.MANIFEST_FILE
         if not folder.is_dir():
-            raise GoldenMissing(f"no golden for {name}: {_show(folder)} does not exist")
+            raise GoldenMissing(f"no golden for {name}: {shown_path(folder)} does not exist")
         if not mpath.is_file():
             raise GoldenMissing(
-                f"no golden for {name}: {_show(folder)} has no {ser.MANIFEST_FILE} "
+                f"no golden for {name}: {shown_path(folder)} has no {ser.MANIFEST_FILE} "
                 "(an interrupted first bless?)"
             )
         files = {ser.MANIFEST_FILE: mpath.read_bytes()}
         try:
             manifest = json.loads(files[ser.MANIFEST_FILE])
         except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-            raise GoldenUnreadable(f"golden {name}: {_show(mpath)} is not JSON ({exc})") from None
+            msg = f"golden {name}: {shown_path(mpath)} is not JSON ({exc})"
+            raise GoldenUnreadable(msg) from None
         fmt = manifest.get("format") if isinstance(manifest, dict) else None
         if fmt != ser.FORMAT_VERSION:
             raise GoldenUnreadable(
@@ -170,7 +171,7 @@ class GoldenStore:
     def _file(self, name, folder, rel, files) -> bytes:
         path = folder / rel
         if not path.is_file():
-            raise GoldenUnreadable(f"golden {name}: {_show(path)} is missing; bless it again")
+            raise GoldenUnreadable(f"golden {name}: {shown_path(path)} is missing; bless it again")
         files[rel] = path.read_bytes()
         return files[rel]
 
@@ -248,17 +249,20 @@ def _ci_message() -> str:
 
 def _torn(name: str, path: Path) -> str:
     return (
-        f"golden {name}: {_show(path)} does not match {ser.MANIFEST_FILE} (edited by hand or an "
-        "interrupted bless); bless it again"
+        f"golden {name}: {shown_path(path)} does not match {ser.MANIFEST_FILE} (edited by hand "
+        "or an interrupted bless); bless it again"
     )
 
 
-def _show(path: Path) -> str:
-    """A path as the user would type it: relative to the current directory when inside it."""
+def shown_path(path) -> str:
+    """A path as the user would type it, with forward slashes: relative to the current directory
+    when it lies inside it, else as given."""
+    path = Path(path)
     try:
-        return Path(os.path.relpath(path)).as_posix()
+        rel = Path(os.path.relpath(path.resolve()))
     except ValueError:
-        return str(path)
+        return path.as_posix()
+    return path.as_posix() if rel.parts[:1] == ("..",) else rel.as_posix()
 
 
 def _check_rel(rel: str) -> None:

@@ -181,6 +181,14 @@ def test_drawn_line_is_the_dda_points_clipped(x0, y0, x1, y1, clip):
     assert pixel_set(buf) == expect
 
 
+def test_drawn_lines_all_directions_match_reference():
+    """Every line of up to 12 px each way from one pixel, including all rounding ties."""
+    for dx in range(-12, 13):
+        for dy in range(-12, 13):
+            buf = draw_line(27, 27, 13, 13, 13 + dx, 13 + dy)
+            assert pixel_set(buf) == set(ref_dda(13, 13, 13 + dx, 13 + dy)), (dx, dy)
+
+
 # ------------------------------------------------------------------ boxes
 
 
@@ -220,14 +228,15 @@ def ref_doubled_circle(d):
     """Circle in doubled units from the closed form of the midpoint rule, not the stepping.
 
     For each V (parity of R = d-1) the outer candidate U is kept while the midpoint U-1 is inside:
-    U(V) = the largest U of R's parity with (U-1)^2 + V^2 <= R^2 (at least V - 1 near the diagonal).
+    U(V) = the largest U of R's parity with (U-1)^2 + V^2 <= R^2; the first point is (R, R mod 2),
+    the rightmost pixel of the box's middle row(s).
     """
     r = d - 1
     pts = set()
     v = r % 2
     while True:
         u = r
-        while (u - 1) ** 2 + v * v > r * r:
+        while v > r % 2 and u >= v and (u - 1) ** 2 + v * v > r * r:
             u -= 2
         if u < v:
             break
@@ -412,6 +421,24 @@ def test_dirty_redraw_equals_full_redraw_every_tick(seed):
         partial += not dirty.last_was_full
         assert np.array_equal(got, full.draw_full(pos))
     assert partial > 0
+
+
+def test_degenerate_objects_draw_nothing_and_do_not_break_redraw():
+    world = WorldSpec(10, 8, 10)
+    empty = raster.Renderer(world, Bodies.boxes(np.zeros((0, 2)), 1, 0))
+    assert not empty.draw(np.zeros((0, 2))).any() and not empty.draw(np.zeros((0, 2))).any()
+    bodies = make_bodies(
+        [KIND_BOX, KIND_CIRCLE, KIND_POLYGON, KIND_BOX],
+        np.zeros((4, 2)),
+        [[0, 3], [0, 0], [1, 1], [2, 2]],
+        [1, 2, 3, 4],
+        [True, True, True, False],
+    )
+    r = raster.Renderer(world, bodies)
+    pos = np.array([[1.0, 1], [2, 2], [3, 3], [5, 5]])
+    assert pixel_set(r.draw(pos)) == {(5, 5), (6, 5), (5, 6), (6, 6)}
+    pos[:3] += 1
+    assert pixel_set(r.draw(pos)) == {(5, 5), (6, 5), (5, 6), (6, 6)}
 
 
 def test_draw_with_nothing_moving_keeps_the_frame():

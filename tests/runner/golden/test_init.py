@@ -198,3 +198,16 @@ def test_bless_replaces_an_unreadable_golden(tree, garbage):
     out = bless_run(scn, run, store)
     assert out.status == UPDATED and out.summary.startswith("replaced an unreadable golden")
     assert check_run(scn, run, store).ok
+
+
+def test_a_failure_notes_settings_changed_since_the_bless(tree):
+    store = _blessed(tree)
+    assert _check(tree, store, ticks=5).ok  # same results: the settings alone are no failure
+    out = _check(tree, store, ticks=5, final=[[1.0, 2.0, 10.0, 0.0], [6.5, 3.0, -10.0, 2.5]])
+    assert out.problems[0] == "note: the golden was blessed with ticks 4, the scenario now has 5"
+    assert len(out.problems) == 2 and out.problems[1].startswith("final state:")
+
+
+def test_a_created_summary_counts_in_words(tree):
+    scn, run = _scn(tree, events=[[2, 0.2, 0, 1, -1, 0, -1, -1]], final=[[1.0, 2.0, 3.0, 4.0]])
+    assert bless_run(scn, run, GoldenStore(tree)).summary == "1 event, 2 frames, 1 object"

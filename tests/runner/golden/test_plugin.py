@@ -130,4 +130,4 @@ def test_xdist_blesses_each_golden_once_and_checks(project):
     assert store.names() == ["a", "b", "c", "d", "e"]
     for name in store.names():
         store.read(name)
-    project.runpytest_subprocess("-n", "2").assert_outcomes(passed=5)
+    project.runpytest().assert_outcomes(passed=5)

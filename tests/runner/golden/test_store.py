@@ -101,6 +101,21 @@ def test_a_rename_failing_midway_puts_the_old_golden_back(tmp_path, monkeypatch,
     store.read("demo")
 
 
+def test_the_manifest_is_renamed_into_place_last(tmp_path, monkeypatch):
+    old, new = _old_and_new(tmp_path)
+    store = GoldenStore(tmp_path)
+    store.write("demo", old)
+    targets, real_replace = [], os.replace
+
+    def replace(src, dst):
+        targets.append(os.path.basename(dst))
+        real_replace(src, dst)
+
+    monkeypatch.setattr(st.os, "replace", replace)
+    store.write("demo", new)
+    assert len(targets) == len(new) and targets[-1] == ser.MANIFEST_FILE
+
+
 def test_a_first_write_failing_leaves_no_golden(tmp_path, monkeypatch):
     files, _ = _files(tmp_path)
     store = GoldenStore(tmp_path)

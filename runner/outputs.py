@@ -1,0 +1,449 @@
+"""The files a run writes (SPEC section 5): PNG frames, GIF, events.jsonl, final.csv, summary.json.
+
+Input: RGB pictures `(H, W, 3) uint8`, palette-index frames `(H, W) uint8` with the scenario's
+palette `(k, 3) uint8`, event records (`engine.events.EVENT_DTYPE`), final positions and
+velocities, and plain JSON objects. Output: files on disk, written so that a killed run never leaves
+half of one: every file is written under a temporary name in its own folder
+(`.NAME.PID.RANDOM.tmp`) and renamed over `NAME` with `os.replace` only once it is whole, so a
+reader sees the old file or the new one. (This guards against a killed process; it does not fsync,
+which would cost a disk flush per frame, so a power cut may still lose the newest files.)
+
+Encodings are deterministic: the same input gives the same bytes. PNGs carry no metadata and use a
+fixed compression level. The GIF streams frame by frame to disk with exact palette colours, looping
+forever, with whole-centisecond delays scheduled by `gif_schedule` so that its total length is the
+run's length to the centisecond.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import os
+import re
+import secrets
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+from PIL import GifImagePlugin, Image
+
+from engine.events import format_event, format_number
+
+# zlib level of every PNG (0-9): fixed so that the same pixels give the same bytes.
+PNG_COMPRESS_LEVEL = 6
+# The shortest GIF frame delay browsers show as written, in centiseconds; shorter ones are
+# stretched (usually to 10 cs), so at most 100 / GIF_MIN_DELAY_CS frames per second are kept.
+GIF_MIN_DELAY_CS = 2
+GIF_MAX_FPS = 100 // GIF_MIN_DELAY_CS
+# A GIF delay is an unsigned 16-bit number of centiseconds.
+GIF_MAX_DELAY_CS = 65535
+# A GIF colour table has at most this many colours.
+GIF_MAX_COLORS = 256
+
+TEMP_SUFFIX = ".tmp"
+_TEMP_RE = re.compile(r"^\..+\.\d+\.[0-9a-f]{8}\.tmp$")
+
+
+# --------------------------------------------------------------------------------------------
+# Atomic files
+
+
+def _open_temp(path: Path) -> tuple[Path, int]:
+    """Create a new empty file next to `path`, only ours; returns (its path, an open write fd).
+
+    The mode is 0o666 less the umask, as for any new file, so the renamed result has the usual
+    permissions.
+    """
+    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0)
+    while True:
+        tmp = path.with_name(f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}{TEMP_SUFFIX}")
+        try:
+            return tmp, os.open(tmp, flags, 0o666)
+        except FileExistsError:
+            continue
+
+
+def _remove(path: Path) -> None:
+    with contextlib.suppress(FileNotFoundError):
+        os.unlink(path)
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
+    """Yield a temporary path next to `path`; rename it over `path` when the block ends normally.
+
+    The temporary file exists (empty) when the block starts. If the block raises, the temporary
+    file is removed, `path` is left as it was, and the exception propagates.
+    """
+    path = Path(path)
+    tmp, fd = _open_temp(path)
+    os.close(fd)
+    try:
+        yield tmp
+        os.replace(tmp, path)
+    except BaseException:
+        _remove(tmp)
+        raise
+
+
+def atomic_write_bytes(path: str | os.PathLike, data: bytes) -> None:
+    """Write `data` to `path` atomically."""
+    with atomic_path(path) as tmp, open(tmp, "wb") as f:
+        f.write(data)
+
+
+def atomic_write_text(path: str | os.PathLike, text: str) -> None:
+    """Write `text` to `path` atomically, UTF-8, newlines as written (no translation)."""
+    atomic_write_bytes(path, text.encode("utf-8"))
+
+
+class _StreamFile:
+    """A binary file written in pieces under a temporary name; `commit` renames it into place."""
+
+    def __init__(self, path: str | os.PathLike):
+        self.path = Path(path)
+        self.tmp, fd = _open_temp(self.path)
+        self._file = os.fdopen(fd, "wb")
+        self.done = False
+
+    def write(self, data: bytes) -> None:
+        if self.done:
+            raise ValueError(f"{self.path}: already closed")
+        self._file.write(data)
+
+    def flush(self) -> None:
+        self._file.flush()
+
+    def commit(self) -> None:
+        if self.done:
+            return
+        self.done = True
+        try:
+            self._file.close()
+            os.replace(self.tmp, self.path)
+        except BaseException:
+            _remove(self.tmp)
+            raise
+
+    def abort(self) -> None:
+        if self.done:
+            return
+        self.done = True
+        try:
+            self._file.close()
+        finally:
+            _remove(self.tmp)
+
+
+def clean_temporaries(folder: str | os.PathLike) -> int:
+    """Remove temporary files this module left in `folder` (not below it) after a killed run.
+
+    Only names of the form `.NAME.PID.XXXXXXXX.tmp` are touched; call it only when no other run is
+    writing into `folder`. Returns how many files were removed.
+    """
+    removed = 0
+    folder = Path(folder)
+    if not folder.is_dir():
+        return 0
+    for entry in sorted(os.scandir(folder), key=lambda e: e.name):
+        if _TEMP_RE.match(entry.name) and entry.is_file(follow_symlinks=False):
+            _remove(Path(entry.path))
+            removed += 1
+    return removed
+
+
+# --------------------------------------------------------------------------------------------
+# PNG
+
+
+def _check_scale(scale: int) -> int:
+    if isinstance(scale, bool) or int(scale) != scale or scale < 1:
+        raise ValueError(f"scale must be a whole number >= 1, got {scale!r}")
+    return int(scale)
+
+
+def enlarge(image: np.ndarray, scale: int) -> np.ndarray:
+    """`image` (H, W, ...) enlarged by nearest neighbour to (H*scale, W*scale, ...)."""
+    scale = _check_scale(scale)
+    if scale == 1:
+        return image
+    return np.repeat(np.repeat(image, scale, axis=0), scale, axis=1)
+
+
+def encode_png(rgb: np.ndarray, scale: int = 1) -> bytes:
+    """PNG bytes of an RGB picture (H, W, 3) uint8, enlarged `scale` times by nearest neighbour.
+
+    No metadata, fixed compression (PNG_COMPRESS_LEVEL), no optimisation pass: the same pixels give
+    the same bytes with the same Pillow and zlib.
+    """
+    rgb = np.asarray(rgb)
+    if rgb.dtype != np.uint8 or rgb.ndim != 3 or rgb.shape[2] != 3:
+        raise ValueError(f"expected an (H, W, 3) uint8 picture, got {rgb.shape} {rgb.dtype}")
+    if rgb.shape[0] == 0 or rgb.shape[1] == 0:
+        raise ValueError(f"cannot encode an empty picture {rgb.shape}")
+    im = Image.fromarray(np.ascontiguousarray(enlarge(rgb, scale)))
+    out = io.BytesIO()
+    im.save(out, format="PNG", compress_level=PNG_COMPRESS_LEVEL, optimize=False)
+    return out.getvalue()
+
+
+def write_png(path: str | os.PathLike, rgb: np.ndarray, scale: int = 1) -> None:
+    """Write `encode_png(rgb, scale)` to `path` atomically."""
+    atomic_write_bytes(path, encode_png(rgb, scale))
+
+
+# --------------------------------------------------------------------------------------------
+# GIF
+
+
+def gif_schedule(n_frames: int, fps: int) -> tuple[np.ndarray, np.ndarray, str | None]:
+    """Which frames the GIF shows and for how long: (kept (m,) int64, delays_cs (m,) int64, note).
+
+    Frame i of n is due at t_i = i / fps seconds and the animation ends at t_n. GIF delays are
+    whole centiseconds, so each kept frame starts at a rounded time and lasts until the next kept
+    frame starts: the rounding never accumulates and the delays add up to round(100 * t_n), the
+    exact length to the centisecond. Rounding is half up, in integers: round(100 i / fps) =
+    (200 i + fps) // (2 fps).
+
+    Up to GIF_MAX_FPS (50) every frame is kept, and every delay is at least
+    floor(100 / fps) >= 2 cs. Above it, browsers would stretch delays under 2 cs, so frames are
+    dropped evenly: frame i is kept when floor(i * 50 / fps) changes, that is the first frame of
+    each 2 cs slot, which then starts at its slot's time 2 * slot (at most 1/fps early) and lasts
+    2 cs. The last kept frame lasts until the end; if that leaves it under 2 cs, it is dropped and
+    the one before lasts until the end (2 or 3 cs). A whole animation shorter than 2 cs is one frame
+    of 2 cs. `note` says, for people, that frames were dropped; it is None when none were.
+    """
+    n = int(n_frames)
+    fps = int(fps)
+    if fps < 1:
+        raise ValueError(f"fps must be >= 1, got {fps}")
+    if n <= 0:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64), None
+    end_cs = (200 * n + fps) // (2 * fps)
+    if fps <= GIF_MAX_FPS:
+        i = np.arange(n + 1, dtype=np.int64)
+        starts = (200 * i + fps) // (2 * fps)
+        return np.arange(n, dtype=np.int64), np.diff(starts), None
+    slots = (n - 1) * GIF_MAX_FPS // fps + 1
+    m = np.arange(slots, dtype=np.int64)
+    kept = (m * fps + GIF_MAX_FPS - 1) // GIF_MAX_FPS  # ceil(m * fps / 50): first frame of slot m
+    starts = GIF_MIN_DELAY_CS * m
+    if slots >= 2 and end_cs - starts[-1] < GIF_MIN_DELAY_CS:
+        kept = kept[:-1]
+        starts = starts[:-1]
+    delays = np.diff(np.append(starts, max(end_cs, GIF_MIN_DELAY_CS)))
+    if len(kept) == n:
+        return kept, delays, None
+    note = (
+        f"GIF shows {GIF_MAX_FPS} of {fps} frames per second "
+        f"(delays under {GIF_MIN_DELAY_CS} cs are stretched by browsers)"
+    )
+    return kept, delays, note
+
+
+def _gif_palette(palette: np.ndarray) -> bytes:
+    """The palette's bytes padded with black to a power-of-two size >= 2 (a GIF colour table)."""
+    k = palette.shape[0]
+    size = 2
+    while size < k:
+        size *= 2
+    table = np.zeros((size, 3), np.uint8)
+    table[:k] = palette
+    return table.tobytes()
+
+
+class GifWriter:
+    """Streams an animated GIF of palette-index frames to `path`, one frame at a time.
+
+    palette (k, 3) uint8 with 1 <= k <= 256 is the scenario's palette; frames are (height, width)
+    uint8 indices into it, shown enlarged `scale` times, at `fps` frames per second, looping
+    forever. Give `add` every one of the `n_frames` frames in order: frames the schedule drops
+    (`gif_schedule`, above 50 fps) are skipped here. `close` writes the trailer and renames the
+    file into place; `abort` removes it and leaves any older GIF at `path` whole. As a context
+    manager it closes on success and aborts on an exception. `note` is the schedule's message.
+    """
+
+    def __init__(
+        self,
+        path: str | os.PathLike,
+        palette: np.ndarray,
+        width: int,
+        height: int,
+        fps: int,
+        n_frames: int,
+        scale: int = 1,
+    ):
+        palette = np.asarray(palette)
+        if palette.dtype != np.uint8 or palette.ndim != 2 or palette.shape[1] != 3:
+            raise ValueError(f"palette must be (k, 3) uint8, got {palette.shape} {palette.dtype}")
+        if not 1 <= palette.shape[0] <= GIF_MAX_COLORS:
+            raise ValueError(f"a GIF holds 1 to {GIF_MAX_COLORS} colours, got {palette.shape[0]}")
+        if int(n_frames) < 1:
+            raise ValueError(f"a GIF needs at least one frame, got {n_frames}")
+        self.scale = _check_scale(scale)
+        self.width = int(width)
+        self.height = int(height)
+        if self.width < 1 or self.height < 1:
+            raise ValueError(f"frame size must be positive, got {width}x{height}")
+        out_w = self.width * self.scale
+        out_h = self.height * self.scale
+        if out_w > 65535 or out_h > 65535:
+            raise ValueError(f"a GIF is at most 65535 px a side, got {out_w}x{out_h}")
+        self.n_frames = int(n_frames)
+        self.n_colors = int(palette.shape[0])
+        self.kept, self.delays_cs, self.note = gif_schedule(self.n_frames, int(fps))
+        self._palette = _gif_palette(palette)
+        self._size = (out_w, out_h)
+        self._seen = 0  # frames given to add
+        self._next = 0  # index into kept of the next frame to write
+        self._file = _StreamFile(path)
+        try:
+            im = self._image(np.zeros((self.height, self.width), np.uint8))
+            header, _ = GifImagePlugin.getheader(im, None, {"loop": 0})
+            for part in header:
+                self._file.write(part)
+        except BaseException:
+            self._file.abort()
+            raise
+
+    @property
+    def path(self) -> Path:
+        return self._file.path
+
+    def _image(self, frame: np.ndarray) -> Image.Image:
+        data = np.ascontiguousarray(enlarge(frame, self.scale))
+        im = Image.frombuffer("P", self._size, data, "raw", "P", 0, 1)
+        im.putpalette(self._palette, "RGB")
+        return im
+
+    def add(self, frame: np.ndarray) -> None:
+        """Take the next frame, (height, width) uint8 palette indices; write it if it is kept."""
+        if self._file.done:
+            raise ValueError(f"{self.path}: the GIF is already closed")
+        if self._seen >= self.n_frames:
+            raise ValueError(f"{self.path}: more than the {self.n_frames} frames announced")
+        i = self._seen
+        self._seen += 1
+        if self._next >= len(self.kept) or self.kept[self._next] != i:
+            return
+        frame = np.asarray(frame)
+        if frame.shape != (self.height, self.width) or frame.dtype != np.uint8:
+            raise ValueError(
+                f"frame must be ({self.height}, {self.width}) uint8, "
+                f"got {frame.shape} {frame.dtype}"
+            )
+        if int(frame.max()) >= self.n_colors:
+            raise ValueError(
+                f"frame uses colour {int(frame.max())}; the palette has {self.n_colors}"
+            )
+        delay = int(self.delays_cs[self._next])
+        if delay > GIF_MAX_DELAY_CS:
+            raise ValueError(f"a GIF frame lasts at most {GIF_MAX_DELAY_CS} cs, needed {delay}")
+        self._next += 1
+        # getdata takes the duration in milliseconds and writes duration // 10 centiseconds;
+        # disposal 1 leaves each full frame in place until the next covers it.
+        for part in GifImagePlugin.getdata(
+            self._image(frame), (0, 0), duration=delay * 10, disposal=1
+        ):
+            self._file.write(bytes(part))
+        self._file.flush()  # on disk frame by frame: memory stays one frame whatever the length
+
+    def close(self) -> None:
+        """Write the trailer and rename the GIF into place; all n_frames frames must have come."""
+        if self._file.done:
+            return
+        if self._seen != self.n_frames:
+            self.abort()
+            raise ValueError(
+                f"{self.path}: {self._seen} frames given, {self.n_frames} announced; "
+                "GIF not written"
+            )
+        self._file.write(b";")
+        self._file.commit()
+
+    def abort(self) -> None:
+        """Drop the unfinished GIF; an older file at `path` stays as it was."""
+        self._file.abort()
+
+    def __enter__(self) -> GifWriter:
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        if exc_type is None:
+            self.close()
+        else:
+            self.abort()
+
+
+# --------------------------------------------------------------------------------------------
+# Text outputs
+
+
+class EventsWriter:
+    """Streams events.jsonl: one `engine.events.format_event` line per event, in the order given.
+
+    `write(events)` appends an EVENT_DTYPE array; `close` renames the file into place, `abort`
+    removes it. As a context manager it closes on success and aborts on an exception.
+    """
+
+    def __init__(self, path: str | os.PathLike):
+        self._file = _StreamFile(path)
+        self.count = 0
+
+    @property
+    def path(self) -> Path:
+        return self._file.path
+
+    def write(self, events: np.ndarray) -> None:
+        if len(events) == 0:
+            return
+        text = "".join(format_event(rec) + "\n" for rec in events)
+        self._file.write(text.encode("utf-8"))
+        self.count += len(events)
+
+    def close(self) -> None:
+        self._file.commit()
+
+    def abort(self) -> None:
+        self._file.abort()
+
+    def __enter__(self) -> EventsWriter:
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        if exc_type is None:
+            self.close()
+        else:
+            self.abort()
+
+
+def final_csv_text(pos: np.ndarray, vel: np.ndarray) -> str:
+    """final.csv's text: header `id,x,y,vx,vy`, then one row per object in id order.
+
+    pos (n, 2) px and vel (n, 2) px/s; numbers as `engine.events.format_number` writes them.
+    """
+    pos = np.asarray(pos, dtype=np.float64).reshape(-1, 2)
+    vel = np.asarray(vel, dtype=np.float64).reshape(-1, 2)
+    if pos.shape != vel.shape:
+        raise ValueError(f"positions {pos.shape} and velocities {vel.shape} differ in shape")
+    cols = np.concatenate([pos, vel], axis=1).tolist()
+    fmt = format_number
+    lines = ["id,x,y,vx,vy"]
+    lines.extend(
+        f"{i},{fmt(x)},{fmt(y)},{fmt(vx)},{fmt(vy)}" for i, (x, y, vx, vy) in enumerate(cols)
+    )
+    return "\n".join(lines) + "\n"
+
+
+def write_final_csv(path: str | os.PathLike, pos: np.ndarray, vel: np.ndarray) -> None:
+    """Write final.csv (see `final_csv_text`) to `path` atomically."""
+    atomic_write_text(path, final_csv_text(pos, vel))
+
+
+def write_json(path: str | os.PathLike, obj) -> None:
+    """Write `json.dumps(obj, indent=2)` and a newline to `path` atomically, keys in given order.
+
+    Non-finite floats are refused (ValueError): they are not JSON.
+    """
+    atomic_write_text(path, json.dumps(obj, indent=2, allow_nan=False) + "\n")
