@@ -489,7 +489,7 @@ def midpoint_circle(d: int, fill: bool = False) -> np.ndarray:
     if d <= 0:
         return np.zeros((0, 2), np.int64)
     buf = np.zeros((d, d), np.uint8)
-    _circle(buf, 0, 0, d, 1, bool(fill), np.empty(d, np.int64), 0, 0, d - 1, d - 1)
+    _circle(buf, 0, 0, d, np.uint8(1), bool(fill), np.empty(d, np.int64), 0, 0, d - 1, d - 1)
     ys, xs = np.nonzero(buf)
     return np.stack([xs, ys], axis=1).astype(np.int64)
 

@@ -22,7 +22,7 @@ from runner.options import (
     overrides_from_args,
     positive_int,
 )
-from runner.run import RunOptions, run_to_dir
+from runner.run import RunOptions, RunStopped, run_to_dir
 from runner.scenario import ScenarioError, load
 
 EXIT_OK = 0
@@ -37,23 +37,41 @@ def demo_path() -> str:
 
 def register_run(subparsers) -> None:
     p = subparsers.add_parser(
-        "run", help="run a scenario and write its frames, GIF and event log",
+        "run",
+        help="run a scenario and write its frames, GIF and event log",
         description="Run SCENARIO (default: the bundled 50-box demo of the paper's section IV) "
         "and write OUT/NAME/: frames/*.png, animation.gif, events.jsonl, final.csv, summary.json. "
         "Flags override the scenario's output and settings.",
     )
     p.add_argument("scenario", nargs="?", help="scenario YAML file (default: the bundled demo)")
     p.add_argument("--out", default="out", metavar="DIR", help="output folder (default: out)")
-    p.add_argument("--gif", action=argparse.BooleanOptionalAction, default=None,
-                   help="write animation.gif (default: the scenario's output.gif)")
-    p.add_argument("--png", action=argparse.BooleanOptionalAction, default=None,
-                   help="write PNG frames: the scenario's output.frames, or all when it asks for "
-                   "none (default: only if output.frames asks for some)")
-    p.add_argument("--events", action=argparse.BooleanOptionalAction, default=None,
-                   help="write events.jsonl (default: the scenario's output.events)")
+    p.add_argument(
+        "--gif",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="write animation.gif (default: the scenario's output.gif)",
+    )
+    p.add_argument(
+        "--png",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="write PNG frames: the scenario's output.frames, or all when it asks for "
+        "none (default: only if output.frames asks for some)",
+    )
+    p.add_argument(
+        "--events",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="write events.jsonl (default: the scenario's output.events)",
+    )
     add_override_arguments(p)
-    p.add_argument("--scale", type=positive_int, default=1, metavar="K",
-                   help="enlarge PNG and GIF frames K times, nearest neighbour (default 1)")
+    p.add_argument(
+        "--scale",
+        type=positive_int,
+        default=1,
+        metavar="K",
+        help="enlarge PNG and GIF frames K times, nearest neighbour (default 1)",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar, no notes")
     add_limit_arguments(p, output=True)
     p.set_defaults(func=cmd_run)
@@ -75,8 +93,10 @@ def cmd_run(args: argparse.Namespace) -> int:
     if not args.quiet:
         counts = summary["events"]
         said = f", {counts['wall']} wall and {counts['pair']} pair events" if counts else ""
-        print(f"{scenario.name}: {scenario.ticks} ticks under {scenario.model}{said} "
-              f"in {summary['run_time_s']:.3f}s -> {target}")
+        print(
+            f"{scenario.name}: {scenario.ticks} ticks under {scenario.model}{said} "
+            f"in {summary['run_time_s']:.3f}s -> {target}"
+        )
     return EXIT_OK
 
 
@@ -103,6 +123,13 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_BAD_INPUT
     except ModelUnavailable as err:
         print(f"collide2d: error: {err}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except RunStopped as err:
+        print(str(err), file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except OSError as err:
+        where = f"{err.filename}: " if err.filename else ""
+        print(f"collide2d: error: {where}{err.strerror or err}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:
         print("collide2d: interrupted; outputs already written are whole", file=sys.stderr)

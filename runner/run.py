@@ -20,6 +20,7 @@ import numpy as np
 
 from engine import models
 from engine.events import EV_PAIR, EV_WALL, empty_events
+from engine.models.exact import EventCapExceeded
 from engine.raster import Renderer
 from engine.world import kinetic_energy, momentum
 from runner import outputs
@@ -33,9 +34,16 @@ CHUNK_TICKS = 65_536
 # PNG and GIF frames are compressed, so raw RGB (PNG) and raw indices (GIF) bound them.
 PNG_BYTES_PER_PIXEL = 3
 GIF_BYTES_PER_PIXEL = 1
+# The largest side of a GIF picture, px (its header holds 16-bit sizes).
+GIF_MAX_SIDE_PX = 65535
 # The output files `run_to_dir` knows; any of them not written by a run is removed, so the folder
 # always shows one run.
 OUTPUT_FILES = ("animation.gif", "events.jsonl", "final.csv", "summary.json")
+
+
+class RunStopped(Exception):
+    """A model stopped the run with a clear error (a runaway: the exact model's event cap, or an
+    object crossing the world too many times in one stepped step). str(err) is the message."""
 
 
 @dataclass
@@ -67,8 +75,11 @@ def drive(
     """
     bodies = scenario.bodies
     model = models.make(
-        scenario.model, scenario.world, bodies,
-        substeps=scenario.substeps, geometry=scenario.geometry,
+        scenario.model,
+        scenario.world,
+        bodies,
+        substeps=scenario.substeps,
+        geometry=scenario.geometry,
     )
     wanted = sorted({int(k) for k in frames if 0 <= k <= scenario.ticks})
     renderer = Renderer(scenario.world, bodies) if wanted else None
@@ -84,7 +95,13 @@ def drive(
         stop = min(scenario.ticks, model.tick + CHUNK_TICKS)
         if next_frame < len(wanted):
             stop = min(stop, wanted[next_frame])
-        events = model.advance(stop - model.tick, log_events)
+        try:
+            events = model.advance(stop - model.tick, log_events)
+        except (EventCapExceeded, ValueError) as exc:
+            raise RunStopped(
+                f"{scenario.path or scenario.name}: error: the {scenario.model} model stopped the "
+                f"run between ticks {model.tick + 1} and {stop}: {exc}"
+            ) from None
         if log_events and len(events):
             counts["wall"] += int(np.count_nonzero(events["type"] == EV_WALL))
             counts["pair"] += int(np.count_nonzero(events["type"] == EV_PAIR))
@@ -115,7 +132,10 @@ def drive(
 
 
 def simulate(
-    scenario: Scenario, *, keep_frames: Iterable[int] = (), log_events: bool = True,
+    scenario: Scenario,
+    *,
+    keep_frames: Iterable[int] = (),
+    log_events: bool = True,
     progress: bool = False,
 ) -> RunResult:
     """Run in memory; frames in `keep_frames` come back as RGB arrays."""
@@ -132,9 +152,7 @@ def simulate(
         progress=Progress.for_terminal(scenario.ticks, scenario.name) if progress else None,
     )
     events = np.concatenate(chunks) if chunks else empty_events()
-    return RunResult(
-        scenario, events, model.positions(), model.velocities(), kept, summary
-    )
+    return RunResult(scenario, events, model.positions(), model.velocities(), kept, summary)
 
 
 @dataclass(frozen=True)
@@ -155,15 +173,27 @@ def output_dir(out_root: str | os.PathLike, scenario: Scenario) -> Path:
     for path in (target, target / "frames"):
         if path.is_symlink():
             raise ScenarioError(
-                scenario.path or "<scenario>", 1, 1,
+                scenario.path or "<scenario>",
+                1,
+                1,
                 f"output folder {path} is a symbolic link; refusing to write through it",
             )
     return target
 
 
 def check_output_size(scenario: Scenario, options: RunOptions, limits: Limits) -> None:
-    """Refuse before running when the frames asked for could pass limits.max_output_bytes."""
+    """Refuse before running when the frames asked for could pass limits.max_output_bytes, or a
+    GIF would be larger than a GIF can be."""
     pixels = scenario.world.width * scenario.world.height * options.scale**2
+    side = max(scenario.world.width, scenario.world.height) * options.scale
+    if options.gif and side > GIF_MAX_SIDE_PX:
+        raise ScenarioError(
+            scenario.path or "<scenario>",
+            1,
+            1,
+            f"a GIF is at most {GIF_MAX_SIDE_PX} px a side, and this world at scale "
+            f"{options.scale} needs {side} px; use a smaller --scale or --no-gif",
+        )
     total = 0
     if options.png:
         total += len(png_frames(scenario)) * pixels * PNG_BYTES_PER_PIXEL
@@ -171,7 +201,9 @@ def check_output_size(scenario: Scenario, options: RunOptions, limits: Limits) -
         total += (scenario.ticks + 1) * pixels * GIF_BYTES_PER_PIXEL
     if total > limits.max_output_bytes:
         raise ScenarioError(
-            scenario.path or "<scenario>", 1, 1,
+            scenario.path or "<scenario>",
+            1,
+            1,
             f"the frames asked for could take up to {total:,} bytes, past the output limit of "
             f"{limits.max_output_bytes:,} bytes; ask for fewer frames (output.frames, --no-png, "
             f"--no-gif, a smaller --scale) or raise --max-output-bytes",
@@ -186,7 +218,9 @@ def png_frames(scenario: Scenario) -> tuple[int, ...]:
 
 
 def run_to_dir(
-    scenario: Scenario, out_root: str | os.PathLike, options: RunOptions,
+    scenario: Scenario,
+    out_root: str | os.PathLike,
+    options: RunOptions,
     limits: Limits | None = None,
 ) -> tuple[Path, dict]:
     """Run and write SPEC section 5's files under OUT/NAME; returns (that folder, the summary)."""
@@ -203,8 +237,13 @@ def run_to_dir(
     if options.gif:
         wanted.update(range(scenario.ticks + 1))
         gif = outputs.GifWriter(
-            target / "animation.gif", scenario.palette, scenario.world.width,
-            scenario.world.height, scenario.world.fps, scenario.ticks + 1, scale=options.scale,
+            target / "animation.gif",
+            scenario.palette,
+            scenario.world.width,
+            scenario.world.height,
+            scenario.world.fps,
+            scenario.ticks + 1,
+            scale=options.scale,
         )
         if gif.note and not options.quiet:
             print(f"{scenario.name}: {gif.note}", file=sys.stderr)
@@ -223,8 +262,11 @@ def run_to_dir(
     progress = None if options.quiet else Progress.for_terminal(scenario.ticks, scenario.name)
     try:
         model, summary = drive(
-            scenario, frames=sorted(wanted), on_frame=on_frame,
-            log_events=options.events, on_events=log.write if log else None,
+            scenario,
+            frames=sorted(wanted),
+            on_frame=on_frame,
+            log_events=options.events,
+            on_events=log.write if log else None,
             progress=progress,
         )
     except BaseException:

@@ -538,14 +538,15 @@ def _predict_all(first, F, N, C, cells, s_start, s_items, HF, HI, st, world):
     return F.shape[0]
 
 
-@njit(cache=True, _nrt=False)
-def _run(jobs, tick_to, log, cap, F, N, C, cells, s_start, s_items, HF, HI, st, stf, world, rows, times):
+@njit(cache=True)
+def _run(tick_to, log, cap, F, N, C, cells, s_start, s_items, HF, HI, st, stf, world, rows, times):
     """Run ticks until tick_to: take due events in order, apply each, predict again for the objects
     it touched; move everything to each tick's end.
 
     Returns a status: STATUS_DONE; STATUS_HEAP_FULL / STATUS_LOG_FULL (grow, call again: nothing
     was lost); STATUS_CAP (a runaway; stops mid-tick). st[_LOGGED] counts the rows written.
     """
+    jobs = np.zeros((2, 8), np.int64)
     while st[_TICK] < tick_to:
         tick = st[_TICK] + 1
         t_end = tick / world[2]
