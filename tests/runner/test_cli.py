@@ -65,7 +65,7 @@ def test_png_on_a_scenario_that_asks_for_no_frames_writes_them_all(tmp_path):
     path = tmp_path / "t1.yaml"
     path.write_text(src)
     run([path, "--out", tmp_path, "--png", "--quiet"])
-    assert len(list((tmp_path / "tunnelling_1fps" / "frames").glob("*.png"))) == 13
+    assert len(list((tmp_path / "t1" / "frames").glob("*.png"))) == 13
 
 
 def test_events_and_no_events(tmp_path):
@@ -91,14 +91,20 @@ def test_ticks_sets_the_length(tmp_path):
     assert summary["ticks"] == 30
     rows = (tmp_path / "tunnelling_10fps" / "final.csv").read_text().splitlines()
     assert rows[0] == "id,x,y,vx,vy"
-    assert rows[1].split(",")[:2] == ["130", "115"]  # 100 + 30 px
+    assert rows[1].split(",")[:3] == ["0", "130", "115"]  # id 0 at 100 + 30 px
 
 
 def test_model_is_checked_again_under_the_new_model(tmp_path, capsys):
-    code = run([TUNNEL, "--out", tmp_path, "--model", "paper", "--fps", "3", "--quiet"])
-    assert code == 2
+    src = tmp_path / "floaty.yaml"
+    src.write_text(
+        "version: 1\nmodel: stepped\nticks: 5\nobjects:\n"
+        "  - {shape: box, size: 10, position: [10.5, 20], velocity: [3, 0]}\n"
+    )
+    assert run([src, "--out", tmp_path / "ok", "--quiet"]) == 0
+    assert run([src, "--out", tmp_path / "no", "--model", "paper", "--quiet"]) == 2
     err = capsys.readouterr().err
-    assert "tunnelling_10fps.yaml:" in err and "error:" in err and "--fps 3" in err
+    assert err.startswith(f"{src}:5:") and "--model paper" in err and "error:" in err
+    assert not (tmp_path / "no").exists()
 
 
 def test_scale_enlarges_png_and_gif(tmp_path):
