@@ -41,14 +41,17 @@ def main() -> int:
         def go():
             model = models.make("paper", scn.world, scn.bodies)
             model.advance(TICKS, log)
+
         return go
 
     headless(False)()  # warm-up: compile or load the cached kernels
     quiet = ticks_per_second(headless(False))
     logged = ticks_per_second(headless(True))
     driven = ticks_per_second(lambda: drive(scn))
-    print(f"paper model, section IV scene ({scn.bodies.n} boxes, {TICKS:,} ticks, "
-          f"median of {REPEATS})")
+    print(
+        f"paper model, section IV scene ({scn.bodies.n} boxes, {TICKS:,} ticks, "
+        f"median of {REPEATS})"
+    )
     print(f"  headless, no log : {quiet:12,.0f} ticks/s")
     print(f"  headless, logged : {logged:12,.0f} ticks/s")
     print(f"  through drive()  : {driven:12,.0f} ticks/s")

@@ -39,7 +39,13 @@ def test_wall_line_matches_the_spec_byte_for_byte():
 def test_models_without_overlap_sizes_leave_xdiff_out():
     rec = record(tick=2, t=0.123456789, type=EV_PAIR, a=1, b=4, code=AXIS_X, xdiff=-1, ydiff=-1)
     assert json.loads(format_event(rec)) == {
-        "tick": 2, "t": 0.123456789, "type": "pair", "a": 1, "b": 4, "axis": "x"}
+        "tick": 2,
+        "t": 0.123456789,
+        "type": "pair",
+        "a": 1,
+        "b": 4,
+        "axis": "x",
+    }
 
 
 def test_times_round_trip_exactly():
@@ -48,8 +54,18 @@ def test_times_round_trip_exactly():
     assert json.loads(format_event(rec))["t"] == t
 
 
-@pytest.mark.parametrize("x, text", [(3.0, "3"), (-0.0, "0"), (2.5, "2.5"), (0.1, "0.1"),
-                                     (1e15, "1000000000000000"), (1e20, "1e+20"), (1e300, "1e+300")])
+@pytest.mark.parametrize(
+    "x, text",
+    [
+        (3.0, "3"),
+        (-0.0, "0"),
+        (2.5, "2.5"),
+        (0.1, "0.1"),
+        (1e15, "1000000000000000"),
+        (1e20, "1e+20"),
+        (1e300, "1e+300"),
+    ],
+)
 def test_format_number(x, text):
     assert format_number(x) == text
 

@@ -7,8 +7,17 @@ from engine.motion import MAX_PERIOD_TICKS, paper_rate
 
 @pytest.mark.parametrize(
     "v, fps, expected",
-    [(10, 10, (1, 1)), (5, 10, (1, 2)), (7.5, 10, (3, 4)), (-7.5, 10, (-3, 4)), (0, 10, (0, 1)),
-     (10, 1, (10, 1)), (0.1, 10, (1, 100)), (33, 60, (11, 20)), (2.5, 1, (5, 2))],
+    [
+        (10, 10, (1, 1)),
+        (5, 10, (1, 2)),
+        (7.5, 10, (3, 4)),
+        (-7.5, 10, (-3, 4)),
+        (0, 10, (0, 1)),
+        (10, 1, (10, 1)),
+        (0.1, 10, (1, 100)),
+        (33, 60, (11, 20)),
+        (2.5, 1, (5, 2)),
+    ],
 )
 def test_rates_in_lowest_terms(v, fps, expected):
     assert paper_rate(v, fps) == expected

@@ -21,11 +21,15 @@ def model(pos, size, vel, *, fps=10, world=(320, 240), static=None):
 
 
 def pairs_of(events):
-    return [(int(e["a"]), int(e["b"]), AXIS_NAMES[e["code"]], int(e["xdiff"]), int(e["ydiff"]))
-            for e in events if e["type"] == EV_PAIR]
+    return [
+        (int(e["a"]), int(e["b"]), AXIS_NAMES[e["code"]], int(e["xdiff"]), int(e["ydiff"]))
+        for e in events
+        if e["type"] == EV_PAIR
+    ]
 
 
-# --- a reference written from SPEC 3.1 with Fractions and a plain all-pairs loop ------------------
+# --- a reference written from SPEC 3.1 with Fractions and a plain all-pairs loop
+
 
 def reference(pos, size, vel, fps, world, ticks, static=None):
     n = len(pos)
@@ -86,12 +90,22 @@ def logged(events):
         if e["type"] == EV_WALL:
             out.append(("wall", int(e["tick"]), int(e["a"]), SIDE_NAMES[e["code"]]))
         else:
-            out.append(("pair", int(e["tick"]), int(e["a"]), int(e["b"]), AXIS_NAMES[e["code"]],
-                        int(e["xdiff"]), int(e["ydiff"])))
+            out.append(
+                (
+                    "pair",
+                    int(e["tick"]),
+                    int(e["a"]),
+                    int(e["b"]),
+                    AXIS_NAMES[e["code"]],
+                    int(e["xdiff"]),
+                    int(e["ydiff"]),
+                )
+            )
     return out
 
 
-# --- Figure 2 and the tie -------------------------------------------------------------------------
+# --- Figure 2 and the tie
+
 
 @pytest.mark.parametrize(
     "pos, size, vel, axis, xdiff, ydiff",
@@ -131,7 +145,8 @@ def test_after_a_vertical_flip_the_boxes_part_vertically():
     assert len(pairs_of(m.advance(5))) == 0
 
 
-# --- counters (paper section II.D) -----------------------------------------------------------------
+# --- counters (paper section II.D)
+
 
 def trajectory(vx, fps, ticks):
     m = model([[100, 100]], [10, 10], [[vx, 0]], fps=fps)
@@ -160,12 +175,17 @@ def test_velocity_reports_px_per_second():
     assert np.array_equal(m.velocities(), [[7.5, -5.0]])
 
 
-# --- walls (paper sections II.E, II.F) -------------------------------------------------------------
+# --- walls (paper sections II.E, II.F)
+
 
 @pytest.mark.parametrize(
     "pos, vel, side, axis",
-    [([0, 50], [-10, 3], "left", 0), ([310, 50], [10, 3], "right", 0),
-     ([50, 0], [3, -10], "top", 1), ([50, 230], [3, 10], "bottom", 1)],
+    [
+        ([0, 50], [-10, 3], "left", 0),
+        ([310, 50], [10, 3], "right", 0),
+        ([50, 0], [3, -10], "top", 1),
+        ([50, 230], [3, 10], "bottom", 1),
+    ],
 )
 def test_each_wall_reverses_its_component_and_takes_the_step_back(pos, vel, side, axis):
     m = model([pos], [10, 10], [vel], fps=10)
@@ -184,12 +204,15 @@ def test_a_box_at_the_wall_moving_inward_is_left_alone():
     assert np.array_equal(m.positions(), [[5, 5]])
 
 
-# --- undo at most once per object per axis per tick -----------------------------------------------
+# --- undo at most once per object per axis per tick
+
 
 def test_displacement_is_taken_back_once_whatever_it_hit():
     # A (id 0) moves right into B (static, id 1); C (id 2) catches A from behind in the same tick.
     m = model(
-        [[10, 100], [20, 100], [0, 100]], [10, 10], [[10, 0], [0, 0], [20, 0]],
+        [[10, 100], [20, 100], [0, 100]],
+        [10, 10],
+        [[10, 0], [0, 0], [20, 0]],
         static=[False, True, False],
     )
     events = m.advance(1)
@@ -211,7 +234,8 @@ def test_wall_and_pair_in_one_tick_take_back_once():
     assert m.positions()[0, 0] == 300 and m.positions()[0, 1] == 100
 
 
-# --- tunnelling (paper section III.A) ---------------------------------------------------------------
+# --- tunnelling (paper section III.A)
+
 
 def test_tunnelling_at_1_fps_and_bounce_at_10_fps():
     one = model([[100, 115], [210, 115]], 10, [[10, 0], [-10, 0]], fps=1)
@@ -224,16 +248,22 @@ def test_tunnelling_at_1_fps_and_bounce_at_10_fps():
     assert ten.positions()[0, 0] < ten.positions()[1, 0]
 
 
-# --- the broad phase changes nothing: the kernel equals the all-pairs reference ------------------------
+# --- the broad phase changes nothing: the kernel equals the all-pairs reference
 
 scene = st.integers(2, 14).flatmap(
     lambda n: st.tuples(
-        st.lists(st.tuples(st.integers(0, 50), st.integers(0, 36)), min_size=n, max_size=n,
-                 unique=True),
+        st.lists(
+            st.tuples(st.integers(0, 50), st.integers(0, 36)), min_size=n, max_size=n, unique=True
+        ),
         st.lists(st.tuples(st.integers(1, 6), st.integers(1, 6)), min_size=n, max_size=n),
-        st.lists(st.tuples(st.sampled_from([-20, -10, -5, -2.5, 0, 2.5, 5, 10, 20, 30]),
-                           st.sampled_from([-20, -10, -5, 0, 5, 7.5, 10, 20])),
-                 min_size=n, max_size=n),
+        st.lists(
+            st.tuples(
+                st.sampled_from([-20, -10, -5, -2.5, 0, 2.5, 5, 10, 20, 30]),
+                st.sampled_from([-20, -10, -5, 0, 5, 7.5, 10, 20]),
+            ),
+            min_size=n,
+            max_size=n,
+        ),
         st.lists(st.booleans(), min_size=n, max_size=n),
     )
 )
@@ -245,7 +275,7 @@ def test_kernel_equals_the_all_pairs_reference(data):
     cells, size, vel, static = data
     # lay boxes on a 6 px grid so they start apart, inside a 320x240 world
     pos = [[6 * cx, 6 * cy] for cx, cy in cells]
-    vel = [[0, 0] if s else list(v) for v, s in zip(vel, static)]
+    vel = [[0, 0] if s else list(v) for v, s in zip(vel, static, strict=True)]
     world = (306, 222)
     ref_pos, ref_step, ref_log = reference(pos, size, vel, 10, world, 80, static)
     m = Model(WorldSpec(*world, 10), Bodies.boxes(pos, size, vel, static=static))

@@ -74,8 +74,16 @@ def test_events_and_no_events(tmp_path):
     run([TUNNEL, "--out", tmp_path, "--events", "--quiet"])
     lines = (tmp_path / "tunnelling_10fps" / "events.jsonl").read_text().splitlines()
     first = json.loads(lines[0])
-    assert first == {"tick": 51, "t": 5.1, "type": "pair", "a": 0, "b": 1, "axis": "x",
-                     "xdiff": 2, "ydiff": 10}
+    assert first == {
+        "tick": 51,
+        "t": 5.1,
+        "type": "pair",
+        "a": 0,
+        "b": 1,
+        "axis": "x",
+        "xdiff": 2,
+        "ydiff": 10,
+    }
 
 
 def test_fps_changes_the_outcome_tunnelling_at_1_fps(tmp_path):
@@ -123,8 +131,12 @@ def test_quiet_prints_nothing(tmp_path, capsys):
 
 @pytest.mark.parametrize(
     "flag, value, needle",
-    [("--max-objects", 1, "objects"), ("--max-ticks", 10, "ticks"), ("--max-side", 100, "side"),
-     ("--max-output-bytes", 1000, "output")],
+    [
+        ("--max-objects", 1, "objects"),
+        ("--max-ticks", 10, "ticks"),
+        ("--max-side", 100, "side"),
+        ("--max-output-bytes", 1000, "output"),
+    ],
 )
 def test_limits_refuse_with_exit_2_and_write_nothing(tmp_path, capsys, flag, value, needle):
     code = run([TUNNEL, "--out", tmp_path, flag, value, "--quiet"])
@@ -136,8 +148,10 @@ def test_limits_refuse_with_exit_2_and_write_nothing(tmp_path, capsys, flag, val
 
 def test_a_bad_scenario_is_refused_with_its_location_and_nothing_written(tmp_path, capsys):
     bad = tmp_path / "bad.yaml"
-    bad.write_text("version: 1\nworld: {width: 100, height: 100}\nobjects:\n"
-                   "  - {shape: box, size: 10, position: [0, 0], velocty: [1, 0]}\n")
+    bad.write_text(
+        "version: 1\nworld: {width: 100, height: 100}\nobjects:\n"
+        "  - {shape: box, size: 10, position: [0, 0], velocty: [1, 0]}\n"
+    )
     out = tmp_path / "out"
     assert run([bad, "--out", out]) == 2
     err = capsys.readouterr().err
@@ -166,9 +180,20 @@ def test_same_scenario_same_bytes(tmp_path):
 
 def test_python_dash_m_runner_is_the_same_command(tmp_path):
     proc = subprocess.run(
-        [sys.executable, "-m", "runner", "run", TUNNEL, "--out", str(tmp_path), "--quiet",
-         "--no-gif"],
-        capture_output=True, text=True, cwd=ROOT,
+        [
+            sys.executable,
+            "-m",
+            "runner",
+            "run",
+            TUNNEL,
+            "--out",
+            str(tmp_path),
+            "--quiet",
+            "--no-gif",
+        ],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
     )
     assert proc.returncode == 0, proc.stderr
     assert (tmp_path / "tunnelling_10fps" / "final.csv").is_file()

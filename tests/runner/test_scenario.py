@@ -1214,7 +1214,9 @@ def test_ticks_override_resolves_frames():
     text = BASE + "ticks: 12\noutput: {frames: [0, 6, 10]}\n"
     assert loads(text, overrides={"ticks": 8}).output.frames == (0, 6)
     # the file's own list must fit the file's own ticks
-    check_refused(text.replace("ticks: 12", "ticks: 9"), "10]", "frame 10 is past the last frame, 9")
+    check_refused(
+        text.replace("ticks: 12", "ticks: 9"), "10]", "frame 10 is past the last frame, 9"
+    )
 
 
 def test_fps_override_counts_duration_again():
