@@ -23,9 +23,9 @@ from numba import njit
 # The grid's cell is this much larger than the largest moving box, so that rounding at a cell
 # crossing (~1e-12 px) can never hide a touching neighbour two cells away.
 CELL_MARGIN = 1.01
-# Aim for about this many moving objects per cell when they are sparse (fewer crossings, few
-# neighbours to test). Tuned on benchmarks/bench_exact.py.
-TARGET_PER_CELL = 2.0
+# Aim for about this many moving objects per cell when they are sparse: larger cells mean fewer
+# cell crossings but more neighbours to test. Tuned on benchmarks/bench_exact.py (10,000 boxes).
+TARGET_PER_CELL = 0.6
 # The grid never has more cells than this per moving object (and at least one cell).
 MAX_CELLS_PER_OBJECT = 4
 

@@ -73,6 +73,25 @@ def box_sweep(qx, qy, ux, uy, wa, ha, wb, hb):
     return t_enter, t_exit, AXIS_XY, sx, sy
 
 
+@njit(cache=True, inline="always")
+def box_reach(qx, qy, ux, uy, wa, ha, wb, hb, dt):
+    """False when boxes A and B (any shapes inside them) surely cannot touch within dt seconds:
+    on some axis they are apart and not closing, or too far apart to close the gap in time. A
+    cheap filter before a sweep; True does not promise a contact."""
+    for q, u, lo, hi in ((qx, ux, -wb, wa), (qy, uy, -hb, ha)):
+        if q > hi:
+            gap = q - hi
+            closing = -u
+        elif q < lo:
+            gap = lo - q
+            closing = u
+        else:
+            continue
+        if not closing > 0.0 or gap > closing * dt:
+            return False
+    return True
+
+
 @njit(cache=True)
 def box_penetration(qx, qy, wa, ha, wb, hb):
     """Minimum-penetration contact of two boxes: (depth, code, nx, ny).
@@ -143,6 +162,8 @@ def _combine(n1x, n1y, n2x, n2y, distinct):
     sx = n1x + n2x
     sy = n1y + n2y
     length = np.sqrt(sx * sx + sy * sy)
+    if length < 1e-9:  # opposite faces tie (q at the very centre): take the first
+        return classify(n1x, n1y)
     return classify(sx / length, sy / length)
 
 

@@ -1,7 +1,8 @@
 """Command-line options shared by the commands that read scenarios (run, validate, check, bless).
 
 `add_limit_arguments` / `limits_from_args` carry SPEC section 8's bounds (`--max-objects`,
-`--max-ticks`, `--max-side`, `--max-frames`, and `--max-output-bytes` where frames are written);
+`--max-ticks`, `--max-side`, `--max-frames`, `--max-file-bytes`, `--max-yaml-nodes`, and
+`--max-output-bytes` where frames are written);
 `add_override_arguments` / `overrides_from_args` carry `--model`, `--fps`, `--ticks`, which override
 the scenario file (the loader checks the result again).
 """
@@ -18,6 +19,8 @@ _LIMIT_OPTIONS = (
     ("--max-ticks", "max_ticks", "ticks of a run"),
     ("--max-side", "max_side", "pixels per world side"),
     ("--max-frames", "max_frames", "frame numbers one `frames` entry may ask for"),
+    ("--max-file-bytes", "max_file_bytes", "bytes in a scenario file"),
+    ("--max-yaml-nodes", "max_yaml_nodes", "YAML values in a scenario file"),
 )
 _OUTPUT_OPTION = ("--max-output-bytes", "max_output_bytes", "bytes of frame output")
 

@@ -4,7 +4,9 @@
 at every frame someone needs (and often enough to show progress and stream events), rasterises only
 those frames, and calls back with events and frames as they come. Two front ends sit on it:
 `simulate` keeps everything in memory (goldens, tests), `run_to_dir` streams the files of SPEC
-section 5 into `OUT/NAME/`, each through a temporary name and a rename.
+section 5 into `OUT/NAME/`, each through a temporary name and a rename (temporaries a killed run
+left there are removed first). A model that stops a run as a runaway (the exact model's event cap,
+the stepped model's fold limit) raises `RunStopped` with a message for the user.
 """
 
 from __future__ import annotations
@@ -98,9 +100,10 @@ def drive(
         try:
             events = model.advance(stop - model.tick, log_events)
         except (EventCapExceeded, ValueError) as exc:
+            when = f"tick {stop}" if stop == model.tick + 1 else f"ticks {model.tick + 1}-{stop}"
             raise RunStopped(
-                f"{scenario.path or scenario.name}: error: the {scenario.model} model stopped the "
-                f"run between ticks {model.tick + 1} and {stop}: {exc}"
+                f"{scenario.path or scenario.name}: error: the {scenario.model} model stopped "
+                f"the run in {when}: {exc}"
             ) from None
         if log_events and len(events):
             counts["wall"] += int(np.count_nonzero(events["type"] == EV_WALL))
@@ -232,6 +235,8 @@ def run_to_dir(
     png_set = set(png_frames(scenario)) if options.png else set()
     if png_set:
         frames_dir.mkdir(exist_ok=True)
+    for folder in (target, frames_dir):  # what a killed run left (`.NAME.PID.XXXXXXXX.tmp`)
+        outputs.clean_temporaries(folder)
     wanted = set(png_set)
     gif = None
     if options.gif:

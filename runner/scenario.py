@@ -11,9 +11,12 @@ Reading goes in three steps. (1) The text is streamed as YAML events (iterativel
 exhaust a stack): nesting deeper than `MAX_YAML_DEPTH`, a second document, a YAML tag outside the
 plain core types (`!!python/...` and the like) and aliases are checked there; every alias adds the
 size of the node it repeats to a count, and past `Limits.max_alias_nodes` the file is refused at
-that alias, so a "billion laughs" file costs no more than its own length. (2) `yaml.compose` with
-the safe loader (libyaml's when available) builds the node tree. (3) The tree is walked by hand, so
-every value is checked where it stands and every error carries its node's place.
+that alias, so a "billion laughs" file costs no more than its own length; the file's size
+(`Limits.max_file_bytes`, checked before it is read whole) and its count of YAML values
+(`Limits.max_yaml_nodes`, before any is built) bound the memory the next step takes. (2)
+`yaml.compose` with the safe loader (libyaml's when available) builds the node tree. (3) The tree
+is walked by hand, so every value is checked where it stands and every error carries its node's
+place.
 
 Values follow YAML 1.1 as PyYAML reads it (`yes` is a boolean, `0x1f` an integer), with one
 addition: an unquoted number in exponent form such as `1e3` or `1.5E-7`, a string to YAML 1.1, is
@@ -66,6 +69,7 @@ DEFAULT_MASS = 1.0  # mass units
 MAX_SPEED = 1e9  # px/s, largest velocity component (a larger one crosses any world in a tick)
 MAX_SUBSTEPS = 10_000  # substeps per tick of the stepped model
 MAX_YAML_DEPTH = 64  # nesting levels of YAML collections
+READ_CHUNK_BYTES = 2**16  # a scenario file is read in pieces of this many bytes
 MAX_POINT_OFFSET = 2**24  # px, largest |coordinate| of a polygon point relative to its position
 MAX_NAME_LENGTH = 100  # characters in a scenario name (it names a folder)
 PALETTE_SIZE = 256  # palette rows: the background and up to 255 object colours
@@ -159,6 +163,8 @@ class Limits:
     max_alias_nodes: int = 10_000  # YAML nodes reached a second time or more through aliases
     max_output_bytes: int = 4 * 2**30  # used by the run, carried here so all bounds live together
     max_frames: int = 1_000_000  # frame numbers one `frames` entry may list (output or golden)
+    max_file_bytes: int = 64 * 2**20  # bytes of a scenario file (it is read whole)
+    max_yaml_nodes: int = 2_000_000  # YAML values in a file: each costs memory when composed
 
 
 @dataclass(frozen=True)
@@ -202,11 +208,18 @@ class Scenario:
 def load(path, *, overrides: dict | None = None, limits: Limits | None = None) -> Scenario:
     """Read and check the scenario file at `path` (str or os.PathLike); ScenarioError if bad."""
     shown = os.fspath(path)
+    limits = limits if limits is not None else Limits()
+    chunks: list[bytes] = []
+    size = 0
     try:
         with open(path, "rb") as f:
-            data = f.read()
+            while chunk := f.read(READ_CHUNK_BYTES):  # in pieces: an endless file stops here
+                size += len(chunk)
+                _check_length(size, shown, limits)
+                chunks.append(chunk)
     except OSError as exc:
         raise ScenarioError(shown, 1, 1, f"cannot read the file: {exc.strerror or exc}") from None
+    data = b"".join(chunks)
     text = _decode(data, shown)
     digest = hashlib.sha256(data).hexdigest()
     return _Reader(shown, shown, overrides, limits).scenario(text, digest)
@@ -217,8 +230,21 @@ def loads(text: str, path: str = "<string>", *, overrides=None, limits=None) -> 
 
     Without a `name`, text read under the default path is named NAME_FOR_TEXT.
     """
+    limits = limits if limits is not None else Limits()
+    _check_length(len(text), path, limits)  # characters: never more than the UTF-8 bytes
     digest = hashlib.sha256(text.encode("utf-8", "surrogatepass")).hexdigest()
     return _Reader(path, None, overrides, limits).scenario(text, digest)
+
+
+def _check_length(length: int, path: str, limits: Limits) -> None:
+    if length > limits.max_file_bytes:
+        raise ScenarioError(
+            path,
+            1,
+            1,
+            f"the file is larger than the limit of {limits.max_file_bytes:,} bytes; "
+            "raise it with --max-file-bytes",
+        )
 
 
 # ----------------------------------------------------------------------------- reading YAML
@@ -272,6 +298,7 @@ def _check_events(text: str, path: str, limits: Limits) -> None:
     sizes: dict[str, int] = {}  # anchor -> nodes in the node it names, aliases expanded
     stack: list[list] = []  # per open collection: [nodes so far, anchor]
     repeated = 0  # nodes reached again through aliases
+    nodes = 0  # nodes written out in the text
     documents = 0
 
     def add(n: int) -> None:
@@ -305,6 +332,14 @@ def _check_events(text: str, path: str, limits: Limits) -> None:
                 add(n)
             elif isinstance(ev, yaml.NodeEvent) and not isinstance(ev, yaml.CollectionEndEvent):
                 tag = getattr(ev, "tag", None)
+                nodes += 1
+                if nodes > limits.max_yaml_nodes:
+                    raise _mark_error(
+                        path,
+                        ev.start_mark,
+                        f"the file holds more than {limits.max_yaml_nodes:,} YAML values, the "
+                        "limit; raise it with --max-yaml-nodes",
+                    )
                 if tag is not None and tag not in _ALLOWED_TAGS:
                     raise _mark_error(
                         path,

@@ -678,10 +678,14 @@ def report_markdown(results: list[CaseResult], quick: bool, total_s: float) -> s
                 lines.append(f"- **{r.scene} / {r.model}**: {p}")
             if r.note:
                 lines.append(f"- {r.scene} / {r.model}: {r.note}")
+    run = {r.scene for r in results}
+    lines += ["", "## Scenes", ""]
+    lines += [f"- `{s.name}`: {s.about}." for s in scenes(quick) if s.name in run]
     return "\n".join(lines) + "\n"
 
 
 def report_json(results: list[CaseResult], quick: bool, total_s: float) -> dict:
+    """The report as a JSON object: mode, verdict, bounds, scene descriptions, every case."""
     return {
         "mode": "quick" if quick else "full",
         "ok": all(r.verdict != VERDICT_FAIL for r in results),
@@ -693,6 +697,7 @@ def report_json(results: list[CaseResult], quick: bool, total_s: float) -> dict:
             "stepped_momentum": STEPPED_MOMENTUM_TOL,
             "penetration_px": PENETRATION_TOL_PX,
         },
+        "scenes": {s.name: s.about for s in scenes(quick)},
         "cases": [{k: _json_number(v) for k, v in asdict(r).items()} for r in results],
     }
 
@@ -728,13 +733,13 @@ def cmd_stress(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return EXIT_BAD_INPUT
+    target.mkdir(parents=True, exist_ok=True)
     echo = None if args.quiet else print
     if echo is not None:
         echo(HEADER)
     began = time.perf_counter()
     results = run_suite(args.quick, args.scene or (), args.model or (), echo)
     total = time.perf_counter() - began
-    target.mkdir(parents=True, exist_ok=True)
     outputs.atomic_write_text(target / "report.md", report_markdown(results, args.quick, total))
     outputs.write_json(target / "report.json", report_json(results, args.quick, total))
     broken = [r for r in results if r.verdict == VERDICT_FAIL]

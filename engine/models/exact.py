@@ -1,21 +1,25 @@
 """The `exact` model (SPEC 3.3): event-driven elastic collisions, the reference for every result.
 
-Input: the world, the `Bodies` (copied) and the options `geometry` ("exact", the default: circles
-and polygons by their real shapes; "box": every object as its box), `max_events_per_tick` and
-`cell_size` (px; the grid's cell, chosen from the scene when not given). Output, per `advance`: the
-wall and pair events in the order they happened, `t` = the exact contact time; positions and
-velocities at the end of the last tick.
+Input: the world, the `Bodies` (copied) and the options `geometry` ("exact", the default, also
+for None: circles and polygons by their real shapes; "box": every object as its box),
+`max_events_per_tick` and `cell_size` (px; the grid's cell, chosen from the scene when not given).
+Output, per `advance`: the wall and pair events in the order they happened, `t` = the exact
+contact time; positions and velocities at the end of the last tick.
 
-Objects fly on straight lines between events. State is two packed arrays, floats F (n, 8) and ints
-N (n, 7), columns named below, so that the kernel's helpers (inlined into one loop) pass few
-arrays. A binary heap, in preallocated arrays that grow when full, holds predicted events keyed
-by (time, rank, a, b): cell crossings first (bookkeeping, never logged), then walls by id, then
-pairs in (a, b) order. Each object keeps its own clock (TLOC: its position is valid at that time)
-and an invalidation counter; an entry records the counters of its objects when predicted and is
-skipped as stale if either has changed since. After an event only the objects it touched are
-moved, counted and predicted again, against the 3×3 grid cells around them (broadphase.py), so
-prediction stays local; a cell crossing predicts only against the cells it brings into reach. At
-each tick's end every object is moved to that instant, for the frames.
+Objects fly on straight lines between events. Each keeps its own clock (TLOC: its position is
+valid at that time) and an invalidation counter. A 4-ary heap, in preallocated arrays that grow
+when full, holds predicted events keyed by (time, rank, a, b): cell crossings first (bookkeeping,
+never logged), then walls by (id, side), then pairs in (a, b) order. An entry records the counters
+of its objects when predicted and is skipped as stale if either has changed since.
+
+Prediction stays local and short. Moving objects are filed in a uniform grid (broadphase.py) by
+their box centre. Each moving object has one entry for its *horizon*: the first of its next wall
+contact and its next cell crossing. Its contacts are predicted against the objects in the 3×3
+cells around it, and pushed only when they come no later than its horizon: at the horizon it is
+predicted again anyway (a wall changes its velocity, a crossing its neighbours), and a contact
+between i and j is always pushed by whichever of the two last changed velocity or cell before it,
+since that one's horizon lies beyond it. After an event only the objects it touched are moved,
+counted and predicted again. At each tick's end every object is moved to that instant.
 
 Robust rules (contact.next_contact): touching or overlapping and approaching collide now;
 overlapping and separating make no event; nothing is scheduled in the past; a pair that has just
@@ -24,6 +28,11 @@ of the two has another event), so a rounding error cannot make it collide twice.
 (a row of touching boxes hit at one end) then run as a sequence of events at one instant. A tick
 that needs more than `max_events_per_tick` events raises EventCapExceeded: a runaway is an error,
 never a hang.
+
+State is packed in few arrays, floats F (n, 8) and ints N (n, 7), columns named below; the heap
+is HT (time), HI (key, counters) and HN (contact normal). The small helpers are inlined into two
+kernels, `_predict_all` and `_run`, which allocate nothing: growing the heap or the event log is
+done in Python between calls (the kernel stops before an event it has no room for, and resumes).
 """
 
 from __future__ import annotations
@@ -32,7 +41,7 @@ import numpy as np
 from numba import njit
 
 from engine.broadphase import grid_cell, grid_dims, static_cells
-from engine.contact import box_next_contact, next_contact
+from engine.contact import box_next_contact, box_reach, next_contact
 from engine.events import EV_PAIR, EV_WALL, SIDE_BOTTOM, SIDE_LEFT, SIDE_RIGHT, SIDE_TOP
 from engine.models.stepped import event_records, new_log
 from engine.response import exchange
@@ -41,8 +50,11 @@ from engine.world import KIND_BOX, Bodies, WorldSpec
 
 # Most wall and pair events one tick may take before the run is stopped as a runaway.
 MAX_EVENTS_PER_TICK = 1_000_000
-# Heap entries to start with per object (the heap doubles, or drops stale entries, when full).
-HEAP_PER_OBJECT = 8
+# Heap entries to start with per object (the heap drops stale entries, or doubles, when full).
+HEAP_PER_OBJECT = 4
+# Children per heap node: a 4-ary heap is half as deep as a binary one, and its four children
+# share a cache line.
+ARITY = 4
 
 # Columns of F (n, 8) float64: position (top-left, px) valid at the object's own clock TLOC (s),
 # velocity (px/s), box size (px), inverse mass (0 for static objects).
@@ -50,9 +62,14 @@ X, Y, VX, VY, TLOC, SW, SH, INV_MASS = range(8)
 # Columns of N (n, 7) int64: invalidation counter, static flag, contact shape kind, grid cell,
 # next / previous object in that cell's list (-1 for none), last query stamp (static objects).
 CNT, STATIC, SHAPE, CELL, NEXT, PREV, STAMP = range(7)
-# Heap arrays: HF (cap, 3) float64 time, normal x, normal y; HI (cap, 3) int64 key, counters.
-HT, HNX, HNY = range(3)
+# Heap: HT (cap,) float64 times; HI (cap, 3) int64 key and the two counters; HN (cap, 2) float64
+# the contact normal (code and normal as contact.py gives them).
 HKEY, HCA, HCB = range(3)
+# Grid cells (gnx·gny, 2) int64: the first moving object filed there (-1: none) and how many.
+C_HEAD, C_COUNT = range(2)
+# A prediction job (one row of `jobs`): the object, the partner to leave out (-1: none), whether
+# to take only static objects and higher ids (the first prediction, each pair once).
+J_OBJ, J_SKIP, J_HIGHER = range(3)
 
 # Heap keys: rank, a, b (or a wall side / crossing direction) and contact code in one int64, so that
 # ties in time resolve as crossings, then walls by (id, side), then pairs by (a, b).
@@ -70,9 +87,8 @@ MAX_OBJECTS = 1 << _ID_BITS
 DIR_LEFT, DIR_RIGHT, DIR_UP, DIR_DOWN = range(4)
 
 # Scalar state st (int64): heap size, ticks done, events in the current tick, query stamp, event
-# rows written in this `advance`.
+# rows written in this `advance`. stf (float64): the current time, s.
 _HEAP_N, _TICK, _TICK_EVENTS, _STAMP, _LOGGED = range(5)
-# stf (float64): the current time, s.
 _T_NOW = 0
 
 STATUS_DONE = 0
@@ -112,116 +128,115 @@ def _unkey(key):
 
 
 @_hot
-def _valid(key, ca, cb, N):
-    """An entry is valid while its objects' counters are those it was predicted with."""
-    rank, a, b, _ = _unkey(key)
-    if N[a, CNT] != ca:
+def _valid(HI, i, N):
+    """Entry i is valid while its objects' counters are those it was predicted with."""
+    rank, a, b, _ = _unkey(HI[i, HKEY])
+    if N[a, CNT] != HI[i, HCA]:
         return False
-    return rank != RANK_PAIR or N[b, CNT] == cb
+    return rank != RANK_PAIR or N[b, CNT] == HI[i, HCB]
 
 
-# --- the binary heap (HF, HI); the caller makes sure there is room before an event ---------------
+# --- the heap; the caller makes sure there is room before an event -----------------------------
 
 
 @_hot
-def _before(HF, HI, i, t, key):
+def _earlier(HT, HI, i, t, key):
     """Entry i comes strictly before (t, key)."""
-    return HF[i, HT] < t or (HF[i, HT] == t and HI[i, HKEY] < key)
+    return HT[i] < t or (HT[i] == t and HI[i, HKEY] < key)
 
 
 @_hot
-def _after(HF, HI, i, t, key):
-    """Entry i comes strictly after (t, key)."""
-    return HF[i, HT] > t or (HF[i, HT] == t and HI[i, HKEY] > key)
-
-
-@_hot
-def _put(HF, HI, i, t, nx, ny, key, ca, cb):
-    HF[i, HT], HF[i, HNX], HF[i, HNY] = t, nx, ny
+def _put(HT, HI, HN, i, t, key, ca, cb, nx, ny):
+    HT[i] = t
     HI[i, HKEY], HI[i, HCA], HI[i, HCB] = key, ca, cb
+    HN[i, 0], HN[i, 1] = nx, ny
 
 
 @_hot
-def _copy(HF, HI, i, j):
-    HF[i, HT], HF[i, HNX], HF[i, HNY] = HF[j, HT], HF[j, HNX], HF[j, HNY]
-    HI[i, HKEY], HI[i, HCA], HI[i, HCB] = HI[j, HKEY], HI[j, HCA], HI[j, HCB]
+def _move(HT, HI, HN, i, j):
+    """Entry j moves to slot i."""
+    _put(HT, HI, HN, i, HT[j], HI[j, HKEY], HI[j, HCA], HI[j, HCB], HN[j, 0], HN[j, 1])
 
 
 @_hot
-def _sift_up(HF, HI, i, t, nx, ny, key, ca, cb):
+def _sift_up(HT, HI, HN, i, t, key, ca, cb, nx, ny):
     """Place an entry at hole i, moving it up past later parents."""
     while i > 0:
-        p = (i - 1) >> 1
-        if not _after(HF, HI, p, t, key):
+        p = (i - 1) // ARITY
+        if _earlier(HT, HI, p, t, key) or (HT[p] == t and HI[p, HKEY] == key):
             break
-        _copy(HF, HI, i, p)
+        _move(HT, HI, HN, i, p)
         i = p
-    _put(HF, HI, i, t, nx, ny, key, ca, cb)
+    _put(HT, HI, HN, i, t, key, ca, cb, nx, ny)
 
 
 @_hot
-def _sift_down(HF, HI, n, i, t, nx, ny, key, ca, cb):
+def _sift_down(HT, HI, HN, n, i, t, key, ca, cb, nx, ny):
     """Place an entry at hole i of a heap of n, moving it down past earlier children."""
     while True:
-        c = 2 * i + 1
-        if c >= n:
+        first = ARITY * i + 1
+        if first >= n:
             break
-        if c + 1 < n and _before(HF, HI, c + 1, HF[c, HT], HI[c, HKEY]):
-            c += 1
-        if not _before(HF, HI, c, t, key):
+        c = first
+        for m in range(first + 1, min(first + ARITY, n)):
+            if _earlier(HT, HI, m, HT[c], HI[c, HKEY]):
+                c = m
+        if not _earlier(HT, HI, c, t, key):
             break
-        _copy(HF, HI, i, c)
+        _move(HT, HI, HN, i, c)
         i = c
-    _put(HF, HI, i, t, nx, ny, key, ca, cb)
+    _put(HT, HI, HN, i, t, key, ca, cb, nx, ny)
 
 
 @_hot
-def _push(HF, HI, st, t, key, ca, cb, nx, ny):
+def _push(HT, HI, HN, st, t, key, ca, cb, nx, ny):
     """Add an entry (there is room)."""
     n = st[_HEAP_N]
     st[_HEAP_N] = n + 1
-    _sift_up(HF, HI, n, t, nx, ny, key, ca, cb)
+    _sift_up(HT, HI, HN, n, t, key, ca, cb, nx, ny)
 
 
 @_hot
-def _pop(HF, HI, st):
+def _pop(HT, HI, HN, st):
     """Remove and return the earliest entry (t, key, ca, cb, nx, ny)."""
-    top = (HF[0, HT], HI[0, HKEY], HI[0, HCA], HI[0, HCB], HF[0, HNX], HF[0, HNY])
+    top = (HT[0], HI[0, HKEY], HI[0, HCA], HI[0, HCB], HN[0, 0], HN[0, 1])
     n = st[_HEAP_N] - 1
     st[_HEAP_N] = n
     if n > 0:
-        _sift_down(
-            HF, HI, n, 0, HF[n, HT], HF[n, HNX], HF[n, HNY], HI[n, HKEY], HI[n, HCA], HI[n, HCB]
-        )
+        _sift_down(HT, HI, HN, n, 0, HT[n], HI[n, HKEY], HI[n, HCA], HI[n, HCB], HN[n, 0], HN[n, 1])
     return top
 
 
 @njit(cache=True)
-def _compact(HF, HI, st, N):
+def _compact(HT, HI, HN, st, N):
     """Drop stale entries and rebuild the heap in place; returns the free room."""
     keep = 0
     for i in range(st[_HEAP_N]):
-        if _valid(HI[i, HKEY], HI[i, HCA], HI[i, HCB], N):
-            _copy(HF, HI, keep, i)
+        if _valid(HI, i, N):
+            _move(HT, HI, HN, keep, i)
             keep += 1
-    for i in range(keep // 2 - 1, -1, -1):
+    for i in range((keep - 2) // ARITY, -1, -1):
         _sift_down(
-            HF, HI, keep, i, HF[i, HT], HF[i, HNX], HF[i, HNY], HI[i, HKEY], HI[i, HCA], HI[i, HCB]
+            HT, HI, HN, keep, i, HT[i], HI[i, HKEY], HI[i, HCA], HI[i, HCB], HN[i, 0], HN[i, 1]
         )
     st[_HEAP_N] = keep
-    return HF.shape[0] - keep
+    return HT.shape[0] - keep
 
 
-def _grown(a: np.ndarray, rows: int) -> np.ndarray:
-    """a with at least `rows` rows (doubling), the old rows kept."""
-    out = np.empty((max(rows, 2 * a.shape[0]),) + a.shape[1:], a.dtype)
+@_hot
+def _has_room(room, HT, HI, HN, st, N):
+    """Whether `room` more entries fit, dropping stale entries first if they would not."""
+    return HT.shape[0] - st[_HEAP_N] >= room or _compact(HT, HI, HN, st, N) >= room
+
+
+def _grown(a: np.ndarray) -> np.ndarray:
+    """a with twice the rows, the old rows kept."""
+    out = np.empty((2 * a.shape[0],) + a.shape[1:], a.dtype)
     out[: a.shape[0]] = a
     return out
 
 
 # --- grid cells: doubly linked lists of the moving objects in each cell -----------------------
-# cells (gnx·gny, 2) int64: the first object filed in the cell (-1: none) and how many there are.
-C_HEAD, C_COUNT = range(2)
 
 
 @_hot
@@ -248,7 +263,7 @@ def _cell_remove(N, cells, i):
 
 @njit(cache=True)
 def _build_grid(F, N, cell, gnx, gny):
-    """Grid G = (cells, static_start, static_items); moving objects filed by their box centre."""
+    """Grid (cells, static_start, static_items); moving objects filed by their box centre."""
     cells = np.zeros((gnx * gny, 2), np.int64)
     cells[:, C_HEAD] = -1
     static = N[:, STATIC] != 0
@@ -265,35 +280,34 @@ def _build_grid(F, N, cell, gnx, gny):
 
 
 @_hot
-def _population(x0, x1, y0, y1, cells, s_start, world):
-    """How many objects (moving and static) are filed in cells [x0, x1] × [y0, y1], clipped."""
+def _room_around(gx, gy, N, cells, s_start, world):
+    """Heap entries a prediction in cell (gx, gy) may push: a horizon, and one contact per object
+    filed in the 3×3 cells around it (moving and static)."""
     gnx, gny = world[4], world[5]
-    total = 0
-    for cy in range(max(y0, 0), min(y1, gny - 1) + 1):
-        for cx in range(max(x0, 0), min(x1, gnx - 1) + 1):
+    room = 1
+    for cy in range(max(gy - 1, 0), min(gy + 1, gny - 1) + 1):
+        for cx in range(max(gx - 1, 0), min(gx + 1, gnx - 1) + 1):
             c = cy * gnx + cx
-            total += cells[c, C_COUNT] + s_start[c + 1] - s_start[c]
-    return total
+            room += cells[c, C_COUNT] + s_start[c + 1] - s_start[c]
+    return room
 
 
 @_hot
-def _room_needed(rank, a, b, N, cells, s_start, world):
-    """Heap entries the event (rank, a, b) may push at most: a wall and a crossing per object it
-    touches, and one contact per object in the cells predicted against."""
+def _room_needed(rank, a, b, HT, st, N, cells, s_start, world):
+    """Heap entries the event (rank, a, b) may push at most; when the heap has room for the worst
+    case of any event (two predictions against everything), it is not counted."""
+    if HT.shape[0] - st[_HEAP_N] >= 2 * (N.shape[0] + 1):
+        return 0
     gnx = world[4]
     gx = N[a, CELL] % gnx
     gy = N[a, CELL] // gnx
     if rank == RANK_CROSS:
-        if b == DIR_LEFT or b == DIR_RIGHT:
-            x = gx + (2 if b == DIR_RIGHT else -2)
-            return 1 + _population(x, x, gy - 1, gy + 1, cells, s_start, world)
-        y = gy + (2 if b == DIR_DOWN else -2)
-        return 1 + _population(gx - 1, gx + 1, y, y, cells, s_start, world)
-    room = 2 + _population(gx - 1, gx + 1, gy - 1, gy + 1, cells, s_start, world)
+        gx += 1 if b == DIR_RIGHT else -1 if b == DIR_LEFT else 0
+        gy += 1 if b == DIR_DOWN else -1 if b == DIR_UP else 0
+        return _room_around(gx, gy, N, cells, s_start, world)
+    room = _room_around(gx, gy, N, cells, s_start, world)
     if rank == RANK_PAIR:
-        gx = N[b, CELL] % gnx
-        gy = N[b, CELL] // gnx
-        room += 2 + _population(gx - 1, gx + 1, gy - 1, gy + 1, cells, s_start, world)
+        room += _room_around(N[b, CELL] % gnx, N[b, CELL] // gnx, N, cells, s_start, world)
     return room
 
 
@@ -306,11 +320,9 @@ def _wall_time(i, F, world):
     t_best = INF
     side = -1
     if F[i, VX] > 0.0:
-        t_best = F[i, TLOC] + (world[0] - F[i, SW] - F[i, X]) / F[i, VX]
-        side = SIDE_RIGHT
+        t_best, side = F[i, TLOC] + (world[0] - F[i, SW] - F[i, X]) / F[i, VX], SIDE_RIGHT
     elif F[i, VX] < 0.0:
-        t_best = F[i, TLOC] + F[i, X] / -F[i, VX]
-        side = SIDE_LEFT
+        t_best, side = F[i, TLOC] + F[i, X] / -F[i, VX], SIDE_LEFT
     if F[i, VY] > 0.0:
         t = F[i, TLOC] + (world[1] - F[i, SH] - F[i, Y]) / F[i, VY]
         if t < t_best:
@@ -349,7 +361,7 @@ def _cross_time(i, F, N, world):
 
 @njit(cache=True)
 def _shape_contact(a, b, qx, qy, ux, uy, F, N, C):
-    """next_contact for a pair with a circle or polygon (the cores C = radius, start, verts,
+    """next_contact for a pair with a circle or polygon; cores C = (radius, start, verts,
     normals)."""
     radius, start, verts, normals = C
     return next_contact(
@@ -373,8 +385,8 @@ def _shape_contact(a, b, qx, qy, ux, uy, F, N, C):
 
 
 @_hot
-def _predict_pair(i, j, t_now, F, N, C, HF, HI, st):
-    """Push the next contact of i and j, if any."""
+def _predict_pair(i, j, t_now, horizon, F, N, C, HT, HI, HN, st):
+    """Push the next contact of i and j if it comes no later than `horizon` (s)."""
     a = min(i, j)
     b = max(i, j)
     da = t_now - F[a, TLOC]
@@ -383,64 +395,57 @@ def _predict_pair(i, j, t_now, F, N, C, HF, HI, st):
     qy = (F[b, Y] + F[b, VY] * db) - (F[a, Y] + F[a, VY] * da)
     ux = F[b, VX] - F[a, VX]
     uy = F[b, VY] - F[a, VY]
+    if not box_reach(qx, qy, ux, uy, F[a, SW], F[a, SH], F[b, SW], F[b, SH], horizon - t_now):
+        return
     if N[a, SHAPE] == KIND_BOX and N[b, SHAPE] == KIND_BOX:
         t, code, nx, ny = box_next_contact(qx, qy, ux, uy, F[a, SW], F[a, SH], F[b, SW], F[b, SH])
     else:
         t, code, nx, ny = _shape_contact(a, b, qx, qy, ux, uy, F, N, C)
-    if t < INF:
-        _push(HF, HI, st, t_now + t, _key(RANK_PAIR, a, b, code), N[a, CNT], N[b, CNT], nx, ny)
-
-
-# A prediction job, one row of an int64 array: the object, the partner to leave out (-1: none),
-# the cells [x0, x1] × [y0, y1] to predict against, whether to predict its wall contact too (its
-# velocity changed) and whether to take only static objects and higher ids (the first prediction).
-J_OBJ, J_SKIP, J_X0, J_X1, J_Y0, J_Y1, J_WALL, J_HIGHER = range(8)
+    if t_now + t <= horizon:
+        key = _key(RANK_PAIR, a, b, code)
+        _push(HT, HI, HN, st, t_now + t, key, N[a, CNT], N[b, CNT], nx, ny)
 
 
 @_hot
-def _job(jobs, k, i, skip, x0, x1, y0, y1, wall, higher):
-    jobs[k, J_OBJ], jobs[k, J_SKIP], jobs[k, J_WALL], jobs[k, J_HIGHER] = i, skip, wall, higher
-    jobs[k, J_X0], jobs[k, J_X1], jobs[k, J_Y0], jobs[k, J_Y1] = x0, x1, y0, y1
-
-
-@_hot
-def _job_around(jobs, k, i, skip, higher, N, world):
-    """Job k: everything about i after its velocity changed, against the 3×3 cells around it."""
-    gx = N[i, CELL] % world[4]
-    gy = N[i, CELL] // world[4]
-    _job(jobs, k, i, skip, gx - 1, gx + 1, gy - 1, gy + 1, 1, higher)
-
-
-@_hot
-def _predict(jobs, k, t_now, F, N, C, cells, s_start, s_items, HF, HI, st, world):
-    """Run prediction job k: push i's wall contact (if asked), its next cell crossing, and its
-    contacts with the objects filed in the job's cells (clipped to the grid)."""
+def _predict(jobs, k, t_now, F, N, C, cells, s_start, s_items, HT, HI, HN, st, world):
+    """Run prediction job k for object i: push its horizon (the first of its next wall contact
+    and its next cell crossing) and its contacts with the objects in the 3×3 cells around it
+    that come no later than that."""
     i, skip, higher = jobs[k, J_OBJ], jobs[k, J_SKIP], jobs[k, J_HIGHER] != 0
-    if jobs[k, J_WALL] != 0:
-        t, side = _wall_time(i, F, world)
-        if t < INF:
-            _push(HF, HI, st, max(t, t_now), _key(RANK_WALL, i, side, side), N[i, CNT], 0, 0.0, 0.0)
-    t, d = _cross_time(i, F, N, world)
-    if t < INF:
-        _push(HF, HI, st, max(t, t_now), _key(RANK_CROSS, i, d, d), N[i, CNT], 0, 0.0, 0.0)
+    t_wall, side = _wall_time(i, F, world)
+    t_cross, d = _cross_time(i, F, N, world)
+    if t_cross <= t_wall and t_cross < INF:
+        key = _key(RANK_CROSS, i, d, d)
+        _push(HT, HI, HN, st, max(t_cross, t_now), key, N[i, CNT], 0, 0.0, 0.0)
+    elif t_wall < INF:
+        key = _key(RANK_WALL, i, side, side)
+        _push(HT, HI, HN, st, max(t_wall, t_now), key, N[i, CNT], 0, 0.0, 0.0)
+    horizon = max(min(t_wall, t_cross), t_now)
     gnx, gny = world[4], world[5]
+    gx = N[i, CELL] % gnx
+    gy = N[i, CELL] // gnx
     st[_STAMP] += 1
-    for cy in range(max(jobs[k, J_Y0], 0), min(jobs[k, J_Y1], gny - 1) + 1):
-        for cx in range(max(jobs[k, J_X0], 0), min(jobs[k, J_X1], gnx - 1) + 1):
+    for cy in range(max(gy - 1, 0), min(gy + 1, gny - 1) + 1):
+        for cx in range(max(gx - 1, 0), min(gx + 1, gnx - 1) + 1):
             c = cy * gnx + cx
             j = cells[c, C_HEAD]
             while j >= 0:
                 if j != i and j != skip and not (higher and j < i):
-                    _predict_pair(i, j, t_now, F, N, C, HF, HI, st)
+                    _predict_pair(i, j, t_now, horizon, F, N, C, HT, HI, HN, st)
                 j = N[j, NEXT]
             for m in range(s_start[c], s_start[c + 1]):
                 j = s_items[m]
                 if N[j, STAMP] != st[_STAMP] and j != skip:
                     N[j, STAMP] = st[_STAMP]
-                    _predict_pair(i, j, t_now, F, N, C, HF, HI, st)
+                    _predict_pair(i, j, t_now, horizon, F, N, C, HT, HI, HN, st)
 
 
-# --- events: each changes the state and says what to predict next ------------------------------
+@_hot
+def _job(jobs, k, i, skip, higher):
+    jobs[k, J_OBJ], jobs[k, J_SKIP], jobs[k, J_HIGHER] = i, skip, higher
+
+
+# --- events: each changes the state and says which objects to predict again --------------------
 
 
 @_hot
@@ -454,19 +459,13 @@ def _move_to(i, t, F):
 
 @_hot
 def _on_cross(i, d, N, cells, world, jobs):
-    """i's centre enters the next cell: refile it; predict its next crossing and its contacts with
-    the row or column of cells that comes into reach. Returns the number of jobs (1)."""
+    """i's centre enters the next cell: refile it. Returns the number of jobs (1)."""
     gnx = world[4]
     gx = N[i, CELL] % gnx + (1 if d == DIR_RIGHT else -1 if d == DIR_LEFT else 0)
     gy = N[i, CELL] // gnx + (1 if d == DIR_DOWN else -1 if d == DIR_UP else 0)
     _cell_remove(N, cells, i)
     _cell_insert(N, cells, i, gy * gnx + gx)
-    if d == DIR_RIGHT or d == DIR_LEFT:
-        x = gx + (1 if d == DIR_RIGHT else -1)
-        _job(jobs, 0, i, -1, x, x, gy - 1, gy + 1, 0, 0)
-    else:
-        y = gy + (1 if d == DIR_DOWN else -1)
-        _job(jobs, 0, i, -1, gx - 1, gx + 1, y, y, 0, 0)
+    _job(jobs, 0, i, -1, 0)
     return 1
 
 
@@ -482,12 +481,12 @@ def _on_wall(i, side, t, F, N, world, jobs):
         F[i, VY] = -F[i, VY]
         F[i, Y] = 0.0 if side == SIDE_TOP else world[1] - F[i, SH]
     N[i, CNT] += 1
-    _job_around(jobs, 0, i, -1, 0, N, world)
+    _job(jobs, 0, i, -1, 0)
     return 1
 
 
 @_hot
-def _on_pair(a, b, code, nx, ny, t, F, N, world, jobs):
+def _on_pair(a, b, code, nx, ny, t, F, N, jobs):
     """a and b touch: the elastic exchange; then each moving one is predicted again, but not
     against the other. Returns the number of jobs (0: they were not approaching, no event)."""
     _move_to(a, t, F)
@@ -502,7 +501,7 @@ def _on_pair(a, b, code, nx, ny, t, F, N, world, jobs):
     for i, other in ((a, b), (b, a)):
         if N[i, STATIC] == 0:
             N[i, CNT] += 1
-            _job_around(jobs, n_jobs, i, other, 0, N, world)
+            _job(jobs, n_jobs, i, other, 0)
             n_jobs += 1
     return n_jobs
 
@@ -519,11 +518,17 @@ def _sync(t, F, N, world):
         F[i, TLOC] = t
 
 
+@_hot
+def _log_row(rows, times, n, tick, t, kind, a, b, code):
+    rows[n, 0], rows[n, 1], rows[n, 2], rows[n, 3], rows[n, 4] = tick, kind, a, b, code
+    times[n] = t
+
+
 # --- the kernels ---------------------------------------------------------------------------------
 
 
 @_kernel
-def _predict_all(jobs, first, F, N, C, cells, s_start, s_items, HF, HI, st, world):
+def _predict_all(jobs, first, F, N, C, cells, s_start, s_items, HT, HI, HN, st, world):
     """Initial predictions at time 0 for moving objects first, first+1, ..., each pair once.
 
     Returns the object to resume from when the heap is full (n when done).
@@ -531,19 +536,34 @@ def _predict_all(jobs, first, F, N, C, cells, s_start, s_items, HF, HI, st, worl
     for i in range(first, F.shape[0]):
         if N[i, STATIC] != 0:
             continue
-        _job_around(jobs, 0, i, -1, 1, N, world)
-        room = 2 + _population(
-            jobs[0, J_X0], jobs[0, J_X1], jobs[0, J_Y0], jobs[0, J_Y1], cells, s_start, world
-        )
-        if HF.shape[0] - st[_HEAP_N] < room and _compact(HF, HI, st, N) < room:
+        room = _room_around(N[i, CELL] % world[4], N[i, CELL] // world[4], N, cells, s_start, world)
+        if not _has_room(room, HT, HI, HN, st, N):
             return i
-        _predict(jobs, 0, 0.0, F, N, C, cells, s_start, s_items, HF, HI, st, world)
+        _job(jobs, 0, i, -1, 1)
+        _predict(jobs, 0, 0.0, F, N, C, cells, s_start, s_items, HT, HI, HN, st, world)
     return F.shape[0]
 
 
 @_kernel
 def _run(
-    jobs, tick_to, log, cap, F, N, C, cells, s_start, s_items, HF, HI, st, stf, world, rows, times
+    jobs,
+    tick_to,
+    log,
+    cap,
+    F,
+    N,
+    C,
+    cells,
+    s_start,
+    s_items,
+    HT,
+    HI,
+    HN,
+    st,
+    stf,
+    world,
+    rows,
+    times,
 ):
     """Run ticks until tick_to: take due events in order, apply each, predict again for the objects
     it touched; move everything to each tick's end.
@@ -554,17 +574,17 @@ def _run(
     while st[_TICK] < tick_to:
         tick = st[_TICK] + 1
         t_end = tick / world[2]
-        while st[_HEAP_N] > 0 and HF[0, HT] <= t_end:
-            if not _valid(HI[0, HKEY], HI[0, HCA], HI[0, HCB], N):
-                _pop(HF, HI, st)
+        while st[_HEAP_N] > 0 and HT[0] <= t_end:
+            if not _valid(HI, 0, N):
+                _pop(HT, HI, HN, st)
                 continue
             rank, a, b, code = _unkey(HI[0, HKEY])
-            room = _room_needed(rank, a, b, N, cells, s_start, world)
-            if HF.shape[0] - st[_HEAP_N] < room and _compact(HF, HI, st, N) < room:
+            room = _room_needed(rank, a, b, HT, st, N, cells, s_start, world)
+            if not _has_room(room, HT, HI, HN, st, N):
                 return STATUS_HEAP_FULL
             if log and st[_LOGGED] == rows.shape[0]:
                 return STATUS_LOG_FULL
-            t, key, ca, cb, nx, ny = _pop(HF, HI, st)
+            t, key, ca, cb, nx, ny = _pop(HT, HI, HN, st)
             stf[_T_NOW] = t
             if rank == RANK_CROSS:
                 n_jobs = _on_cross(a, b, N, cells, world, jobs)
@@ -576,24 +596,18 @@ def _run(
                     n_jobs = _on_wall(a, b, t, F, N, world, jobs)
                     kind, b = EV_WALL, -1
                 else:
-                    n_jobs = _on_pair(a, b, code, nx, ny, t, F, N, world, jobs)
+                    n_jobs = _on_pair(a, b, code, nx, ny, t, F, N, jobs)
                     kind = EV_PAIR
                 if log and n_jobs > 0:  # a pair that was not approaching is no event
                     _log_row(rows, times, st[_LOGGED], tick, t, kind, a, b, code)
                     st[_LOGGED] += 1
             for k in range(n_jobs):
-                _predict(jobs, k, t, F, N, C, cells, s_start, s_items, HF, HI, st, world)
+                _predict(jobs, k, t, F, N, C, cells, s_start, s_items, HT, HI, HN, st, world)
         _sync(t_end, F, N, world)
         stf[_T_NOW] = t_end
         st[_TICK] = tick
         st[_TICK_EVENTS] = 0
     return STATUS_DONE
-
-
-@_hot
-def _log_row(rows, times, n, tick, t, kind, a, b, code):
-    rows[n, 0], rows[n, 1], rows[n, 2], rows[n, 3], rows[n, 4] = tick, kind, a, b, code
-    times[n] = t
 
 
 class Model:
@@ -604,12 +618,13 @@ class Model:
         world: WorldSpec,
         bodies: Bodies,
         substeps: int = 1,
-        geometry: str = "exact",
+        geometry: str | None = None,
         max_events_per_tick: int = MAX_EVENTS_PER_TICK,
         cell_size: float | None = None,
     ):
         if int(substeps) != substeps or substeps < 1:
             raise ValueError(f"substeps must be a whole number >= 1, got {substeps!r}")
+        geometry = "exact" if geometry is None else geometry
         if geometry not in GEOMETRIES:
             raise ValueError(f"unknown geometry {geometry!r}; expected one of {GEOMETRIES}")
         if int(max_events_per_tick) != max_events_per_tick or max_events_per_tick < 1:
@@ -636,7 +651,7 @@ class Model:
         self._N[:, SHAPE] = cores.shape
         self._C = (cores.radius, cores.start, cores.verts, cores.normals)
         if cell_size is None:
-            cell_size = grid_cell(world.width, world.height, self._F[:, SW : SH + 1], static)
+            cell_size = grid_cell(world.width, world.height, bodies.size, static)
         self.cell_size = float(cell_size)
         gnx, gny = grid_dims(world.width, world.height, self.cell_size)
         self._world = (
@@ -649,24 +664,19 @@ class Model:
         )
         self._G = _build_grid(self._F, self._N, self.cell_size, gnx, gny)
         cap = max(64, HEAP_PER_OBJECT * n)
-        self._HF = np.empty((cap, 3))
-        self._HI = np.empty((cap, 3), np.int64)
+        self._heap = [np.empty(cap), np.empty((cap, 3), np.int64), np.empty((cap, 2))]
         self._st = np.zeros(5, np.int64)
         self._stf = np.zeros(1)
-        self._jobs = np.zeros((2, 8), np.int64)  # scratch: the prediction jobs of one event
+        self._jobs = np.zeros((2, 3), np.int64)  # scratch: the prediction jobs of one event
         first = 0
         while first < n:
-            first = _predict_all(self._jobs, first, *self._kernel_state())
+            first = _predict_all(self._jobs, first, *self._state())
             if first < n:
-                self._grow_heap()
+                self._heap = [_grown(a) for a in self._heap]
 
-    def _kernel_state(self):
-        """The arrays the kernels share: F, N, cores, grid (3 arrays), heap (2), st, world."""
-        return (self._F, self._N, self._C, *self._G, self._HF, self._HI, self._st, self._world)
-
-    def _grow_heap(self):
-        self._HF = _grown(self._HF, 0)
-        self._HI = _grown(self._HI, 0)
+    def _state(self):
+        """The arrays the kernels share: F, N, cores, grid (3), heap (3), st, world."""
+        return (self._F, self._N, self._C, *self._G, *self._heap, self._st, self._world)
 
     def advance(self, ticks: int, log: bool = True) -> np.ndarray:
         """Run `ticks` ticks; the events in the order they happened (empty when log is False)."""
@@ -676,7 +686,7 @@ class Model:
         self._st[_LOGGED] = 0
         target = self.tick + int(ticks)
         while True:
-            F, N, C, cells, s_start, s_items, HF, HI, st, world = self._kernel_state()
+            F, N, C, cells, s_start, s_items, HT, HI, HN, st, world = self._state()
             status = _run(
                 self._jobs,
                 target,
@@ -688,8 +698,9 @@ class Model:
                 cells,
                 s_start,
                 s_items,
-                HF,
+                HT,
                 HI,
+                HN,
                 st,
                 self._stf,
                 world,
@@ -697,9 +708,9 @@ class Model:
                 times,
             )
             if status == STATUS_HEAP_FULL:
-                self._grow_heap()
+                self._heap = [_grown(a) for a in self._heap]
             elif status == STATUS_LOG_FULL:
-                rows, times = _grown(rows, 0), _grown(times, 0)
+                rows, times = _grown(rows), _grown(times)
             elif status == STATUS_CAP:
                 self._broken = (
                     f"tick {int(st[_TICK]) + 1} needed more than {self.max_events_per_tick} "

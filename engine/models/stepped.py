@@ -2,8 +2,9 @@
 
 Input: the world, the `Bodies` (copied: the model owns its state) and the options `substeps`
 (each tick split into that many equal steps of 1/(fps·substeps) s) and `geometry` ("box", the
-default: every object collides as its box; "exact": by its real shape, shapes.py). Output, per
-`advance`: the events of the ticks run, walls and responding pairs, `t` = the tick's end.
+default, also for None: every object collides as its box; "exact": by its real shape, shapes.py).
+Output, per `advance`: the events of the ticks run, walls and responding pairs, `t` = the tick's
+end.
 
 Each step runs move -> walls -> pairs. Walls reflect exactly as a wall would (response.fold).
 Pairs: the candidates are the pairs whose boxes overlap after the walls (broadphase.sweep_pairs),
@@ -139,12 +140,21 @@ def _contact(a, b, pos, size, exact, shape, radius, start, verts, normals):
     if not exact:
         return box_overlap_axis(qx, qy, size[a, 0], size[a, 1], size[b, 0], size[b, 1])
     depth, code, nx, ny = penetration(
-        qx, qy,
-        shape[a], size[a, 0], size[a, 1], radius[a],
-        verts[start[a] : start[a + 1]], normals[start[a] : start[a + 1]],
-        shape[b], size[b, 0], size[b, 1], radius[b],
-        verts[start[b] : start[b + 1]], normals[start[b] : start[b + 1]],
-    )  # fmt: skip
+        qx,
+        qy,
+        shape[a],
+        size[a, 0],
+        size[a, 1],
+        radius[a],
+        verts[start[a] : start[a + 1]],
+        normals[start[a] : start[a + 1]],
+        shape[b],
+        size[b, 0],
+        size[b, 1],
+        radius[b],
+        verts[start[b] : start[b + 1]],
+        normals[start[b] : start[b + 1]],
+    )
     return depth, depth, code, nx, ny
 
 
@@ -216,9 +226,12 @@ def _run(
 class Model:
     """Fixed-step elastic model; see the module docstring. Surface as in engine.models."""
 
-    def __init__(self, world: WorldSpec, bodies: Bodies, substeps: int = 1, geometry: str = "box"):
+    def __init__(
+        self, world: WorldSpec, bodies: Bodies, substeps: int = 1, geometry: str | None = None
+    ):
         if int(substeps) != substeps or substeps < 1:
             raise ValueError(f"substeps must be a whole number >= 1, got {substeps!r}")
+        geometry = "box" if geometry is None else geometry
         if geometry not in GEOMETRIES:
             raise ValueError(f"unknown geometry {geometry!r}; expected one of {GEOMETRIES}")
         self.world = world
