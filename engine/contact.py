@@ -29,6 +29,10 @@ from engine.world import KIND_BOX, KIND_CIRCLE
 INF = np.inf
 # Two unit normals whose dot product is at least this are the same face direction (rad^2 scale).
 SAME_DIRECTION = 1.0 - 1e-12
+# Contacts closer than this (px of travel, or of overlap width) count as simultaneous: two faces
+# starting to overlap within it meet at once (a corner, AXIS_XY), a pass overlapping for less
+# than it grazes. Far below anything visible, far above float rounding of pixel coordinates.
+TIE_PX = 1e-9
 
 
 # --- boxes -----------------------------------------------------------------------------------
@@ -58,19 +62,24 @@ def box_sweep(qx, qy, ux, uy, wa, ha, wb, hb):
 
     Overlap of positive area exactly for t_enter < t < t_exit (relative seconds, may be ±inf;
     t_enter >= t_exit when it never happens). The contact axis is the one whose overlap starts last;
-    AXIS_XY when both start together.
+    AXIS_XY when both start together. "Together" and "positive" are up to TIE_PX of travel, so
+    that a corner hit or a grazing pass that is exact in the scene's numbers stays one after
+    rounding.
     """
     x0, x1 = _slab(qx, ux, -wb, wa)
     y0, y1 = _slab(qy, uy, -hb, ha)
     t_enter = max(x0, y0)
     t_exit = min(x1, y1)
+    tie = TIE_PX / max(abs(ux), abs(uy), 1e-300)
+    if t_exit - t_enter <= tie:
+        t_exit = t_enter  # grazing: no overlap of positive length
     sx = 1.0 if ux < 0.0 else -1.0
     sy = 1.0 if uy < 0.0 else -1.0
+    if abs(x0 - y0) <= tie:
+        return t_enter, t_exit, AXIS_XY, sx, sy
     if x0 > y0:
         return t_enter, t_exit, AXIS_X, sx, 0.0
-    if y0 > x0:
-        return t_enter, t_exit, AXIS_Y, 0.0, sy
-    return t_enter, t_exit, AXIS_XY, sx, sy
+    return t_enter, t_exit, AXIS_Y, 0.0, sy
 
 
 @njit(cache=True, inline="always")
@@ -130,11 +139,11 @@ def box_overlap_axis(qx, qy, wa, ha, wb, hb):
     up = qy + hb
     dx, sx = (right, 1.0) if right <= left else (left, -1.0)
     dy, sy = (down, 1.0) if down <= up else (up, -1.0)
+    if abs(xdiff - ydiff) <= TIE_PX:
+        return dx, dy, AXIS_XY, sx, sy
     if xdiff < ydiff:
         return dx, 0.0, AXIS_X, sx, 0.0
-    if ydiff < xdiff:
-        return dy, 0.0, AXIS_Y, 0.0, sy
-    return dx, dy, AXIS_XY, sx, sy
+    return dy, 0.0, AXIS_Y, 0.0, sy
 
 
 # --- classifying a normal ---------------------------------------------------------------------
@@ -199,12 +208,12 @@ def polygon_sweep(va, na, vb, nb, qx, qy, ux, uy):
     line q + u t: (t_enter, t_exit, code, nx, ny), by Cyrus–Beck clipping against M's faces.
 
     M's faces are A's faces and B's faces turned around (separating axes). Overlap of positive
-    area exactly for t_enter < t < t_exit; the normal is that of the face the line enters by.
+    area exactly for t_enter < t < t_exit; the normal is that of the face the line enters by, or
+    of the vertex where two faces are entered within TIE_PX of travel of each other.
     """
     t_enter = -INF
     t_exit = INF
-    n1x = n1y = n2x = n2y = 0.0
-    distinct = False
+    n1x = n1y = 0.0
     for f in range(na.shape[0] + nb.shape[0]):
         nx, ny, c = _face(va, na, vb, nb, f)
         s0 = nx * qx + ny * qy - c  # signed distance of q outside this face
@@ -217,11 +226,22 @@ def polygon_sweep(va, na, vb, nb, qx, qy, ux, uy):
         if d < 0.0:
             if t > t_enter:
                 t_enter = t
-                n1x, n1y, distinct = nx, ny, False
-            elif t == t_enter and not distinct and nx * n1x + ny * n1y < SAME_DIRECTION:
-                n2x, n2y, distinct = nx, ny, True
+                n1x, n1y = nx, ny
         elif t < t_exit:
             t_exit = t
+    tie = TIE_PX / max(abs(ux), abs(uy), 1e-300)
+    if t_exit - t_enter <= tie:
+        t_exit = t_enter  # grazing: no overlap of positive length
+    # A second face entered at (nearly) the same time, in another direction: a vertex.
+    n2x = n2y = 0.0
+    distinct = False
+    for f in range(na.shape[0] + nb.shape[0]):
+        nx, ny, c = _face(va, na, vb, nb, f)
+        d = nx * ux + ny * uy
+        if d < 0.0 and nx * n1x + ny * n1y < SAME_DIRECTION:
+            if abs((nx * qx + ny * qy - c) / -d - t_enter) <= tie:
+                n2x, n2y, distinct = nx, ny, True
+                break
     code, cx, cy = _combine(n1x, n1y, n2x, n2y, distinct)
     return t_enter, t_exit, code, cx, cy
 
@@ -293,8 +313,8 @@ def rounded_sweep(core, cnorm, s, cx, cy, r, qx, qy, ux, uy):
     if h == 1:
         px, py = _vertex(core, s, cx, cy, 0)
         t1, t2 = disc_roots(px, py, r, qx, qy, ux, uy)
-        if t1 >= t2:
-            return INF, -INF, AXIS_X, 1.0, 0.0
+        if t2 - t1 <= TIE_PX / max(abs(ux), abs(uy), 1e-300):
+            return INF, -INF, AXIS_X, 1.0, 0.0  # missed, or grazed
         nx = qx + ux * t1 - px
         ny = qy + uy * t1 - py
         length = np.sqrt(nx * nx + ny * ny)
@@ -343,6 +363,8 @@ def rounded_sweep(core, cnorm, s, cx, cy, r, qx, qy, ux, uy):
         px, py = _vertex(core, s, cx, cy, corner)
         t1, t2 = disc_roots(px, py, r, qx, qy, ux, uy)
         t_exit = t2 if t1 < t2 else t_enter
+    if t_exit - t_enter <= TIE_PX / max(abs(ux), abs(uy), 1e-300):
+        t_exit = t_enter  # grazing: no overlap of positive length
     return t_enter, t_exit, code, nx, ny
 
 
@@ -472,45 +494,51 @@ def approaching(code, nx, ny, ux, uy):
 
 
 @njit(cache=True, inline="always")
-def _decide(t_enter, t_exit):
-    """The exact model's rules on a sweep: 1 = contact at t_enter (>= 0, touching now included),
-    0 = none (never, or already leaving), -1 = overlapping now: ask whether they approach."""
-    if not t_enter < t_exit or t_exit <= 0.0:
+def _decide(t_enter, t_exit, now):
+    """The exact model's rules on a sweep, at time `now` on the same clock: 1 = contact at
+    t_enter (>= now: touching now included), 0 = none (never, or already leaving), -1 =
+    overlapping now: ask whether they approach."""
+    if not t_enter < t_exit or t_exit <= now:
         return 0
-    if t_enter >= 0.0:
+    if t_enter >= now:
         return 1
     return -1
 
 
 @njit(cache=True, inline="always")
-def box_next_contact(qx, qy, ux, uy, wa, ha, wb, hb):
+def box_next_contact(qx, qy, ux, uy, wa, ha, wb, hb, now=0.0):
     """next_contact for two boxes, on scalars alone."""
     t_enter, t_exit, code, nx, ny = box_sweep(qx, qy, ux, uy, wa, ha, wb, hb)
-    rule = _decide(t_enter, t_exit)
+    rule = _decide(t_enter, t_exit, now)
     if rule == 1:
         return t_enter, code, nx, ny
     if rule == -1:
-        depth, code, nx, ny = box_penetration(qx, qy, wa, ha, wb, hb)
+        depth, code, nx, ny = box_penetration(qx + ux * now, qy + uy * now, wa, ha, wb, hb)
         if approaching(code, nx, ny, ux, uy):
-            return 0.0, code, nx, ny
+            return now, code, nx, ny
     return INF, code, nx, ny
 
 
 @njit(cache=True)
-def next_contact(qx, qy, ux, uy, ka, wa, ha, ra, va, na, kb, wb, hb, rb, vb, nb):
-    """The exact model's next contact of A and B: (t, code, nx, ny), t in seconds from now, inf
-    when none. Robust rules: touching or overlapping and approaching collide now (t = 0);
-    overlapping and separating give nothing (the line leaves M and, M being convex, never comes
-    back); a contact is never in the past.
+def next_contact(qx, qy, ux, uy, ka, wa, ha, ra, va, na, kb, wb, hb, rb, vb, nb, now=0.0):
+    """The exact model's next contact of A and B: (t, code, nx, ny), inf when none.
+
+    q is the offset at time 0 of the pair's own clock, `now` the present on that clock (s); the
+    contact time t is on the same clock, never before now. (Predicting from the time the pair was
+    last changed, rather than from now, keeps the answer free of when it is asked.) Robust
+    rules: touching or overlapping and approaching collide now; overlapping and separating give
+    nothing (the line leaves M and, M being convex, never comes back).
     """
     t_enter, t_exit, code, nx, ny = sweep(
         qx, qy, ux, uy, ka, wa, ha, ra, va, na, kb, wb, hb, rb, vb, nb
     )
-    rule = _decide(t_enter, t_exit)
+    rule = _decide(t_enter, t_exit, now)
     if rule == 1:
         return t_enter, code, nx, ny
     if rule == -1:
+        qx += ux * now
+        qy += uy * now
         depth, code, nx, ny = penetration(qx, qy, ka, wa, ha, ra, va, na, kb, wb, hb, rb, vb, nb)
         if approaching(code, nx, ny, ux, uy):
-            return 0.0, code, nx, ny
+            return now, code, nx, ny
     return INF, code, nx, ny

@@ -338,11 +338,19 @@ def _draw_one(buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, c
 
 @njit(cache=True)
 def _round_into(pos, out):
-    """out = floor(pos + 0.5) as int64, clamped to +-POSITION_LIMIT_PX (NaN to the low end)."""
+    """out = floor(pos + 0.5) as int64, clamped to +-POSITION_LIMIT_PX (NaN to the low end).
+
+    floor(x + 0.5) is taken exactly: the float sum x + 0.5 can round up (0.49999999999999994
+    + 0.5 is 1.0 in float64), so the half is compared with the fraction x - floor(x) instead,
+    which is exact for |x| < 2**52.
+    """
     lim = POSITION_LIMIT_PX
     for i in range(pos.shape[0]):
         for a in range(2):
-            v = np.floor(pos[i, a] + 0.5)
+            x = pos[i, a]
+            v = np.floor(x)
+            if x - v >= 0.5:
+                v += 1.0
             if not v >= -lim:
                 out[i, a] = -lim
             elif v > lim:

@@ -316,9 +316,10 @@ def _half_pixel(quick: bool) -> Scene:
         [70.0, 60.5],
         [below(10.5), above(80.5)],
         [below(1.5), below(50.5)],
+        [below(0.5), 90.0],
     ]
-    vel = [[4.0, 4.0], [-4.0, 12.0], [2.0, 0.0], [0.0, -6.0], [0.0, 0.0], [0.0, 0.0]]
-    static = [False, False, False, False, False, True]
+    vel = [[4.0, 4.0], [-4.0, 12.0], [2.0, 0.0], [0.0, -6.0], [0.0, 0.0], [0.0, 0.0], [0.0, 0.0]]
+    static = [False, False, False, False, False, True, False]
     return Scene(
         "half_pixel",
         "positions at and next to .5 px, moving by half pixels (rounding to pixels)",
@@ -410,7 +411,7 @@ class CaseResult:
     energy_drift: float | None = None
     momentum_drift: float | None = None
     penetration_px: float | None = None
-    run_time_s: float = 0.0
+    run_time_s: float = 0.0  # the checked run, tick by tick (not the second run)
     problems: list[str] = field(default_factory=list)
     note: str = ""
 

@@ -19,7 +19,9 @@ cells around it, and pushed only when they come no later than its horizon: at th
 predicted again anyway (a wall changes its velocity, a crossing its neighbours), and a contact
 between i and j is always pushed by whichever of the two last changed velocity or cell before it,
 since that one's horizon lies beyond it. After an event only the objects it touched are moved,
-counted and predicted again. At each tick's end every object is moved to that instant.
+counted and predicted again; a pair is swept from the later of its two clocks, so a predicted
+time depends only on the pair's state, not on when (or on which grid) it was asked. Frames
+sample each object at the tick's end from its own clock.
 
 Robust rules (contact.next_contact): touching or overlapping and approaching collide now;
 overlapping and separating make no event; nothing is scheduled in the past; a pair that has just
@@ -360,7 +362,7 @@ def _cross_time(i, F, N, world):
 
 
 @njit(cache=True)
-def _shape_contact(a, b, qx, qy, ux, uy, F, N, C):
+def _shape_contact(a, b, qx, qy, ux, uy, now, F, N, C):
     """next_contact for a pair with a circle or polygon; cores C = (radius, start, verts,
     normals)."""
     radius, start, verts, normals = C
@@ -381,29 +383,36 @@ def _shape_contact(a, b, qx, qy, ux, uy, F, N, C):
         radius[b],
         verts[start[b] : start[b + 1]],
         normals[start[b] : start[b + 1]],
+        now,
     )
 
 
 @_hot
 def _predict_pair(i, j, t_now, horizon, F, N, C, HT, HI, HN, st):
-    """Push the next contact of i and j if it comes no later than `horizon` (s)."""
+    """Push the next contact of i and j if it comes no later than `horizon` (s).
+
+    The pair is swept from the later of the two objects' clocks, so that only one position is
+    carried forward and the predicted time does not depend on when the question is asked.
+    """
     a = min(i, j)
     b = max(i, j)
-    da = t_now - F[a, TLOC]
-    db = t_now - F[b, TLOC]
-    qx = (F[b, X] + F[b, VX] * db) - (F[a, X] + F[a, VX] * da)
-    qy = (F[b, Y] + F[b, VY] * db) - (F[a, Y] + F[a, VY] * da)
+    t0 = max(F[a, TLOC], F[b, TLOC])
+    qx = (F[b, X] + F[b, VX] * (t0 - F[b, TLOC])) - (F[a, X] + F[a, VX] * (t0 - F[a, TLOC]))
+    qy = (F[b, Y] + F[b, VY] * (t0 - F[b, TLOC])) - (F[a, Y] + F[a, VY] * (t0 - F[a, TLOC]))
     ux = F[b, VX] - F[a, VX]
     uy = F[b, VY] - F[a, VY]
-    if not box_reach(qx, qy, ux, uy, F[a, SW], F[a, SH], F[b, SW], F[b, SH], horizon - t_now):
+    if not box_reach(qx, qy, ux, uy, F[a, SW], F[a, SH], F[b, SW], F[b, SH], horizon - t0):
         return
+    now = t_now - t0
     if N[a, SHAPE] == KIND_BOX and N[b, SHAPE] == KIND_BOX:
-        t, code, nx, ny = box_next_contact(qx, qy, ux, uy, F[a, SW], F[a, SH], F[b, SW], F[b, SH])
+        t, code, nx, ny = box_next_contact(
+            qx, qy, ux, uy, F[a, SW], F[a, SH], F[b, SW], F[b, SH], now
+        )
     else:
-        t, code, nx, ny = _shape_contact(a, b, qx, qy, ux, uy, F, N, C)
-    if t_now + t <= horizon:
-        key = _key(RANK_PAIR, a, b, code)
-        _push(HT, HI, HN, st, t_now + t, key, N[a, CNT], N[b, CNT], nx, ny)
+        t, code, nx, ny = _shape_contact(a, b, qx, qy, ux, uy, now, F, N, C)
+    t = max(t0 + t, t_now)
+    if t <= horizon:
+        _push(HT, HI, HN, st, t, _key(RANK_PAIR, a, b, code), N[a, CNT], N[b, CNT], nx, ny)
 
 
 @_hot
@@ -507,18 +516,6 @@ def _on_pair(a, b, code, nx, ny, t, F, N, jobs):
 
 
 @_hot
-def _sync(t, F, N, world):
-    """Move every object to time t (a tick's end), kept inside the world against rounding."""
-    for i in range(F.shape[0]):
-        if N[i, STATIC] != 0:
-            continue
-        dt = t - F[i, TLOC]
-        F[i, X] = min(max(F[i, X] + F[i, VX] * dt, 0.0), world[0] - F[i, SW])
-        F[i, Y] = min(max(F[i, Y] + F[i, VY] * dt, 0.0), world[1] - F[i, SH])
-        F[i, TLOC] = t
-
-
-@_hot
 def _log_row(rows, times, n, tick, t, kind, a, b, code):
     rows[n, 0], rows[n, 1], rows[n, 2], rows[n, 3], rows[n, 4] = tick, kind, a, b, code
     times[n] = t
@@ -566,7 +563,7 @@ def _run(
     times,
 ):
     """Run ticks until tick_to: take due events in order, apply each, predict again for the objects
-    it touched; move everything to each tick's end.
+    it touched. (Objects not touched keep their clocks; positions() moves them to the tick's end.)
 
     Returns a status: STATUS_DONE; STATUS_HEAP_FULL / STATUS_LOG_FULL (grow, call again: nothing
     was lost); STATUS_CAP (a runaway; stops mid-tick). st[_LOGGED] counts the rows written.
@@ -603,7 +600,6 @@ def _run(
                     st[_LOGGED] += 1
             for k in range(n_jobs):
                 _predict(jobs, k, t, F, N, C, cells, s_start, s_items, HT, HI, HN, st, world)
-        _sync(t_end, F, N, world)
         stf[_T_NOW] = t_end
         st[_TICK] = tick
         st[_TICK_EVENTS] = 0
@@ -724,8 +720,13 @@ class Model:
         return event_records(rows, times, int(self._st[_LOGGED]))
 
     def positions(self) -> np.ndarray:
-        """(n, 2) float64 top-left corners at the last tick's end, px."""
-        return self._F[:, X : Y + 1].copy()
+        """(n, 2) float64 top-left corners at the last tick's end, px (each object carried from
+        its own clock; kept inside the world against the last rounding)."""
+        F = self._F
+        t = self.tick / self._world[2]
+        pos = F[:, X : Y + 1] + F[:, VX : VY + 1] * (t - F[:, TLOC : TLOC + 1])
+        limit = np.array(self._world[:2]) - F[:, SW : SH + 1]
+        return np.minimum(np.maximum(pos, 0.0), limit)
 
     def velocities(self) -> np.ndarray:
         """(n, 2) float64 velocities, px/s."""

@@ -126,11 +126,6 @@ def test_exact_round_at_the_float_half_trap():
     assert stress.exact_round(np.array([[x, 2.5]])).tolist() == [[0, 3]]
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="engine/raster.py round_positions computes floor(x + 0.5) in floating point, which "
-    "rounds 0.49999999999999994 up to pixel 1 (SPEC 4: floor(x + 0.5) = 0)",
-)
 def test_raster_rounds_the_float_just_below_a_half_down():
     x = float(np.nextafter(0.5, 0.0))
     assert round_positions(np.array([[x, 0.0]])).tolist() == [[0, 0]]

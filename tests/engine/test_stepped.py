@@ -1,0 +1,266 @@
+"""The stepped model (SPEC 3.2): analytic outcomes, invariants, walls, statics, determinism."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from engine.events import AXIS_NAMES, EV_PAIR, EV_WALL, SIDE_LEFT, SIDE_RIGHT
+from engine.models import make
+from engine.world import KIND_CIRCLE, Bodies, WorldSpec, kinetic_energy, momentum
+
+
+def boxes_overlap(pos, size):
+    """Pairs whose boxes overlap with positive area."""
+    lo, hi = pos, pos + size
+    n = len(pos)
+    return [
+        (a, b)
+        for a in range(n)
+        for b in range(a + 1, n)
+        if (lo[a] < hi[b]).all() and (lo[b] < hi[a]).all()
+    ]
+
+
+def inside(model, bodies, world):
+    p = model.positions()
+    return bool((p >= 0).all() and (p + bodies.size <= [world.width, world.height]).all())
+
+
+def random_boxes(n, seed, world, size=8.0, speed=60.0, mass_range=(0.2, 5.0)):
+    """n boxes on a jittered grid (no overlap), random velocities and masses."""
+    rng = np.random.default_rng(seed)
+    k = int(np.ceil(np.sqrt(n)))
+    pitch = np.array([world.width, world.height]) / k
+    idx = np.arange(n)
+    cells = np.stack([idx % k, idx // k], axis=1)
+    pos = cells * pitch + rng.uniform(0, 1, (n, 2)) * (pitch - size)
+    vel = rng.uniform(-speed, speed, (n, 2))
+    return Bodies.boxes(pos, size, vel, mass=rng.uniform(*mass_range, n))
+
+
+def test_tunnelling_at_one_fps_passes_through_without_a_collision():
+    world = WorldSpec(320, 240, 1)
+    bodies = Bodies.boxes([[100, 115], [210, 115]], 10, [[10, 0], [-10, 0]])
+    model = make("stepped", world, bodies)
+    for _ in range(12):
+        assert len(model.advance(1)) == 0
+        assert boxes_overlap(model.positions(), bodies.size) == []
+    assert model.positions().tolist() == [[220, 115], [90, 115]]
+    assert model.tick == 12
+
+
+def test_at_ten_fps_the_same_pair_collides_and_swaps():
+    world = WorldSpec(320, 240, 10)
+    bodies = Bodies.boxes([[100, 115], [210, 115]], 10, [[10, 0], [-10, 0]])
+    model = make("stepped", world, bodies)
+    events = model.advance(60)
+    assert len(events) == 1
+    e = events[0]
+    assert (e["type"], e["a"], e["b"], AXIS_NAMES[e["code"]]) == (EV_PAIR, 0, 1, "x")
+    assert (e["tick"], e["t"], e["xdiff"]) == (51, 5.1, -1)  # first overlap at tick 51
+    assert model.velocities().tolist() == [[-10, 0], [10, 0]]
+
+
+@pytest.mark.parametrize("m1,m2", [(1.0, 1.0), (9.0, 1.0), (1.0, 3.0), (2.5, 0.5)])
+def test_head_on_unequal_masses_give_the_textbook_velocities(m1, m2):
+    world = WorldSpec(1000, 100, 20)
+    v1, v2 = 30.0, -10.0
+    bodies = Bodies.boxes([[100, 45], [300, 45]], 10, [[v1, 0], [v2, 0]], mass=[m1, m2])
+    model = make("stepped", world, bodies, substeps=4)
+    events = model.advance(200)
+    assert [(e["type"], e["a"], e["b"]) for e in events] == [(EV_PAIR, 0, 1)]
+    u1 = ((m1 - m2) * v1 + 2 * m2 * v2) / (m1 + m2)
+    u2 = ((m2 - m1) * v2 + 2 * m1 * v1) / (m1 + m2)
+    assert model.velocities()[:, 0] == pytest.approx([u1, u2], rel=1e-14, abs=1e-13)
+
+
+def test_newtons_cradle_passes_the_speed_to_the_last_box():
+    world = WorldSpec(320, 60, 10)
+    xs = [20] + [100 + 10 * k for k in range(5)]
+    bodies = Bodies.boxes([[x, 25] for x in xs], 10, [[50, 0]] + [[0, 0]] * 5)
+    model = make("stepped", world, bodies, substeps=8)
+    model.advance(25)
+    assert model.velocities()[:, 0].tolist() == [0, 0, 0, 0, 0, 50]
+
+
+@pytest.mark.parametrize("fps,substeps", [(7, 1), (10, 3), (1, 50)])
+def test_free_flight_between_walls_is_the_reflection_formula(fps, substeps):
+    world = WorldSpec(97, 61, fps)
+    x0, y0, vx, vy, w, h = 13.0, 40.0, 231.7, -83.3, 9.0, 5.0
+    bodies = Bodies.boxes([[x0, y0]], [[w, h]], [[vx, vy]])
+    model = make("stepped", world, bodies, substeps=substeps)
+    walls = 0
+    for k in range(1, 41):
+        walls += len(model.advance(1))
+        t = k / fps
+        for axis, (p0, v, span) in enumerate(((x0, vx, 97 - w), (y0, vy, 61 - h))):
+            y = (p0 + v * t) % (2 * span)
+            expected = y if y <= span else 2 * span - y
+            assert model.positions()[0, axis] == pytest.approx(expected, abs=1e-9)
+    # One wall event per fold: the number of wall lines the free coordinate crossed.
+    t = 40 / fps
+    crossings = sum(int(abs(np.floor((p0 + v * t) / span))) for p0, v, span in
+                    ((x0, vx, 97 - w), (y0, vy, 61 - h)))  # fmt: skip
+    assert walls == crossings
+
+
+def test_wall_events_name_the_side_and_reverse_the_component():
+    world = WorldSpec(100, 100, 10)
+    model = make("stepped", world, Bodies.boxes([[85, 50]], 10, [[30, 0]]))
+    events = model.advance(3)
+    assert [(e["type"], e["a"], e["b"], e["code"]) for e in events] == [
+        (EV_WALL, 0, -1, SIDE_RIGHT)
+    ]
+    assert model.velocities().tolist() == [[-30, 0]]
+    model = make("stepped", world, Bodies.boxes([[1, 50]], 10, [[-30, 0]]))
+    assert model.advance(1)["code"].tolist() == [SIDE_LEFT]
+    assert model.positions()[0, 0] == pytest.approx(2.0)
+
+
+@pytest.mark.parametrize("geometry", ["box", "exact"])
+def test_energy_and_momentum_are_kept_in_a_pair_only_scene(geometry):
+    # A crowd in the middle of a large world: many collisions, no wall reached in the run.
+    world = WorldSpec(4000, 4000, 20)
+    inner = random_boxes(36, seed=3, world=WorldSpec(120, 120, 20), speed=20.0)
+    bodies = Bodies.boxes(inner.pos + 1900, inner.size, inner.vel, mass=inner.mass)
+    model = make("stepped", world, bodies, substeps=2, geometry=geometry)
+    events = model.advance(200)
+    assert (events["type"] == EV_PAIR).sum() > 20 and (events["type"] == EV_WALL).sum() == 0
+    e0 = kinetic_energy(bodies.mass, bodies.static, bodies.vel)
+    p0 = np.array(momentum(bodies.mass, bodies.static, bodies.vel))
+    v = model.velocities()
+    assert kinetic_energy(bodies.mass, bodies.static, v) == pytest.approx(e0, rel=1e-12)
+    p1 = np.array(momentum(bodies.mass, bodies.static, v))
+    scale = float(np.sum(bodies.mass * np.abs(bodies.vel).max(axis=1)))
+    assert np.abs(p1 - p0).max() <= 1e-12 * scale
+
+
+def test_energy_is_kept_with_walls_over_a_long_run():
+    world = WorldSpec(200, 150, 30)
+    bodies = random_boxes(40, seed=5, world=world, mass_range=(0.1, 10.0))
+    model = make("stepped", world, bodies, substeps=2)
+    events = model.advance(1500)
+    assert (events["type"] == EV_PAIR).sum() > 200
+    e0 = kinetic_energy(bodies.mass, bodies.static, bodies.vel)
+    e1 = kinetic_energy(bodies.mass, bodies.static, model.velocities())
+    assert e1 == pytest.approx(e0, rel=1e-12)
+    assert inside(model, bodies, world)
+
+
+def test_a_static_object_never_moves_and_reflects_what_hits_it():
+    world = WorldSpec(200, 100, 10)
+    bodies = Bodies.boxes(
+        [[20, 45], [100, 0]], [[10, 10], [10, 100]], [[40, 0], [5, 5]], static=[False, True]
+    )
+    model = make("stepped", world, bodies, substeps=4)
+    events = model.advance(30)
+    assert [(e["a"], e["b"]) for e in events if e["type"] == EV_PAIR] == [(0, 1)]
+    assert model.positions()[1].tolist() == [100, 0]
+    assert model.velocities().tolist() == [[-40, 0], [0, 0]]
+
+
+def test_extreme_mass_ratio_keeps_everything_finite_and_conserved():
+    world = WorldSpec(3000, 100, 10)
+    mass = [1e10, 1.0]
+    bodies = Bodies.boxes([[100, 45], [400, 45]], 10, [[10, 0], [0, 0]], mass=mass)
+    model = make("stepped", world, bodies, substeps=10)
+    events = model.advance(400)
+    v = model.velocities()
+    assert np.isfinite(v).all() and np.isfinite(model.positions()).all()
+    assert [(e["a"], e["b"]) for e in events] == [(0, 1)]
+    # The light box leaves at twice the heavy one's speed (to 1e-10), the heavy one barely slows.
+    assert v[1, 0] == pytest.approx(20.0 * 1e10 / (1e10 + 1), rel=1e-14)
+    e0 = kinetic_energy(bodies.mass, bodies.static, bodies.vel)
+    assert kinetic_energy(bodies.mass, bodies.static, v) == pytest.approx(e0, rel=1e-12)
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 10_000), st.integers(2, 25), st.sampled_from([1, 5, 10]))
+def test_nothing_ever_leaves_the_world(seed, n, fps):
+    world = WorldSpec(90, 70, fps)
+    bodies = random_boxes(n, seed, world, speed=400.0)
+    model = make("stepped", world, bodies, substeps=2)
+    for _ in range(10):
+        model.advance(3)
+        assert inside(model, bodies, world)
+        assert np.isfinite(model.velocities()).all()
+
+
+def test_same_input_same_bytes_and_chunks_do_not_matter():
+    world = WorldSpec(160, 120, 10)
+    bodies = random_boxes(30, seed=9, world=world)
+    a = make("stepped", world, bodies, substeps=3)
+    b = make("stepped", world, bodies, substeps=3)
+    ev_a = a.advance(120)
+    ev_b = np.concatenate([b.advance(1) for _ in range(120)])
+    assert ev_a.tobytes() == ev_b.tobytes()
+    assert a.positions().tobytes() == b.positions().tobytes()
+    assert a.velocities().tobytes() == b.velocities().tobytes()
+    # The bodies handed in are not touched.
+    assert bodies.pos.tobytes() == random_boxes(30, seed=9, world=world).pos.tobytes()
+
+
+def test_log_off_gives_no_events_and_the_same_state():
+    world = WorldSpec(160, 120, 10)
+    bodies = random_boxes(20, seed=4, world=world)
+    a, b = make("stepped", world, bodies), make("stepped", world, bodies)
+    assert len(a.advance(50, log=False)) == 0
+    assert len(b.advance(50)) > 0
+    assert a.positions().tobytes() == b.positions().tobytes()
+
+
+def circles(pos, d, vel):
+    n = len(pos)
+    return Bodies(
+        kind=np.full(n, KIND_CIRCLE, np.int8),
+        pos=np.array(pos, float),
+        size=np.full((n, 2), float(d)),
+        vel=np.array(vel, float),
+        mass=np.ones(n),
+        static=np.zeros(n, bool),
+        color=np.ones(n, np.uint8),
+        fill=np.zeros(n, bool),
+        vert_start=np.zeros(n + 1, np.int64),
+        verts=np.zeros((0, 2), np.int64),
+    )
+
+
+def test_exact_geometry_lets_circles_pass_where_their_boxes_collide():
+    world = WorldSpec(200, 200, 10)
+    # Discs of diameter 20 pass each other diagonally, centres 22 px apart at the closest: their
+    # boxes overlap there by 4.4 px on both axes, the discs stay 2 px apart.
+    side = 22.0 / np.sqrt(2.0)
+    a_centre = np.array([50.0, 50.0])
+    b_centre = np.array([70.0 + side + 20.0, 70.0 - side + 20.0])
+    bodies = circles([a_centre - 10, b_centre - 10], 20, [[10, 10], [-10, -10]])
+    as_box = make("stepped", world, bodies, geometry="box", substeps=4)
+    exact = make("stepped", world, bodies, geometry="exact", substeps=4)
+    assert (as_box.advance(40)["type"] == EV_PAIR).sum() >= 1
+    assert (exact.advance(40)["type"] == EV_PAIR).sum() == 0
+
+
+def test_exact_geometry_circles_exchange_along_the_centre_line():
+    world = WorldSpec(400, 200, 100)
+    # Equal discs, the target offset by 0.6 diameters: the normal is (0.8, 0.6).
+    bodies = circles([[100, 100], [150, 112]], 20, [[40, 0], [0, 0]])
+    model = make("stepped", world, bodies, geometry="exact", substeps=20)
+    events = model.advance(200)
+    assert [(e["a"], e["b"], AXIS_NAMES[e["code"]]) for e in events[:1]] == [(0, 1, "n")]
+    v = model.velocities()
+    # Equal masses: the struck disc takes the normal part, the striker keeps the tangential part.
+    # The stepped normal is the centre line at the first overlapping step, at most v·dt = 0.02 px
+    # of travel past the touch: its direction is off by ~0.02/20 rad, the velocities by < 0.1.
+    n = np.array([0.8, 0.6])
+    assert v[1] == pytest.approx(40 * 0.8 * n, abs=0.1)
+    assert v[0] == pytest.approx(np.array([40.0, 0]) - 40 * 0.8 * n, abs=0.1)
+    assert np.hypot(*v[0]) ** 2 + np.hypot(*v[1]) ** 2 == pytest.approx(1600, rel=1e-12)
+
+
+def test_bad_options_are_refused():
+    world = WorldSpec(10, 10, 1)
+    bodies = Bodies.boxes([[0, 0]], 1, [[0, 0]])
+    with pytest.raises(ValueError, match="substeps"):
+        make("stepped", world, bodies, substeps=0)
+    with pytest.raises(ValueError, match="geometry"):
+        make("stepped", world, bodies, geometry="round")
