@@ -98,12 +98,13 @@ def _record(ev, n_ev, tick, kind, a, b, code, xdiff, ydiff):
 
 
 @njit(cache=True, inline="always")
-def _move(pos, step, period, count, disp, anchor):
+def _move(pos, step, period, count, disp, anchor, size, limit):
     """Counters rise by one; a component whose counter reaches its period moves by its step.
 
-    Returns how far (px, largest over objects and axes) anything now is from `anchor`.
+    Returns (how far, px, anything now is from `anchor` at most; whether any box left the world).
     """
     drift = 0
+    left = False
     for i in range(pos.shape[0]):
         for ax in range(2):
             c = count[i, ax] + 1
@@ -114,7 +115,8 @@ def _move(pos, step, period, count, disp, anchor):
             pos[i, ax] = p
             disp[i, ax] = d
             drift = max(drift, abs(p - anchor[i, ax]))
-    return drift
+            left |= (p < 0) | (p + size[i, ax] > limit[ax])
+    return drift, left
 
 
 @njit(cache=True, inline="always")
@@ -262,11 +264,12 @@ def _run(pos, size, step, period, count, movable, limit, tick0, nticks, log, can
     for k in range(nticks):
         tick = tick0 + k + 1
         # move: counters fire, this tick's displacement is kept to be taken back
-        drift = _move(pos, step, period, count, disp, anchor)
+        drift, left = _move(pos, step, period, count, disp, anchor, size, limit)
         # walls: reverse and take back what left the world moving outward
-        if log and n_ev + 2 * n > ev.shape[0]:
-            ev = _grow(ev, n_ev + 2 * n)
-        n_ev = _walls(pos, size, step, disp, limit, tick, log, ev, n_ev)
+        if left:
+            if log and n_ev + 2 * n > ev.shape[0]:
+                ev = _grow(ev, n_ev + 2 * n)
+            n_ev = _walls(pos, size, step, disp, limit, tick, log, ev, n_ev)
         # pairs: the candidate list (made anew once anything drifted a margin from where it
         # was made; drift is measured before the walls take steps back, which only errs early),
         # then the flip rule on every overlapping pair in (a, b) order
