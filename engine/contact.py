@@ -42,11 +42,11 @@ TIE_PX = 1e-9
 def _slab(q, u, lo, hi):
     """Times (t0, t1) while lo <= q + u t <= hi; interior strictly between them.
 
-    For u == 0: (-inf, inf) when lo < q < hi strictly, else (inf, -inf): resting exactly on the
-    boundary never gives an overlap of positive length.
+    For u == 0: (-inf, inf) when lo < q < hi by more than TIE_PX, else (inf, -inf): sliding
+    along the boundary never gives an overlap of positive length.
     """
     if u == 0.0:
-        if lo < q < hi:
+        if lo + TIE_PX < q < hi - TIE_PX:
             return -INF, INF
         return INF, -INF
     t0 = (lo - q) / u
@@ -219,7 +219,7 @@ def polygon_sweep(va, na, vb, nb, qx, qy, ux, uy):
         s0 = nx * qx + ny * qy - c  # signed distance of q outside this face
         d = nx * ux + ny * uy
         if d == 0.0:
-            if s0 >= 0.0:
+            if s0 >= -TIE_PX:  # outside, or sliding along this face
                 return INF, -INF, AXIS_X, 1.0, 0.0
             continue
         t = -s0 / d
@@ -331,7 +331,7 @@ def rounded_sweep(core, cnorm, s, cx, cy, r, qx, qy, ux, uy):
         s0 = nx * (qx - vx) + ny * (qy - vy) - r
         d = nx * ux + ny * uy
         if d == 0.0:
-            if s0 >= 0.0:
+            if s0 >= -TIE_PX:  # outside, or sliding along this face
                 return INF, -INF, AXIS_X, 1.0, 0.0
             continue
         t = -s0 / d

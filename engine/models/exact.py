@@ -93,6 +93,13 @@ DIR_LEFT, DIR_RIGHT, DIR_UP, DIR_DOWN = range(4)
 _HEAP_N, _TICK, _TICK_EVENTS, _STAMP, _LOGGED = range(5)
 _T_NOW = 0
 
+# Events closer in time than max(INSTANT_S, INSTANT_REL·t) are one instant: what parts them is
+# rounding (a few units in the last place of t, or of a pixel coordinate over a speed), not
+# physics, so they go in key order. At most INSTANT_STACK entries of one instant are compared.
+INSTANT_S = 1e-12
+INSTANT_REL = 2.0**-46
+INSTANT_STACK = 1024
+
 STATUS_DONE = 0
 STATUS_CAP = 1
 STATUS_HEAP_FULL = 2
@@ -207,6 +214,53 @@ def _pop(HT, HI, HN, st):
     if n > 0:
         _sift_down(HT, HI, HN, n, 0, HT[n], HI[n, HKEY], HI[n, HCA], HI[n, HCB], HN[n, 0], HN[n, 1])
     return top
+
+
+@_hot
+def _remove(HT, HI, HN, st, k):
+    """Remove and return entry k (t, key, ca, cb, nx, ny); the last entry takes its place."""
+    entry = (HT[k], HI[k, HKEY], HI[k, HCA], HI[k, HCB], HN[k, 0], HN[k, 1])
+    n = st[_HEAP_N] - 1
+    st[_HEAP_N] = n
+    if k < n:
+        t, key, ca, cb, nx, ny = HT[n], HI[n, HKEY], HI[n, HCA], HI[n, HCB], HN[n, 0], HN[n, 1]
+        if k > 0 and not _earlier(HT, HI, (k - 1) // ARITY, t, key):
+            _sift_up(HT, HI, HN, k, t, key, ca, cb, nx, ny)
+        else:
+            _sift_down(HT, HI, HN, n, k, t, key, ca, cb, nx, ny)
+    return entry
+
+
+@_hot
+def _instant(t):
+    """Events closer to t than this (s) happen at one instant: rounding, not physics, parts them."""
+    return max(INSTANT_S, abs(t) * INSTANT_REL)
+
+
+@_hot
+def _first_of_instant(HT, HI, st, N, stack):
+    """The entry to take next: of the valid entries at the top's instant, the one with the
+    smallest key, so that simultaneous events go walls first, then pairs in (a, b) order,
+    whatever rounding did to their times. Those entries are the heap's top subtree of times
+    within the instant; `stack` is scratch for walking it."""
+    n = st[_HEAP_N]
+    bound = HT[0] + _instant(HT[0])
+    best = 0
+    sp = 0
+    for c in range(1, min(1 + ARITY, n)):
+        if HT[c] <= bound:
+            stack[sp] = c
+            sp += 1
+    while sp > 0:
+        sp -= 1
+        k = stack[sp]
+        if HI[k, HKEY] < HI[best, HKEY] and _valid(HI, k, N):
+            best = k
+        for c in range(ARITY * k + 1, min(ARITY * k + 1 + ARITY, n)):
+            if HT[c] <= bound and sp < stack.shape[0]:
+                stack[sp] = c
+                sp += 1
+    return best
 
 
 @njit(cache=True)
@@ -544,6 +598,7 @@ def _predict_all(jobs, first, F, N, C, cells, s_start, s_items, HT, HI, HN, st, 
 @_kernel
 def _run(
     jobs,
+    stack,
     tick_to,
     log,
     cap,
@@ -571,17 +626,20 @@ def _run(
     while st[_TICK] < tick_to:
         tick = st[_TICK] + 1
         t_end = tick / world[2]
-        while st[_HEAP_N] > 0 and HT[0] <= t_end:
+        while st[_HEAP_N] > 0 and HT[0] <= t_end + _instant(t_end):  # t = k/fps is tick k's
             if not _valid(HI, 0, N):
                 _pop(HT, HI, HN, st)
                 continue
-            rank, a, b, code = _unkey(HI[0, HKEY])
+            k = _first_of_instant(HT, HI, st, N, stack)
+            rank, a, b, code = _unkey(HI[k, HKEY])
             room = _room_needed(rank, a, b, HT, st, N, cells, s_start, world)
-            if not _has_room(room, HT, HI, HN, st, N):
-                return STATUS_HEAP_FULL
+            if HT.shape[0] - st[_HEAP_N] < room:
+                if _compact(HT, HI, HN, st, N) < room:
+                    return STATUS_HEAP_FULL
+                continue  # the entries moved: pick again
             if log and st[_LOGGED] == rows.shape[0]:
                 return STATUS_LOG_FULL
-            t, key, ca, cb, nx, ny = _pop(HT, HI, HN, st)
+            t, key, ca, cb, nx, ny = _remove(HT, HI, HN, st, k)
             stf[_T_NOW] = t
             if rank == RANK_CROSS:
                 n_jobs = _on_cross(a, b, N, cells, world, jobs)
@@ -664,6 +722,7 @@ class Model:
         self._st = np.zeros(5, np.int64)
         self._stf = np.zeros(1)
         self._jobs = np.zeros((2, 3), np.int64)  # scratch: the prediction jobs of one event
+        self._stack = np.zeros(INSTANT_STACK, np.int64)  # scratch: walking one instant's entries
         first = 0
         while first < n:
             first = _predict_all(self._jobs, first, *self._state())
@@ -685,6 +744,7 @@ class Model:
             F, N, C, cells, s_start, s_items, HT, HI, HN, st, world = self._state()
             status = _run(
                 self._jobs,
+                self._stack,
                 target,
                 bool(log),
                 self.max_events_per_tick,
