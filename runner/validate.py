@@ -20,7 +20,8 @@ from runner.options import (
     limits_from_args,
     overrides_from_args,
 )
-from runner.scenario import ScenarioError, json_schema, load
+from runner.scenario import ScenarioError, load
+from runner.schema import json_schema
 
 EXIT_OK = 0
 EXIT_BAD_INPUT = 2

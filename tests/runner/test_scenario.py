@@ -20,11 +20,11 @@ from runner.scenario import (
     TOP_KEYS,
     Limits,
     ScenarioError,
-    json_schema,
     load,
     loads,
     polygon_problem,
 )
+from runner.schema import json_schema
 
 DATA = Path(__file__).parent / "data"
 BASE = "version: 1\nworld: {width: 100, height: 80, fps: 10}\n"
