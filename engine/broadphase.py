@@ -1,16 +1,28 @@
 """Broad phase: which pairs could touch, so that exact tests run only on near neighbours.
 
-Two tools, nothing else:
+Input everywhere: boxes as corners `lo`, `hi` (n, 2) px (each box is [lo, hi) on both axes) and
+which objects can move. Output: candidate pairs (a, b), a < b, as keys `a << KEY_SHIFT | b`
+(int64), the pairs whose boxes overlap with positive area and that hold at least one movable
+object: two static objects never become a pair (SPEC 3: static objects never move).
 
-- `sweep_pairs` (the stepped model): sort-and-sweep on x over the objects' boxes. Input: box
-  corners `lo`, `hi` (n, 2) px and which objects are static. Output: the (k, 2) int64 pairs
-  (a, b), a < b, whose boxes overlap with positive area, in ascending (a, b) order, static–static
-  pairs left out. The same answer as testing every pair, at O(n log n + k).
-- a uniform grid (the exact model): square cells of side `cell` px over the world, each moving
-  object filed by the cell of its box's centre. With the cell at least the largest moving box
-  (plus a margin), two moving objects that touch are in the same or adjacent cells, so an object
-  predicts contacts only against the 3×3 cells around its own. Static objects never move; each is
-  filed in every cell its closed box meets (`static_cells`), so a mover finds it the same way.
+- `sweep_candidates` sorts the boxes on x (an order kept from call to call and mended by
+  insertion sort, since objects move little between calls) and sweeps: cheap when few boxes share
+  an x interval (small scenes, narrow worlds).
+- `grid_candidates` files every box in each cell of a uniform grid that the box meets and tests
+  the pairs inside each cell; a pair is reported only in the cell that holds the lower corner of
+  the two boxes' intersection, so each pair comes once without a set to deduplicate. Its cost
+  grows with n, not with how many boxes share an x interval (large worlds).
+- `choose` picks one of the two and the grid's cell from the scene (object count, world size,
+  box sizes); `sweep_pairs` and `grid_pairs` give the answer as sorted (k, 2) pairs.
+- the exact model's grid: square cells of side `cell` px over the world, each moving object filed
+  by the cell of its box's centre. With the cell at least the largest moving box (plus a margin),
+  two moving objects that touch are in the same or adjacent cells, so an object predicts contacts
+  only against the 3×3 cells around its own. Static objects never move; each is filed in every
+  cell its closed box meets (`static_cells`), so a mover finds it the same way.
+
+The candidate finders write into a caller's key buffer and return how many keys there are; when
+that is more than the buffer holds, only the first keys were written and the caller grows the
+buffer and asks again. Keys come in no particular order: the models sort the few they keep.
 """
 
 from __future__ import annotations
@@ -19,6 +31,31 @@ import math
 
 import numpy as np
 from numba import njit
+
+# A candidate pair (a, b) is one sortable int64 key, a << KEY_SHIFT | b (ids below 2**31).
+KEY_SHIFT = 32
+KEY_MASK = (1 << KEY_SHIFT) - 1
+
+METHOD_SWEEP = 0
+METHOD_GRID = 1
+METHOD_CELLS = 2
+# The sweep is chosen while a box shares its x interval with at most this many others on average
+# (expected); past that the grid, whose cost does not grow with crowding along x, is cheaper.
+# Tuned on the standard scene of `collide2d bench` (boxes 10x10 px, 5 % of a 4:3 world).
+SWEEP_MAX_X_NEIGHBOURS = 6.0
+# Boxes of similar sizes (the largest side at most this many times the median side) are filed
+# once each in a grid whose cell is the largest side (`cell_candidates`); mixed sizes are filed in
+# every cell they meet, on cells GRID_CELL_PER_SIDE x the median side (`grid_candidates`).
+CELLS_MAX_SIDE_RATIO = 2.0
+GRID_CELL_PER_SIDE = 1.5
+# Bounds that keep the grid's memory and work linear in n: at most this many cells per object,
+# and at most this many cell filings per object on average (large boxes meet many cells; the cell
+# grows until the filings fit).
+GRID_CELLS_PER_OBJECT = 4.0
+GRID_FILINGS_PER_OBJECT = 16.0
+# An insertion sort that has to shift more than this many places per object falls back to a full
+# sort (a scene that reshuffled, e.g. objects crossing the world in one step).
+SHIFTS_PER_OBJECT = 8
 
 # The grid's cell is this much larger than the largest moving box, so that rounding at a cell
 # crossing (~1e-12 px) can never hide a touching neighbour two cells away.
@@ -30,6 +67,350 @@ TARGET_PER_CELL = 0.6
 MAX_CELLS_PER_OBJECT = 4
 
 
+# --- candidate pairs ---------------------------------------------------------------------------
+
+
+@njit(cache=True, inline="always")
+def _key(i, j):
+    return (min(i, j) << KEY_SHIFT) | max(i, j)
+
+
+@njit(cache=True)
+def sort_order(order, key, sorted_key):
+    """Mend `order` so key[order] ascends, and set sorted_key = key[order].
+
+    order (n,) int64, the order of an earlier call (nearly sorted: objects move a little between
+    calls) is mended by insertion sort, or replaced by a full sort when it is far off.
+    """
+    n = order.shape[0]
+    for s in range(n):
+        sorted_key[s] = key[order[s]]
+    budget = SHIFTS_PER_OBJECT * n + 16
+    shifts = 0
+    for i in range(1, n):
+        cur = order[i]
+        k = sorted_key[i]
+        j = i - 1
+        while j >= 0 and sorted_key[j] > k:
+            order[j + 1] = order[j]
+            sorted_key[j + 1] = sorted_key[j]
+            j -= 1
+        shifts += i - 1 - j
+        order[j + 1] = cur
+        sorted_key[j + 1] = k
+        if shifts > budget:
+            order[:] = np.argsort(key, kind="mergesort")
+            for s in range(n):
+                sorted_key[s] = key[order[s]]
+            return
+
+
+@njit(cache=True)
+def sweep_candidates(lo, hi, movable, order, out):
+    """Candidate keys by sort-and-sweep on x; returns how many (see the module docstring).
+
+    lo, hi (n, 2) px; movable (n,) bool; order (n,) int64 kept between calls (any permutation to
+    start with); out (m,) int64 receives the keys.
+    """
+    n = lo.shape[0]
+    sorted_lo = np.empty(n, lo.dtype)
+    sort_order(order, np.ascontiguousarray(lo[:, 0]), sorted_lo)
+    k = 0
+    m = out.shape[0]
+    for s in range(n):
+        a = order[s]
+        hax = hi[a, 0]
+        lay = lo[a, 1]
+        hay = hi[a, 1]
+        ma = movable[a]
+        for t in range(s + 1, n):
+            if sorted_lo[t] >= hax:
+                break
+            b = order[t]
+            # branch-free: write the key, keep it only when the y intervals meet too
+            meet = (lo[b, 1] < hay) & (lay < hi[b, 1]) & (ma | movable[b]) & (lo[a, 0] < hi[b, 0])
+            if k < m:
+                out[k] = _key(a, b)
+            k += meet
+    return k
+
+
+@njit(cache=True)
+def _cell_of(x, x0, inv, last):
+    """The grid column (or row) of coordinate x: floor((x - x0) / cell), at most `last`.
+
+    Monotone in x, so the cell of max(x1, x2) is the max of their cells."""
+    return min(int((x - x0) * inv), last)
+
+
+@njit(cache=True)
+def grid_candidates(lo, hi, movable, cell, out):
+    """Candidate keys from a uniform grid of square cells of side `cell` px; returns how many.
+
+    lo, hi (n, 2) px; movable (n,) bool; out (m,) int64 receives the keys. The grid starts at the
+    boxes' lowest corner; when it would have more than GRID_CELLS_PER_OBJECT cells per object the
+    cell grows to fit (any cell gives the same pairs, only the cost changes).
+    """
+    n = lo.shape[0]
+    if n < 2:
+        return 0
+    x0 = lo[0, 0]
+    y0 = lo[0, 1]
+    x1 = hi[0, 0]
+    y1 = hi[0, 1]
+    for i in range(1, n):
+        x0 = min(x0, lo[i, 0])
+        y0 = min(y0, lo[i, 1])
+        x1 = max(x1, hi[i, 0])
+        y1 = max(y1, hi[i, 1])
+    span_x = max(float(x1 - x0), 1e-300)
+    span_y = max(float(y1 - y0), 1e-300)
+    cell = max(float(cell), math.sqrt(span_x * span_y / (GRID_CELLS_PER_OBJECT * n)))
+    # each object's cell range [cx0, cx1] x [cy0, cy1]; the cell doubles while large boxes would
+    # make more than GRID_FILINGS_PER_OBJECT filings per object
+    span = np.empty((n, 4), np.int64)
+    while True:
+        nx = min(int(span_x / cell) + 1, 4 * n + 1)
+        ny = min(int(span_y / cell) + 1, 4 * n + 1)
+        inv = 1.0 / cell
+        total = 0
+        for i in range(n):
+            span[i, 0] = _cell_of(lo[i, 0], x0, inv, nx - 1)
+            span[i, 1] = _cell_of(hi[i, 0], x0, inv, nx - 1)
+            span[i, 2] = _cell_of(lo[i, 1], y0, inv, ny - 1)
+            span[i, 3] = _cell_of(hi[i, 1], y0, inv, ny - 1)
+            total += (span[i, 1] - span[i, 0] + 1) * (span[i, 3] - span[i, 2] + 1)
+        if total <= GRID_FILINGS_PER_OBJECT * n:
+            break
+        cell *= 2.0
+    # how many filings each cell gets
+    start = np.zeros(nx * ny + 1, np.int64)
+    for i in range(n):
+        for cy in range(span[i, 2], span[i, 3] + 1):
+            for cx in range(span[i, 0], span[i, 1] + 1):
+                start[cy * nx + cx + 1] += 1
+    for c in range(nx * ny):
+        start[c + 1] += start[c]
+    # the filings, cell by cell in id order, each with a copy of its box for local reads
+    f_id = np.empty(total, np.int64)
+    f_box = np.empty((total, 4), lo.dtype)
+    fill = start[:-1].copy()
+    for i in range(n):
+        for cy in range(span[i, 2], span[i, 3] + 1):
+            for cx in range(span[i, 0], span[i, 1] + 1):
+                c = cy * nx + cx
+                f = fill[c]
+                fill[c] = f + 1
+                f_id[f] = i
+                f_box[f, 0] = lo[i, 0]
+                f_box[f, 1] = lo[i, 1]
+                f_box[f, 2] = hi[i, 0]
+                f_box[f, 3] = hi[i, 1]
+    k = 0
+    m = out.shape[0]
+    for c in range(nx * ny):
+        cx = c % nx
+        cy = c // nx
+        for p in range(start[c], start[c + 1]):
+            a = f_id[p]
+            for q in range(p + 1, start[c + 1]):
+                b = f_id[q]
+                if not (
+                    (f_box[q, 0] < f_box[p, 2])
+                    & (f_box[p, 0] < f_box[q, 2])
+                    & (f_box[q, 1] < f_box[p, 3])
+                    & (f_box[p, 1] < f_box[q, 3])
+                ):
+                    continue
+                # report only in the cell of the intersection's lower corner
+                if max(span[a, 0], span[b, 0]) != cx or max(span[a, 2], span[b, 2]) != cy:
+                    continue
+                if movable[a] | movable[b]:
+                    if k < m:
+                        out[k] = (a << KEY_SHIFT) | b
+                    k += 1
+    return k
+
+
+@njit(cache=True)
+def cell_candidates(lo, hi, movable, cell, order, out):
+    """Candidate keys from a grid whose cell is at least every box's side; returns how many.
+
+    Each box is filed once, by the cell of its lower corner; two overlapping boxes then sit in the
+    same or neighbouring cells, and each box is tested against the later boxes of its own cell and
+    the boxes of four of its eight neighbours (the other four test it), so each pair comes once.
+    lo, hi (n, 2) px; movable (n,) bool; cell px (grown to CELL_MARGIN x the largest side when
+    smaller, and until the grid has at most GRID_CELLS_PER_OBJECT cells per object); out (m,)
+    int64 receives the keys; order (n,) int64 receives the objects sorted by cell (row by row),
+    in id order within a cell.
+    """
+    n = lo.shape[0]
+    if n < 2:
+        for i in range(n):
+            order[i] = i
+        return 0
+    x0 = lo[0, 0]
+    y0 = lo[0, 1]
+    x1 = hi[0, 0]
+    y1 = hi[0, 1]
+    side = 0.0
+    for i in range(n):
+        x0 = min(x0, lo[i, 0])
+        y0 = min(y0, lo[i, 1])
+        x1 = max(x1, hi[i, 0])
+        y1 = max(y1, hi[i, 1])
+        side = max(side, float(hi[i, 0] - lo[i, 0]), float(hi[i, 1] - lo[i, 1]))
+    span_x = float(x1 - x0)
+    span_y = float(y1 - y0)
+    cell = max(float(cell), side * CELL_MARGIN, 1e-300)
+    cell = max(cell, math.sqrt(span_x * span_y / (GRID_CELLS_PER_OBJECT * n)))
+    while (span_x / cell + 1.0) * (span_y / cell + 1.0) > 4.0 * GRID_CELLS_PER_OBJECT * n + 4:
+        cell *= 2.0  # a long thin spread of boxes
+    nx = int(span_x / cell) + 1
+    ny = int(span_y / cell) + 1
+    inv = 1.0 / cell
+    # counting sort by cell: cell c holds slots [start[c + 1], start[c + 2]) once the scatter
+    # below has moved each cell's end back to its start
+    key = np.empty(n, np.int64)
+    start = np.zeros(nx * ny + 2, np.int64)
+    for i in range(n):
+        c = _cell_of(lo[i, 1], y0, inv, ny - 1) * nx + _cell_of(lo[i, 0], x0, inv, nx - 1)
+        key[i] = c
+        start[c + 1] += 1
+    for c in range(nx * ny):
+        start[c + 1] += start[c]
+    start[nx * ny + 1] = n
+    box = np.empty((n, 4), lo.dtype)
+    for i in range(n - 1, -1, -1):
+        c = key[i]
+        slot = start[c + 1] - 1
+        start[c + 1] = slot
+        order[slot] = i
+        box[slot, 0] = lo[i, 0]
+        box[slot, 1] = lo[i, 1]
+        box[slot, 2] = hi[i, 0]
+        box[slot, 3] = hi[i, 1]
+    k = 0
+    m = out.shape[0]
+    for s in range(n):
+        a = order[s]
+        c = key[a]
+        cx = c % nx
+        cy = c // nx
+        ma = movable[a]
+        lax, lay, hax, hay = box[s, 0], box[s, 1], box[s, 2], box[s, 3]
+        for nb in range(5):
+            if nb == 0:  # the later boxes of its own cell
+                first, last = s + 1, start[c + 2]
+            else:  # (+1, 0), (-1, +1), (0, +1), (+1, +1)
+                gx = cx + (1 if nb == 1 or nb == 4 else (-1 if nb == 2 else 0))
+                gy = cy + (0 if nb == 1 else 1)
+                if gx < 0 or gx >= nx or gy >= ny:
+                    continue
+                g = gy * nx + gx
+                first, last = start[g + 1], start[g + 2]
+            for t in range(first, last):
+                b = order[t]
+                # branch-free: write the key, keep it only when the boxes overlap
+                meet = (
+                    (box[t, 0] < hax)
+                    & (lax < box[t, 2])
+                    & (box[t, 1] < hay)
+                    & (lay < box[t, 3])
+                    & (ma | movable[b])
+                )
+                if k < m:
+                    out[k] = _key(a, b)
+                k += meet
+    return k
+
+
+def choose(width: float, height: float, size: np.ndarray) -> tuple[int, float]:
+    """(method, cell px) for boxes of these sizes (n, 2) px in a width x height world, px.
+
+    The sweep while a box shares its x interval with at most SWEEP_MAX_X_NEIGHBOURS others on
+    average. Else a grid: boxes of similar sizes on cells of the largest side (METHOD_CELLS),
+    mixed sizes on cells GRID_CELL_PER_SIDE x the median side, doubled while the boxes would make
+    more than GRID_FILINGS_PER_OBJECT filings per object (METHOD_GRID).
+    """
+    size = np.asarray(size, np.float64).reshape(-1, 2)
+    n = size.shape[0]
+    if n < 2:
+        return METHOD_SWEEP, 1.0
+    neighbours = (n - 1) * 2.0 * float(size[:, 0].mean()) / max(float(width), 1.0)
+    if not neighbours > SWEEP_MAX_X_NEIGHBOURS:
+        return METHOD_SWEEP, 1.0
+    sides = size.max(axis=1)
+    median, largest = float(np.median(sides)), float(sides.max())
+    if largest <= CELLS_MAX_SIDE_RATIO * median:
+        return METHOD_CELLS, largest * CELL_MARGIN
+    cell = max(GRID_CELL_PER_SIDE * median, 1e-6)
+    while np.sum((np.floor(size / cell) + 2).prod(axis=1)) > GRID_FILINGS_PER_OBJECT * n:
+        cell *= 2.0
+    return METHOD_GRID, cell
+
+
+@njit(cache=True)
+def candidates(method, lo, hi, movable, cell, order, out):
+    """Candidate keys by `method` (`order` is the order kept by the sweep and the cells, `cell`
+    the grid's cell, px); returns how many, as each finder does."""
+    if method == METHOD_GRID:
+        return grid_candidates(lo, hi, movable, cell, out)
+    if method == METHOD_CELLS:
+        return cell_candidates(lo, hi, movable, cell, order, out)
+    return sweep_candidates(lo, hi, movable, order, out)
+
+
+def keys_to_pairs(keys: np.ndarray) -> np.ndarray:
+    """(k, 2) int64 pairs (a, b) in ascending order from candidate keys."""
+    keys = np.sort(np.asarray(keys, np.int64))
+    return np.stack([keys >> KEY_SHIFT, keys & KEY_MASK], axis=1)
+
+
+def grid_pairs(lo: np.ndarray, hi: np.ndarray, movable: np.ndarray, cell: float) -> np.ndarray:
+    """Pairs of boxes that overlap with positive area, at least one movable, found on a grid of
+    `cell` px: (k, 2) int64 in ascending (a, b), a < b. lo, hi (n, 2) px; movable (n,) bool."""
+    lo = np.ascontiguousarray(lo)
+    hi = np.ascontiguousarray(hi, dtype=lo.dtype)
+    movable = np.ascontiguousarray(movable, bool)
+    out = np.empty(max(16, lo.shape[0]), np.int64)
+    k = grid_candidates(lo, hi, movable, float(cell), out)
+    if k > out.shape[0]:
+        out = np.empty(k, np.int64)
+        k = grid_candidates(lo, hi, movable, float(cell), out)
+    return keys_to_pairs(out[:k])
+
+
+# --- the stepped model's reference answer and the exact model's grid ----------------------------
+
+
+@njit(cache=True)
+def heap_argsort(keys):
+    """Indices that sort the 1-D `keys` ascending (heapsort: O(n log n), compiles quickly)."""
+    n = keys.shape[0]
+    idx = np.arange(n)
+    for start in range(n // 2 - 1, -1, -1):
+        _sift(keys, idx, start, n)
+    for end in range(n - 1, 0, -1):
+        idx[0], idx[end] = idx[end], idx[0]
+        _sift(keys, idx, 0, end)
+    return idx
+
+
+@njit(cache=True)
+def _sift(keys, idx, root, n):
+    while True:
+        c = 2 * root + 1
+        if c >= n:
+            return
+        if c + 1 < n and keys[idx[c + 1]] > keys[idx[c]]:
+            c += 1
+        if keys[idx[root]] >= keys[idx[c]]:
+            return
+        idx[root], idx[c] = idx[c], idx[root]
+        root = c
+
+
 @njit(cache=True)
 def sweep_pairs(lo, hi, static):
     """Pairs of boxes that overlap with positive area, (k, 2) int64 in ascending (a, b), a < b.
@@ -38,7 +419,7 @@ def sweep_pairs(lo, hi, static):
     static objects are left out.
     """
     n = lo.shape[0]
-    order = np.argsort(lo[:, 0], kind="mergesort")
+    order = heap_argsort(lo[:, 0].copy())
     keys = np.empty(max(16, 2 * n), np.int64)
     k = 0
     for ii in range(n):
@@ -59,11 +440,12 @@ def sweep_pairs(lo, hi, static):
                     b = max(i, j)
                     keys[k] = a * n + b
                     k += 1
-    keys = np.sort(keys[:k])
+    keys = keys[:k]
+    sorted_keys = heap_argsort(keys)
     out = np.empty((k, 2), np.int64)
     for m in range(k):
-        out[m, 0] = keys[m] // n
-        out[m, 1] = keys[m] % n
+        out[m, 0] = keys[sorted_keys[m]] // n
+        out[m, 1] = keys[sorted_keys[m]] % n
     return out
 
 

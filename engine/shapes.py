@@ -63,10 +63,15 @@ def pixel_hull(verts):
         for c in range(4):
             pts[4 * i + c, 0] = verts[i, 0] + _PIXEL_CORNERS[c, 0]
             pts[4 * i + c, 1] = verts[i, 1] + _PIXEL_CORNERS[c, 1]
-    ymin = pts[:, 1].min()
-    yspan = pts[:, 1].max() - ymin + 1
-    order = np.argsort((pts[:, 0] - pts[:, 0].min()) * yspan + (pts[:, 1] - ymin), kind="mergesort")
-    p = pts[order]
+    # Sort by x, then y (insertion sort: few points, and it compiles quickly).
+    p = pts
+    for i in range(1, p.shape[0]):
+        x, y = p[i, 0], p[i, 1]
+        j = i - 1
+        while j >= 0 and (p[j, 0] > x or (p[j, 0] == x and p[j, 1] > y)):
+            p[j + 1, 0], p[j + 1, 1] = p[j, 0], p[j, 1]
+            j -= 1
+        p[j + 1, 0], p[j + 1, 1] = x, y
     # Andrew's monotone chain; popping on cross <= 0 drops collinear and repeated points.
     hull = np.empty((2 * p.shape[0] + 1, 2), np.int64)
     h = 0

@@ -33,7 +33,7 @@ never a hang.
 
 State is packed in few arrays, floats F (n, 8) and ints N (n, 7), columns named below; the heap
 is HT (time), HI (key, counters) and HN (contact normal). The small helpers are inlined into two
-kernels, `_predict_all` and `_run`, which allocate nothing: growing the heap or the event log is
+kernels, `_predict` and `_run`, which allocate nothing: growing the heap or the event log is
 done in Python between calls (the kernel stops before an event it has no room for, and resumes).
 """
 
@@ -89,8 +89,9 @@ MAX_OBJECTS = 1 << _ID_BITS
 DIR_LEFT, DIR_RIGHT, DIR_UP, DIR_DOWN = range(4)
 
 # Scalar state st (int64): heap size, ticks done, events in the current tick, query stamp, event
-# rows written in this `advance`. stf (float64): the current time, s.
-_HEAP_N, _TICK, _TICK_EVENTS, _STAMP, _LOGGED = range(5)
+# rows written in this `advance`, objects given their first prediction. stf (float64): the current
+# time, s.
+_HEAP_N, _TICK, _TICK_EVENTS, _STAMP, _LOGGED, _FIRST = range(6)
 _T_NOW = 0
 
 # Events closer in time than max(INSTANT_S, INSTANT_REL·t) are one instant: what parts them is
@@ -469,7 +470,7 @@ def _predict_pair(i, j, t_now, horizon, F, N, C, HT, HI, HN, st):
         _push(HT, HI, HN, st, t, _key(RANK_PAIR, a, b, code), N[a, CNT], N[b, CNT], nx, ny)
 
 
-@_hot
+@_kernel
 def _predict(jobs, k, t_now, F, N, C, cells, s_start, s_items, HT, HI, HN, st, world):
     """Run prediction job k for object i: push its horizon (the first of its next wall contact
     and its next cell crossing) and its contacts with the objects in the 3×3 cells around it
@@ -579,23 +580,6 @@ def _log_row(rows, times, n, tick, t, kind, a, b, code):
 
 
 @_kernel
-def _predict_all(jobs, first, F, N, C, cells, s_start, s_items, HT, HI, HN, st, world):
-    """Initial predictions at time 0 for moving objects first, first+1, ..., each pair once.
-
-    Returns the object to resume from when the heap is full (n when done).
-    """
-    for i in range(first, F.shape[0]):
-        if N[i, STATIC] != 0:
-            continue
-        room = _room_around(N[i, CELL] % world[4], N[i, CELL] // world[4], N, cells, s_start, world)
-        if not _has_room(room, HT, HI, HN, st, N):
-            return i
-        _job(jobs, 0, i, -1, 1)
-        _predict(jobs, 0, 0.0, F, N, C, cells, s_start, s_items, HT, HI, HN, st, world)
-    return F.shape[0]
-
-
-@_kernel
 def _run(
     jobs,
     stack,
@@ -617,12 +601,27 @@ def _run(
     rows,
     times,
 ):
-    """Run ticks until tick_to: take due events in order, apply each, predict again for the objects
-    it touched. (Objects not touched keep their clocks; positions() moves them to the tick's end.)
+    """Run ticks until tick_to: first (once) predict every object's first events; then take due
+    events in order, apply each, predict again for the objects it touched. (Objects not touched
+    keep their clocks; positions() moves them to the tick's end.)
 
     Returns a status: STATUS_DONE; STATUS_HEAP_FULL / STATUS_LOG_FULL (grow, call again: nothing
     was lost); STATUS_CAP (a runaway; stops mid-tick). st[_LOGGED] counts the rows written.
     """
+    while st[_FIRST] < F.shape[0]:  # the first predictions, at time 0: each pair once
+        i = st[_FIRST]
+        if N[i, STATIC] == 0:
+            room = _room_around(
+                N[i, CELL] % world[4], N[i, CELL] // world[4], N, cells, s_start, world
+            )
+            if not _has_room(room, HT, HI, HN, st, N):
+                return STATUS_HEAP_FULL
+            _job(jobs, 0, i, -1, 1)
+            for k in range(1):  # (as below: typed arguments, so that one compiled _predict serves)
+                _predict(
+                    jobs, k, stf[_T_NOW], F, N, C, cells, s_start, s_items, HT, HI, HN, st, world
+                )
+        st[_FIRST] += 1
     while st[_TICK] < tick_to:
         tick = st[_TICK] + 1
         t_end = tick / world[2]
@@ -719,15 +718,10 @@ class Model:
         self._G = _build_grid(self._F, self._N, self.cell_size, gnx, gny)
         cap = max(64, HEAP_PER_OBJECT * n)
         self._heap = [np.empty(cap), np.empty((cap, 3), np.int64), np.empty((cap, 2))]
-        self._st = np.zeros(5, np.int64)
+        self._st = np.zeros(6, np.int64)
         self._stf = np.zeros(1)
         self._jobs = np.zeros((2, 3), np.int64)  # scratch: the prediction jobs of one event
         self._stack = np.zeros(INSTANT_STACK, np.int64)  # scratch: walking one instant's entries
-        first = 0
-        while first < n:
-            first = _predict_all(self._jobs, first, *self._state())
-            if first < n:
-                self._heap = [_grown(a) for a in self._heap]
 
     def _state(self):
         """The arrays the kernels share: F, N, cores, grid (3), heap (3), st, world."""

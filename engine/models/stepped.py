@@ -7,21 +7,41 @@ Output, per `advance`: the events of the ticks run, walls and responding pairs, 
 end.
 
 Each step runs move -> walls -> pairs. Walls reflect exactly as a wall would (response.fold).
-Pairs: the candidates are the pairs whose boxes overlap after the walls (broadphase.sweep_pairs),
-taken in ascending (a, b) order, each tested again on the current state so that it sees what the
-pairs before it changed (a pair that only comes to overlap through such a push waits for the next
-step). A pair that overlaps and approaches along the contact normal gets the elastic exchange and
-is pushed apart along the normal, shared by inverse mass, never out of the world.
+Pairs: the candidates are the pairs whose boxes overlap after the walls, taken in ascending (a, b)
+order, each tested again on the current state so that it sees what the pairs before it changed (a
+pair that only comes to overlap through such a push waits for the next step). A pair that overlaps
+and approaches along the contact normal gets the elastic exchange and is pushed apart along the
+normal, shared by inverse mass, never out of the world.
+
+Finding the overlapping pairs without testing them all (a Verlet list): the broad phase
+(broadphase.py, sort-and-sweep or a grid chosen by the scene) lists the pairs whose boxes, each
+grown by a margin of MARGIN_STEPS of the fastest step, overlap, and the list is kept until some
+object has drifted that margin from where it was when the list was made. While no object has, any
+pair overlapping now was on the list (each box moved less than the margin), so each step only
+tests the listed pairs on the current boxes, sorts the few that overlap by (a, b), and takes them
+in that order: exactly the pairs, in exactly the order, of testing every pair. Pairs of two static
+objects are never listed, and with no movable object (or fewer than two objects) the pair stage is
+skipped; the `skip=False` option turns both skips off (for tests and `collide2d bench`).
 
 The event log helpers (`log_event`, `event_records`) serve the exact model too.
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit
 
-from engine.broadphase import sweep_pairs
+from engine.broadphase import (
+    KEY_MASK,
+    KEY_SHIFT,
+    METHOD_GRID,
+    METHOD_SWEEP,
+    candidates,
+    choose,
+    heap_argsort,
+)
 from engine.contact import box_overlap_axis, penetration
 from engine.events import (
     EV_PAIR,
@@ -38,6 +58,24 @@ from engine.world import Bodies, WorldSpec
 
 # Rows of a fresh event buffer; it doubles when full.
 LOG_ROWS = 1024
+# The candidate list's margin, px: this many of the fastest object's step (|v|·dt), within
+# [MARGIN_MIN_PX, MARGIN_MAX_SIDES x the median box side]. A wider margin remakes the list less
+# often but lists more pairs; tuned on the standard scene of `collide2d bench`.
+MARGIN_STEPS = 5.0
+MARGIN_MIN_PX = 0.5
+MARGIN_MAX_SIDES = 1.5
+# The list is remade once an object has drifted within this much (px, and this share of the
+# world's side) of the margin: room for the rounding of the drift and of the grown boxes.
+DRIFT_SLACK_PX = 1e-6
+DRIFT_SLACK_REL = 1e-12
+# Candidate slots to start with per object (the buffers double when full).
+CANDIDATES_PER_OBJECT = 4
+# Lists of overlapping pairs up to this long are sorted by insertion (faster there).
+INSERTION_SORT_MAX = 32
+# The objects inside are put back in the broad phase's order once they have strayed from it by
+# more than this many rows of the grid on average (a row holds about sqrt(n) objects in a
+# squarish world; see the kernels' section).
+REORDER_ROWS = 2.0
 
 
 # --- event log buffers (shared with the exact model) -------------------------------------------
@@ -85,15 +123,11 @@ def event_records(rows: np.ndarray, times: np.ndarray, n: int) -> np.ndarray:
 
 
 # --- the stages of one step ---------------------------------------------------------------------
-
-
-@njit(cache=True)
-def _move(pos, vel, static, dt):
-    """Straight-line motion for dt seconds."""
-    for i in range(pos.shape[0]):
-        if not static[i]:
-            pos[i, 0] += vel[i, 0] * dt
-            pos[i, 1] += vel[i, 1] * dt
+#
+# Inside the kernels objects are kept in the broad phase's order (index i inside is object ext[i];
+# rank[e] is where object e is): objects near in space are then near in memory, which keeps a large
+# scene's pair tests in the cache. Everything that reaches the outside, events and their order,
+# pair order and positions, goes by object id, so the order inside never shows.
 
 
 @njit(cache=True)
@@ -109,32 +143,177 @@ def _log_folds(rows, times, n_ev, tick, t, i, low, high, first_low, side_low, si
     return rows, times, n_ev
 
 
+@njit(cache=True, inline="always")
+def _fold_row(folds, n_folds, e, axis, low, high, first_low):
+    """Note that object e folded on `axis` (low, high folds; the low wall first)."""
+    if low + high == 0:
+        return n_folds
+    folds[n_folds, 0] = 2 * e + axis  # the order of the events: by id, x before y
+    folds[n_folds, 1] = low
+    folds[n_folds, 2] = high
+    folds[n_folds, 3] = first_low
+    return n_folds + 1
+
+
 @njit(cache=True)
-def _walls(pos, vel, size, static, width, height, tick, t, log, rows, times, n_ev):
-    """Reflect every object back into the world, in id order; log each fold."""
+def _move_walls(S, dt, folds):
+    """Move every object for dt seconds, then reflect it back into the world.
+
+    S: the state arrays (see `Model`). folds (2n, 4) int64 receives a row per object and axis that
+    folded. Returns (how many rows, the farthest any object now is from its anchor on an axis, px).
+    """
+    pos, vel, size, inv_mass, static, movable, span, ext, rank, anchor = S
+    drift = 0.0
+    n_folds = 0
     for i in range(pos.shape[0]):
         if static[i]:
             continue
-        x, vx, low, high, first_low = fold(pos[i, 0], vel[i, 0], width - size[i, 0])
+        x = pos[i, 0] + vel[i, 0] * dt
+        y = pos[i, 1] + vel[i, 1] * dt
+        sx = span[i, 0]
+        if not (sx > 0.0 and 0.0 <= x and x <= sx):  # inside, fold would change nothing
+            x, vx, low, high, first_low = fold(x, vel[i, 0], sx)
+            vel[i, 0] = vx
+            n_folds = _fold_row(folds, n_folds, ext[i], 0, low, high, first_low)
+        sy = span[i, 1]
+        if not (sy > 0.0 and 0.0 <= y and y <= sy):
+            y, vy, low, high, first_low = fold(y, vel[i, 1], sy)
+            vel[i, 1] = vy
+            n_folds = _fold_row(folds, n_folds, ext[i], 1, low, high, first_low)
         pos[i, 0] = x
-        vel[i, 0] = vx
-        if log:
-            rows, times, n_ev = _log_folds(
-                rows, times, n_ev, tick, t, i, low, high, first_low, SIDE_LEFT, SIDE_RIGHT
-            )
-        y, vy, low, high, first_low = fold(pos[i, 1], vel[i, 1], height - size[i, 1])
         pos[i, 1] = y
-        vel[i, 1] = vy
-        if log:
-            rows, times, n_ev = _log_folds(
-                rows, times, n_ev, tick, t, i, low, high, first_low, SIDE_TOP, SIDE_BOTTOM
-            )
+        drift = max(drift, abs(x - anchor[i, 0]), abs(y - anchor[i, 1]))
+    return n_folds, drift
+
+
+@njit(cache=True)
+def _log_walls(folds, n_folds, tick, t, rows, times, n_ev):
+    """Log the wall events of the fold rows in id order (x before y): one per fold, alternating
+    from the wall hit first."""
+    order = heap_argsort(folds[:n_folds, 0].copy())
+    for r in range(n_folds):
+        row = order[r]
+        e, axis = folds[row, 0] // 2, folds[row, 0] % 2
+        side_low = SIDE_LEFT if axis == 0 else SIDE_TOP
+        side_high = SIDE_RIGHT if axis == 0 else SIDE_BOTTOM
+        rows, times, n_ev = _log_folds(
+            rows,
+            times,
+            n_ev,
+            tick,
+            t,
+            e,
+            folds[row, 1],
+            folds[row, 2],
+            folds[row, 3] != 0,
+            side_low,
+            side_high,
+        )
     return rows, times, n_ev
 
 
 @njit(cache=True)
-def _contact(a, b, pos, size, exact, shape, radius, start, verts, normals):
-    """(depth, depth_y, code, nx, ny) of a pair now; depth <= 0 when they do not overlap."""
+def _gather(a, order, tmp):
+    """a[:] = a[order] along the first axis, through the scratch tmp (a's shape)."""
+    for s in range(order.shape[0]):
+        tmp[s] = a[order[s]]
+    a[:] = tmp
+
+
+@njit(cache=True)
+def _reorder(S, order):
+    """Put the objects inside in `order` (a permutation of the indices inside), then order is
+    the identity."""
+    pos, vel, size, inv_mass, static, movable, span, ext, rank, anchor = S
+    t2 = np.empty_like(pos)
+    for a in (pos, vel, size, span, anchor):
+        _gather(a, order, t2)
+    _gather(inv_mass, order, np.empty_like(inv_mass))
+    for a in (static, movable):
+        _gather(a, order, np.empty_like(static))
+    _gather(ext, order, np.empty_like(ext))
+    for i in range(ext.shape[0]):
+        rank[ext[i]] = i
+        order[i] = i
+
+
+@njit(cache=True)
+def _relist(S, margin, method, cell, bp):
+    """Make the candidate list anew from the boxes grown by `margin` px and anchor every object
+    where it is; first put the objects inside in the broad phase's order when they have strayed
+    from it (on average more than REORDER_ROWS rows of the grid). Returns (the key buffer, possibly
+    grown; how many keys)."""
+    pos, vel, size, inv_mass, static, movable, span, ext, rank, anchor = S
+    keys, near, order, lo, hi, folds, state, params = bp
+    n = pos.shape[0]
+    for _ in range(2):
+        for i in range(n):
+            lo[i, 0] = pos[i, 0] - margin
+            lo[i, 1] = pos[i, 1] - margin
+            hi[i, 0] = pos[i, 0] + size[i, 0] + margin
+            hi[i, 1] = pos[i, 1] + size[i, 1] + margin
+            anchor[i, 0] = pos[i, 0]
+            anchor[i, 1] = pos[i, 1]
+        k = candidates(method, lo, hi, movable, cell, order, keys)
+        if method == METHOD_GRID:
+            break
+        stray = 0
+        for s in range(n):
+            stray += abs(order[s] - s)
+        if stray <= REORDER_ROWS * math.sqrt(n) * n:
+            break
+        _reorder(S, order)
+    if k > keys.shape[0]:
+        keys = np.empty(2 * k, np.int64)
+        k = candidates(method, lo, hi, movable, cell, order, keys)
+    return keys, k
+
+
+@njit(cache=True)
+def _sort_keys(keys):
+    """Sort in place: insertion sort for the usual handful, a heap sort past that."""
+    if keys.shape[0] > INSERTION_SORT_MAX:
+        keys[:] = keys[heap_argsort(keys.copy())]
+        return
+    for i in range(1, keys.shape[0]):
+        key = keys[i]
+        j = i - 1
+        while j >= 0 and keys[j] > key:
+            keys[j + 1] = keys[j]
+            j -= 1
+        keys[j + 1] = key
+
+
+@njit(cache=True)
+def _overlapping(pos, size, ext, keys, n_keys, near):
+    """The listed pairs whose boxes overlap now with positive area, as keys of object ids
+    ascending, written to `near` when they fit; returns how many (the caller grows `near` and
+    asks again)."""
+    k = 0
+    room = near.shape[0]
+    for c in range(n_keys):
+        a = keys[c] >> KEY_SHIFT
+        b = keys[c] & KEY_MASK
+        if (
+            pos[b, 0] < pos[a, 0] + size[a, 0]
+            and pos[a, 0] < pos[b, 0] + size[b, 0]
+            and pos[b, 1] < pos[a, 1] + size[a, 1]
+            and pos[a, 1] < pos[b, 1] + size[b, 1]
+        ):
+            if k < room:
+                ea = ext[a]
+                eb = ext[b]
+                near[k] = (min(ea, eb) << KEY_SHIFT) | max(ea, eb)
+            k += 1
+    if k <= room:
+        _sort_keys(near[:k])
+    return k
+
+
+@njit(cache=True)
+def _contact(a, b, ea, eb, pos, size, exact, shape, radius, start, verts, normals):
+    """(depth, depth_y, code, nx, ny) of a pair now (a, b inside; ea, eb their ids); depth <= 0
+    when they do not overlap."""
     qx = pos[b, 0] - pos[a, 0]
     qy = pos[b, 1] - pos[a, 1]
     if not exact:
@@ -142,34 +321,35 @@ def _contact(a, b, pos, size, exact, shape, radius, start, verts, normals):
     depth, code, nx, ny = penetration(
         qx,
         qy,
-        shape[a],
+        shape[ea],
         size[a, 0],
         size[a, 1],
-        radius[a],
-        verts[start[a] : start[a + 1]],
-        normals[start[a] : start[a + 1]],
-        shape[b],
+        radius[ea],
+        verts[start[ea] : start[ea + 1]],
+        normals[start[ea] : start[ea + 1]],
+        shape[eb],
         size[b, 0],
         size[b, 1],
-        radius[b],
-        verts[start[b] : start[b + 1]],
-        normals[start[b] : start[b + 1]],
+        radius[eb],
+        verts[start[eb] : start[eb + 1]],
+        normals[start[eb] : start[eb + 1]],
     )
     return depth, depth, code, nx, ny
 
 
 @njit(cache=True)
-def _pairs(
-    pos, vel, size, inv_mass, static, width, height, exact, cores, tick, t, log, rows, times, n_ev
-):
-    """Respond to every overlapping, approaching pair in ascending (a, b) order; log each."""
+def _pairs(S, width, height, exact, cores, near, n_near, tick, t, log, rows, times, n_ev):
+    """Respond to every overlapping, approaching pair of `near` (ascending keys of ids) in order;
+    log each."""
+    pos, vel, size, inv_mass, static, movable, span, ext, rank, anchor = S
     shape, radius, start, verts, normals = cores
-    candidates = sweep_pairs(pos, pos + size, static)
-    for m in range(candidates.shape[0]):
-        a = candidates[m, 0]
-        b = candidates[m, 1]
+    for m in range(n_near):
+        ea = near[m] >> KEY_SHIFT
+        eb = near[m] & KEY_MASK
+        a = rank[ea]
+        b = rank[eb]
         depth, depth_y, code, nx, ny = _contact(
-            a, b, pos, size, exact, shape, radius, start, verts, normals
+            a, b, ea, eb, pos, size, exact, shape, radius, start, verts, normals
         )
         if depth <= 0.0:
             continue
@@ -183,51 +363,71 @@ def _pairs(
             pos, size, a, b, inv_mass[a], inv_mass[b], code, nx, ny, depth, depth_y, width, height
         )
         if log:
-            rows, times = log_event(rows, times, n_ev, tick, t, EV_PAIR, a, b, code)
+            rows, times = log_event(rows, times, n_ev, tick, t, EV_PAIR, ea, eb, code)
             n_ev += 1
     return rows, times, n_ev
 
 
 @njit(cache=True)
-def _run(
-    world, substeps, tick0, ticks, log, pos, vel, size, inv_mass, static, exact, cores, rows, times
-):
-    """Run ticks tick0+1 ... tick0+ticks; returns the event buffers and the number written."""
+def _run(world, substeps, tick0, ticks, log, S, exact, cores, rows, times, bp):
+    """Run ticks tick0+1 ... tick0+ticks; returns (event buffers, how many events, candidate
+    keys, overlap buffer): the buffers that grew replace the caller's.
+
+    S: the state arrays (see `Model`). bp = (keys, near, order, lo, hi, folds, state, params):
+    the candidate list kept between calls (see the module docstring) and scratch; state = [keys
+    listed (-1: no list yet), method, whether pairs can happen at all]; params = [margin px,
+    grid cell px, drift slack px].
+    """
+    keys, near, order, lo, hi, folds, state, params = bp
+    pos, size, ext = S[0], S[2], S[7]
     width, height, fps = world
+    margin, cell, slack = params[0], params[1], params[2]
+    method = state[1]
+    pairs_possible = state[2] != 0
     dt = 1.0 / (fps * substeps)
     n_ev = 0
     for tick in range(tick0 + 1, tick0 + ticks + 1):
         t = tick / fps
         for _ in range(substeps):
-            _move(pos, vel, static, dt)
-            rows, times, n_ev = _walls(
-                pos, vel, size, static, width, height, tick, t, log, rows, times, n_ev
-            )
+            # move, walls: every object; the walls' events in id order; how far anything
+            # drifted from where the candidate list was made
+            n_folds, drift = _move_walls(S, dt, folds)
+            if log and n_folds:
+                rows, times, n_ev = _log_walls(folds, n_folds, tick, t, rows, times, n_ev)
+            if not pairs_possible:
+                continue
+            # pairs: the list made anew once an object drifted its margin, then the listed
+            # pairs that overlap, in (a, b) order
+            if state[0] < 0 or drift >= margin - slack:
+                keys, state[0] = _relist(S, margin, method, cell, bp)
+                bp = (keys, near, order, lo, hi, folds, state, params)
+            n_near = _overlapping(pos, size, ext, keys, state[0], near)
+            if n_near > near.shape[0]:
+                near = np.empty(2 * n_near, np.int64)
+                bp = (keys, near, order, lo, hi, folds, state, params)
+                n_near = _overlapping(pos, size, ext, keys, state[0], near)
             rows, times, n_ev = _pairs(
-                pos,
-                vel,
-                size,
-                inv_mass,
-                static,
-                width,
-                height,
-                exact,
-                cores,
-                tick,
-                t,
-                log,
-                rows,
-                times,
-                n_ev,
+                S, width, height, exact, cores, near, n_near, tick, t, log, rows, times, n_ev
             )
-    return rows, times, n_ev
+    return rows, times, n_ev, keys, near
 
 
 class Model:
-    """Fixed-step elastic model; see the module docstring. Surface as in engine.models."""
+    """Fixed-step elastic model; see the module docstring. Surface as in engine.models.
+
+    State inside, in the broad phase's order: S = (pos (n, 2) px, vel (n, 2) px/s, size (n, 2)
+    px, inv_mass (n,), static (n,), movable (n,) (what the broad phase pairs), span (n, 2) =
+    world side - box side px, ext (n,) the id of each, rank (n,) where each id is, anchor (n, 2)
+    px where each was when the candidate list was made).
+    """
 
     def __init__(
-        self, world: WorldSpec, bodies: Bodies, substeps: int = 1, geometry: str | None = None
+        self,
+        world: WorldSpec,
+        bodies: Bodies,
+        substeps: int = 1,
+        geometry: str | None = None,
+        skip: bool = True,
     ):
         if int(substeps) != substeps or substeps < 1:
             raise ValueError(f"substeps must be a whole number >= 1, got {substeps!r}")
@@ -238,42 +438,86 @@ class Model:
         self.substeps = int(substeps)
         self.geometry = geometry
         self.tick = 0
-        self._static = np.ascontiguousarray(bodies.static, bool).copy()
-        self._pos = np.ascontiguousarray(bodies.pos, np.float64).copy()
-        self._vel = np.ascontiguousarray(bodies.vel, np.float64).copy()
-        self._vel[self._static] = 0.0
-        self._size = np.ascontiguousarray(bodies.size, np.float64).copy()
-        self._inv_mass = np.ascontiguousarray(bodies.inv_mass, np.float64)
+        n = bodies.n
+        static = np.ascontiguousarray(bodies.static, bool).copy()
+        pos = np.ascontiguousarray(bodies.pos, np.float64).copy()
+        vel = np.ascontiguousarray(bodies.vel, np.float64).copy()
+        vel[static] = 0.0
+        size = np.ascontiguousarray(bodies.size, np.float64).copy()
+        span = np.array([world.width, world.height], np.float64) - size
+        movable = ~static if skip else np.ones(n, bool)
+        self._S = (
+            pos,
+            vel,
+            size,
+            np.ascontiguousarray(bodies.inv_mass, np.float64),
+            static,
+            movable,
+            np.ascontiguousarray(span),
+            np.arange(n, dtype=np.int64),
+            np.arange(n, dtype=np.int64),
+            pos.copy(),
+        )
         cores = build_cores(bodies, geometry)
         self._cores = (cores.shape, cores.radius, cores.start, cores.verts, cores.normals)
+        self._bp = _broad_phase(world, pos, vel, size, movable, substeps, skip)
 
     def advance(self, ticks: int, log: bool = True) -> np.ndarray:
         """Run `ticks` ticks; the events in the order they happened (empty when log is False)."""
         world = (float(self.world.width), float(self.world.height), float(self.world.fps))
         rows, times = new_log(log)
-        rows, times, n = _run(
+        rows, times, n, keys, near = _run(
             world,
             self.substeps,
             self.tick,
             int(ticks),
             bool(log),
-            self._pos,
-            self._vel,
-            self._size,
-            self._inv_mass,
-            self._static,
+            self._S,
             self.geometry == "exact",
             self._cores,
             rows,
             times,
+            self._bp,
         )
+        self._bp = (keys, near) + self._bp[2:]
         self.tick += int(ticks)
         return event_records(rows, times, n)
 
     def positions(self) -> np.ndarray:
         """(n, 2) float64 top-left corners, px."""
-        return self._pos.copy()
+        return self._by_id(self._S[0])
 
     def velocities(self) -> np.ndarray:
         """(n, 2) float64 velocities, px/s."""
-        return self._vel.copy()
+        return self._by_id(self._S[1])
+
+    def _by_id(self, a: np.ndarray) -> np.ndarray:
+        out = np.empty_like(a)
+        out[self._S[7]] = a
+        return out
+
+
+def _broad_phase(world, pos, vel, size, movable, substeps, skip):
+    """The candidate list's state and scratch (see `_run`): its margin from the fastest step and
+    the box sizes, the method and cell from the scene (broadphase.choose)."""
+    n = pos.shape[0]
+    possible = n >= 2 and (bool(movable.any()) or not skip)
+    fastest = float(np.abs(vel).max()) / (world.fps * substeps) if n else 0.0
+    median_side = float(np.median(size.max(axis=1))) if n else 1.0
+    margin = min(MARGIN_STEPS * fastest, MARGIN_MAX_SIDES * median_side)
+    margin = max(margin, MARGIN_MIN_PX) if np.isfinite(margin) else MARGIN_MIN_PX
+    method, cell = choose(world.width, world.height, size + 2.0 * margin)
+    slack = DRIFT_SLACK_PX + DRIFT_SLACK_REL * max(world.width, world.height)
+    order = np.arange(n, dtype=np.int64)
+    if method == METHOD_SWEEP:
+        order = np.argsort(pos[:, 0], kind="stable").astype(np.int64)
+    return (
+        np.empty(max(16, CANDIDATES_PER_OBJECT * n), np.int64),  # keys
+        np.empty(max(16, n), np.int64),  # near
+        order,
+        np.empty_like(pos),  # lo
+        np.empty_like(pos),  # hi
+        np.empty((2 * n, 4), np.int64),  # folds
+        np.array([-1, method, int(possible)], np.int64),
+        np.array([margin, cell, slack]),
+    )
