@@ -42,7 +42,7 @@ def project(pytester):
     pytester.makepyfile(
         golden_synthetic=Path(synthetic.__file__).read_text(),
         conftest=CONFTEST,
-        test_goldens=TEST_FILE,
+        test_golden_project=TEST_FILE,  # a name no other test module in the run has
     )
     for name in ("a", "b"):
         synthetic.write(pytester.path / "scenarios" / f"{name}.yaml", synthetic.spec(name=name))
