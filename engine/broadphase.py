@@ -11,9 +11,15 @@ object: two static objects never become a pair (SPEC 3: static objects never mov
 - `grid_candidates` files every box in each cell of a uniform grid that the box meets and tests
   the pairs inside each cell; a pair is reported only in the cell that holds the lower corner of
   the two boxes' intersection, so each pair comes once without a set to deduplicate. Its cost
-  grows with n, not with how many boxes share an x interval (large worlds).
-- `choose` picks one of the two and the grid's cell from the scene (object count, world size,
-  box sizes); `sweep_pairs` and `grid_pairs` give the answer as sorted (k, 2) pairs.
+  grows with n, not with how many boxes share an x interval; large boxes meet many cells, so it
+  suits mixed sizes (1x1 beside 500x500).
+- `cell_candidates` files every box once, by its lower corner, in a grid whose cell is at least
+  the largest box, and tests each box against its own cell and four neighbours: the cheapest
+  for many boxes of similar sizes in a large world. Its counting sort by cell also gives the
+  order in which the stepped model keeps its objects (near in space, near in memory).
+- `choose` picks one of the three and its cell from the scene (object count, world size, box
+  sizes); `candidates` dispatches to it; `find_pairs` and `sweep_pairs` give the answer as
+  sorted (k, 2) pairs (`sweep_pairs` is the reference the tests hold the others to).
 - the exact model's grid: square cells of side `cell` px over the world, each moving object filed
   by the cell of its box's centre. With the cell at least the largest moving box (plus a margin),
   two moving objects that touch are in the same or adjacent cells, so an object predicts contacts
@@ -22,7 +28,9 @@ object: two static objects never become a pair (SPEC 3: static objects never mov
 
 The candidate finders write into a caller's key buffer and return how many keys there are; when
 that is more than the buffer holds, only the first keys were written and the caller grows the
-buffer and asks again. Keys come in no particular order: the models sort the few they keep.
+buffer and asks again. Keys come in no particular order: the models sort the few they keep. They
+allocate nothing (their scratch comes from `workspace`), so that kernels compiled without
+numba's reference counting can call them.
 """
 
 from __future__ import annotations
@@ -39,6 +47,7 @@ KEY_MASK = (1 << KEY_SHIFT) - 1
 METHOD_SWEEP = 0
 METHOD_GRID = 1
 METHOD_CELLS = 2
+METHODS = {"sweep": METHOD_SWEEP, "grid": METHOD_GRID, "cells": METHOD_CELLS}
 # The sweep is chosen while a box shares its x interval with at most this many others on average
 # (expected); past that the grid, whose cost does not grow with crowding along x, is cheaper.
 # Tuned on the standard scene of `collide2d bench` (boxes 10x10 px, 5 % of a 4:3 world).
@@ -75,12 +84,56 @@ def _key(i, j):
     return (min(i, j) << KEY_SHIFT) | max(i, j)
 
 
+def workspace(n: int, dtype=np.float64) -> tuple:
+    """Scratch arrays for the candidate finders over n boxes with coordinates of `dtype`, so that
+    they allocate nothing (the models' kernels run without numba's reference counting):
+    (x starts, sorted x starts, cell keys, cell starts, boxes, cell spans, filed ids, filed boxes).
+    """
+    cells = int(4 * GRID_CELLS_PER_OBJECT * n) + 8
+    filings = int(GRID_FILINGS_PER_OBJECT * n) + 16
+    return (
+        np.empty(n, dtype),
+        np.empty(n, dtype),
+        np.empty(n, np.int64),
+        np.empty(cells, np.int64),
+        np.empty((n, 4), dtype),
+        np.empty((n, 4), np.int64),
+        np.empty(filings, np.int64),
+        np.empty((filings, 4), dtype),
+    )
+
+
+@njit(cache=True)
+def _heapsort_order(order, key):
+    """Sort `order` in place so that key[order] ascends (heap sort: allocates nothing)."""
+    n = order.shape[0]
+    for root in range(n // 2 - 1, -1, -1):
+        _sift_order(order, key, root, n)
+    for end in range(n - 1, 0, -1):
+        order[0], order[end] = order[end], order[0]
+        _sift_order(order, key, 0, end)
+
+
+@njit(cache=True)
+def _sift_order(order, key, root, n):
+    while True:
+        c = 2 * root + 1
+        if c >= n:
+            return
+        if c + 1 < n and key[order[c + 1]] > key[order[c]]:
+            c += 1
+        if key[order[root]] >= key[order[c]]:
+            return
+        order[root], order[c] = order[c], order[root]
+        root = c
+
+
 @njit(cache=True)
 def sort_order(order, key, sorted_key):
     """Mend `order` so key[order] ascends, and set sorted_key = key[order].
 
     order (n,) int64, the order of an earlier call (nearly sorted: objects move a little between
-    calls) is mended by insertion sort, or replaced by a full sort when it is far off.
+    calls) is mended by insertion sort, or sorted afresh when it is far off.
     """
     n = order.shape[0]
     for s in range(n):
@@ -99,22 +152,24 @@ def sort_order(order, key, sorted_key):
         order[j + 1] = cur
         sorted_key[j + 1] = k
         if shifts > budget:
-            order[:] = np.argsort(key, kind="mergesort")
+            _heapsort_order(order, key)
             for s in range(n):
                 sorted_key[s] = key[order[s]]
             return
 
 
 @njit(cache=True)
-def sweep_candidates(lo, hi, movable, order, out):
+def sweep_candidates(lo, hi, movable, order, out, ws):
     """Candidate keys by sort-and-sweep on x; returns how many (see the module docstring).
 
     lo, hi (n, 2) px; movable (n,) bool; order (n,) int64 kept between calls (any permutation to
-    start with); out (m,) int64 receives the keys.
+    start with); out (m,) int64 receives the keys; ws from `workspace`.
     """
     n = lo.shape[0]
-    sorted_lo = np.empty(n, lo.dtype)
-    sort_order(order, np.ascontiguousarray(lo[:, 0]), sorted_lo)
+    x_lo, sorted_lo = ws[0], ws[1]
+    for i in range(n):
+        x_lo[i] = lo[i, 0]
+    sort_order(order, x_lo, sorted_lo)
     k = 0
     m = out.shape[0]
     for s in range(n):
@@ -144,34 +199,46 @@ def _cell_of(x, x0, inv, last):
 
 
 @njit(cache=True)
-def grid_candidates(lo, hi, movable, cell, out):
-    """Candidate keys from a uniform grid of square cells of side `cell` px; returns how many.
-
-    lo, hi (n, 2) px; movable (n,) bool; out (m,) int64 receives the keys. The grid starts at the
-    boxes' lowest corner; when it would have more than GRID_CELLS_PER_OBJECT cells per object the
-    cell grows to fit (any cell gives the same pairs, only the cost changes).
-    """
-    n = lo.shape[0]
-    if n < 2:
-        return 0
+def _bounds(lo, hi):
+    """(x0, y0, x1, y1, largest side) of the boxes, px."""
     x0 = lo[0, 0]
     y0 = lo[0, 1]
     x1 = hi[0, 0]
     y1 = hi[0, 1]
-    for i in range(1, n):
+    side = 0.0
+    for i in range(lo.shape[0]):
         x0 = min(x0, lo[i, 0])
         y0 = min(y0, lo[i, 1])
         x1 = max(x1, hi[i, 0])
         y1 = max(y1, hi[i, 1])
-    span_x = max(float(x1 - x0), 1e-300)
-    span_y = max(float(y1 - y0), 1e-300)
+        side = max(side, float(hi[i, 0] - lo[i, 0]), float(hi[i, 1] - lo[i, 1]))
+    return float(x0), float(y0), float(x1), float(y1), side
+
+
+@njit(cache=True)
+def grid_candidates(lo, hi, movable, cell, out, ws):
+    """Candidate keys from a uniform grid of square cells of side `cell` px; returns how many.
+
+    lo, hi (n, 2) px; movable (n,) bool; out (m,) int64 receives the keys; ws from `workspace`.
+    The grid starts at the boxes' lowest corner; its cell grows while the grid would have more
+    than GRID_CELLS_PER_OBJECT cells per object or the boxes more filings than the workspace
+    holds (any cell gives the same pairs, only the cost changes).
+    """
+    n = lo.shape[0]
+    if n < 2:
+        return 0
+    span, start, f_id, f_box = ws[5], ws[3], ws[6], ws[7]
+    x0, y0, x1, y1, _ = _bounds(lo, hi)
+    span_x = max(x1 - x0, 1e-300)
+    span_y = max(y1 - y0, 1e-300)
     cell = max(float(cell), math.sqrt(span_x * span_y / (GRID_CELLS_PER_OBJECT * n)))
-    # each object's cell range [cx0, cx1] x [cy0, cy1]; the cell doubles while large boxes would
-    # make more than GRID_FILINGS_PER_OBJECT filings per object
-    span = np.empty((n, 4), np.int64)
+    # each object's cell range [cx0, cx1] x [cy0, cy1]
     while True:
-        nx = min(int(span_x / cell) + 1, 4 * n + 1)
-        ny = min(int(span_y / cell) + 1, 4 * n + 1)
+        nx = int(span_x / cell) + 1
+        ny = int(span_y / cell) + 1
+        if nx * ny + 1 > start.shape[0]:
+            cell *= 2.0  # a long thin spread of boxes
+            continue
         inv = 1.0 / cell
         total = 0
         for i in range(n):
@@ -180,32 +247,34 @@ def grid_candidates(lo, hi, movable, cell, out):
             span[i, 2] = _cell_of(lo[i, 1], y0, inv, ny - 1)
             span[i, 3] = _cell_of(hi[i, 1], y0, inv, ny - 1)
             total += (span[i, 1] - span[i, 0] + 1) * (span[i, 3] - span[i, 2] + 1)
-        if total <= GRID_FILINGS_PER_OBJECT * n:
+        if total <= f_id.shape[0]:
             break
-        cell *= 2.0
-    # how many filings each cell gets
-    start = np.zeros(nx * ny + 1, np.int64)
+        cell *= 2.0  # large boxes: fewer, larger cells
+    # how many filings each cell gets, then the filings cell by cell in id order, each with a
+    # copy of its box for local reads; cell c holds [start[c], start[c + 1]) at the end
+    for c in range(nx * ny + 1):
+        start[c] = 0
     for i in range(n):
         for cy in range(span[i, 2], span[i, 3] + 1):
             for cx in range(span[i, 0], span[i, 1] + 1):
                 start[cy * nx + cx + 1] += 1
     for c in range(nx * ny):
         start[c + 1] += start[c]
-    # the filings, cell by cell in id order, each with a copy of its box for local reads
-    f_id = np.empty(total, np.int64)
-    f_box = np.empty((total, 4), lo.dtype)
-    fill = start[:-1].copy()
-    for i in range(n):
-        for cy in range(span[i, 2], span[i, 3] + 1):
-            for cx in range(span[i, 0], span[i, 1] + 1):
-                c = cy * nx + cx
-                f = fill[c]
-                fill[c] = f + 1
+    for i in range(n - 1, -1, -1):
+        for cy in range(span[i, 3], span[i, 2] - 1, -1):
+            for cx in range(span[i, 1], span[i, 0] - 1, -1):
+                c = cy * nx + cx + 1
+                f = start[c] - 1
+                start[c] = f
                 f_id[f] = i
                 f_box[f, 0] = lo[i, 0]
                 f_box[f, 1] = lo[i, 1]
                 f_box[f, 2] = hi[i, 0]
                 f_box[f, 3] = hi[i, 1]
+    # start[c + 1] is now where cell c begins: move each down by one, and close the last cell
+    for c in range(nx * ny):
+        start[c] = start[c + 1]
+    start[nx * ny] = total
     k = 0
     m = out.shape[0]
     for c in range(nx * ny):
@@ -233,46 +302,38 @@ def grid_candidates(lo, hi, movable, cell, out):
 
 
 @njit(cache=True)
-def cell_candidates(lo, hi, movable, cell, order, out):
+def cell_candidates(lo, hi, movable, cell, order, out, ws):
     """Candidate keys from a grid whose cell is at least every box's side; returns how many.
 
     Each box is filed once, by the cell of its lower corner; two overlapping boxes then sit in the
     same or neighbouring cells, and each box is tested against the later boxes of its own cell and
-    the boxes of four of its eight neighbours (the other four test it), so each pair comes once.
-    lo, hi (n, 2) px; movable (n,) bool; cell px (grown to CELL_MARGIN x the largest side when
-    smaller, and until the grid has at most GRID_CELLS_PER_OBJECT cells per object); out (m,)
-    int64 receives the keys; order (n,) int64 receives the objects sorted by cell (row by row),
-    in id order within a cell.
+    the boxes of four of its eight neighbours, (+1, 0) and the three below (the other four test
+    it), so each pair comes once. lo, hi (n, 2) px; movable (n,) bool; cell px (grown to
+    CELL_MARGIN x the largest side when smaller, and while the grid would have more than
+    GRID_CELLS_PER_OBJECT cells per object or more than the workspace holds); out (m,) int64
+    receives the keys; order (n,) int64 receives the objects sorted by cell (row by row), in id
+    order within a cell; ws from `workspace`.
     """
     n = lo.shape[0]
-    if n < 2:
-        for i in range(n):
-            order[i] = i
-        return 0
-    x0 = lo[0, 0]
-    y0 = lo[0, 1]
-    x1 = hi[0, 0]
-    y1 = hi[0, 1]
-    side = 0.0
     for i in range(n):
-        x0 = min(x0, lo[i, 0])
-        y0 = min(y0, lo[i, 1])
-        x1 = max(x1, hi[i, 0])
-        y1 = max(y1, hi[i, 1])
-        side = max(side, float(hi[i, 0] - lo[i, 0]), float(hi[i, 1] - lo[i, 1]))
-    span_x = float(x1 - x0)
-    span_y = float(y1 - y0)
+        order[i] = i
+    if n < 2:
+        return 0
+    key, start, box = ws[2], ws[3], ws[4]
+    x0, y0, x1, y1, side = _bounds(lo, hi)
+    span_x = x1 - x0
+    span_y = y1 - y0
     cell = max(float(cell), side * CELL_MARGIN, 1e-300)
     cell = max(cell, math.sqrt(span_x * span_y / (GRID_CELLS_PER_OBJECT * n)))
-    while (span_x / cell + 1.0) * (span_y / cell + 1.0) > 4.0 * GRID_CELLS_PER_OBJECT * n + 4:
+    while (int(span_x / cell) + 1) * (int(span_y / cell) + 1) + 2 > start.shape[0]:
         cell *= 2.0  # a long thin spread of boxes
     nx = int(span_x / cell) + 1
     ny = int(span_y / cell) + 1
     inv = 1.0 / cell
     # counting sort by cell: cell c holds slots [start[c + 1], start[c + 2]) once the scatter
     # below has moved each cell's end back to its start
-    key = np.empty(n, np.int64)
-    start = np.zeros(nx * ny + 2, np.int64)
+    for c in range(nx * ny + 2):
+        start[c] = 0
     for i in range(n):
         c = _cell_of(lo[i, 1], y0, inv, ny - 1) * nx + _cell_of(lo[i, 0], x0, inv, nx - 1)
         key[i] = c
@@ -280,7 +341,6 @@ def cell_candidates(lo, hi, movable, cell, order, out):
     for c in range(nx * ny):
         start[c + 1] += start[c]
     start[nx * ny + 1] = n
-    box = np.empty((n, 4), lo.dtype)
     for i in range(n - 1, -1, -1):
         c = key[i]
         slot = start[c + 1] - 1
@@ -299,16 +359,18 @@ def cell_candidates(lo, hi, movable, cell, order, out):
         cy = c // nx
         ma = movable[a]
         lax, lay, hax, hay = box[s, 0], box[s, 1], box[s, 2], box[s, 3]
-        for nb in range(5):
-            if nb == 0:  # the later boxes of its own cell
-                first, last = s + 1, start[c + 2]
-            else:  # (+1, 0), (-1, +1), (0, +1), (+1, +1)
-                gx = cx + (1 if nb == 1 or nb == 4 else (-1 if nb == 2 else 0))
-                gy = cy + (0 if nb == 1 else 1)
-                if gx < 0 or gx >= nx or gy >= ny:
-                    continue
-                g = gy * nx + gx
-                first, last = start[g + 1], start[g + 2]
+        # two runs of slots: the later boxes of its own cell and those of the cell to its right
+        # (+1, 0); the cells (-1, +1), (0, +1), (+1, +1) of the next row, side by side in a row
+        for run in range(2):
+            if run == 0:
+                first = s + 1
+                last = start[c + 2 + (1 if cx + 1 < nx else 0)]
+            else:
+                if cy + 1 >= ny:
+                    break
+                g = c + nx
+                first = start[g + (0 if cx > 0 else 1)]
+                last = start[g + (3 if cx + 1 < nx else 2)]
             for t in range(first, last):
                 b = order[t]
                 # branch-free: write the key, keep it only when the boxes overlap
@@ -325,24 +387,36 @@ def cell_candidates(lo, hi, movable, cell, order, out):
     return k
 
 
-def choose(width: float, height: float, size: np.ndarray) -> tuple[int, float]:
+def choose(
+    width: float, height: float, size: np.ndarray, method: str | None = None
+) -> tuple[int, float]:
     """(method, cell px) for boxes of these sizes (n, 2) px in a width x height world, px.
 
     The sweep while a box shares its x interval with at most SWEEP_MAX_X_NEIGHBOURS others on
     average. Else a grid: boxes of similar sizes on cells of the largest side (METHOD_CELLS),
     mixed sizes on cells GRID_CELL_PER_SIDE x the median side, doubled while the boxes would make
-    more than GRID_FILINGS_PER_OBJECT filings per object (METHOD_GRID).
+    more than GRID_FILINGS_PER_OBJECT filings per object (METHOD_GRID). `method` ("sweep",
+    "grid", "cells", a key of METHODS) forces one; any gives the same pairs.
     """
     size = np.asarray(size, np.float64).reshape(-1, 2)
     n = size.shape[0]
+    if method is not None and method not in METHODS:
+        raise ValueError(f"unknown broad phase {method!r}; expected one of {', '.join(METHODS)}")
     if n < 2:
-        return METHOD_SWEEP, 1.0
-    neighbours = (n - 1) * 2.0 * float(size[:, 0].mean()) / max(float(width), 1.0)
-    if not neighbours > SWEEP_MAX_X_NEIGHBOURS:
-        return METHOD_SWEEP, 1.0
+        return METHODS.get(method, METHOD_SWEEP), 1.0
     sides = size.max(axis=1)
     median, largest = float(np.median(sides)), float(sides.max())
-    if largest <= CELLS_MAX_SIDE_RATIO * median:
+    if method is None:
+        neighbours = (n - 1) * 2.0 * float(size[:, 0].mean()) / max(float(width), 1.0)
+        if not neighbours > SWEEP_MAX_X_NEIGHBOURS:
+            method = "sweep"
+        elif largest <= CELLS_MAX_SIDE_RATIO * median:
+            method = "cells"
+        else:
+            method = "grid"
+    if method == "sweep":
+        return METHOD_SWEEP, 1.0
+    if method == "cells":
         return METHOD_CELLS, largest * CELL_MARGIN
     cell = max(GRID_CELL_PER_SIDE * median, 1e-6)
     while np.sum((np.floor(size / cell) + 2).prod(axis=1)) > GRID_FILINGS_PER_OBJECT * n:
@@ -351,14 +425,14 @@ def choose(width: float, height: float, size: np.ndarray) -> tuple[int, float]:
 
 
 @njit(cache=True)
-def candidates(method, lo, hi, movable, cell, order, out):
+def candidates(method, lo, hi, movable, cell, order, out, ws):
     """Candidate keys by `method` (`order` is the order kept by the sweep and the cells, `cell`
     the grid's cell, px); returns how many, as each finder does."""
     if method == METHOD_GRID:
-        return grid_candidates(lo, hi, movable, cell, out)
+        return grid_candidates(lo, hi, movable, cell, out, ws)
     if method == METHOD_CELLS:
-        return cell_candidates(lo, hi, movable, cell, order, out)
-    return sweep_candidates(lo, hi, movable, order, out)
+        return cell_candidates(lo, hi, movable, cell, order, out, ws)
+    return sweep_candidates(lo, hi, movable, order, out, ws)
 
 
 def keys_to_pairs(keys: np.ndarray) -> np.ndarray:
@@ -367,21 +441,25 @@ def keys_to_pairs(keys: np.ndarray) -> np.ndarray:
     return np.stack([keys >> KEY_SHIFT, keys & KEY_MASK], axis=1)
 
 
-def grid_pairs(lo: np.ndarray, hi: np.ndarray, movable: np.ndarray, cell: float) -> np.ndarray:
-    """Pairs of boxes that overlap with positive area, at least one movable, found on a grid of
-    `cell` px: (k, 2) int64 in ascending (a, b), a < b. lo, hi (n, 2) px; movable (n,) bool."""
+def find_pairs(method: int, lo: np.ndarray, hi: np.ndarray, movable: np.ndarray, cell: float = 1.0):
+    """Pairs of boxes that overlap with positive area, at least one movable, found by `method`
+    (METHOD_SWEEP, METHOD_GRID on cells of `cell` px, METHOD_CELLS): (k, 2) int64 in ascending
+    (a, b), a < b. lo, hi (n, 2) px; movable (n,) bool."""
     lo = np.ascontiguousarray(lo)
     hi = np.ascontiguousarray(hi, dtype=lo.dtype)
     movable = np.ascontiguousarray(movable, bool)
-    out = np.empty(max(16, lo.shape[0]), np.int64)
-    k = grid_candidates(lo, hi, movable, float(cell), out)
+    n = lo.shape[0]
+    ws = workspace(n, lo.dtype)
+    order = np.arange(n, dtype=np.int64)
+    out = np.empty(max(16, n), np.int64)
+    k = candidates(method, lo, hi, movable, float(cell), order, out, ws)
     if k > out.shape[0]:
         out = np.empty(k, np.int64)
-        k = grid_candidates(lo, hi, movable, float(cell), out)
+        k = candidates(method, lo, hi, movable, float(cell), order, out, ws)
     return keys_to_pairs(out[:k])
 
 
-# --- the stepped model's reference answer and the exact model's grid ----------------------------
+# --- the reference answer (tests) and the exact model's grid ------------------------------------
 
 
 @njit(cache=True)

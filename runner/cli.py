@@ -13,7 +13,7 @@ import sys
 from importlib import resources
 
 from engine.models import ModelUnavailable
-from runner import stress, validate
+from runner import bench, stress, validate
 from runner.golden import cli as golden_cli
 from runner.options import (
     add_limit_arguments,
@@ -110,6 +110,7 @@ def build_parser() -> argparse.ArgumentParser:
     golden_cli.register(subparsers)
     validate.register(subparsers)
     stress.register(subparsers)
+    bench.register(subparsers)
     return parser
 
 

@@ -2,9 +2,11 @@
 
 Input: the world, the `Bodies` (copied) and the options `geometry` ("exact", the default, also
 for None: circles and polygons by their real shapes; "box": every object as its box),
-`max_events_per_tick` and `cell_size` (px; the grid's cell, chosen from the scene when not given).
-Output, per `advance`: the wall and pair events in the order they happened, `t` = the exact
-contact time; positions and velocities at the end of the last tick.
+`max_events_per_tick`, `cell_size` (px; the grid's cell, chosen from the scene when not given)
+and `repredict` ("touched", the default; "all" predicts every moving object again after each
+event, the work the local re-prediction saves, for tests and `collide2d bench`). Output, per
+`advance`: the wall and pair events in the order they happened, `t` = the exact contact time;
+positions and velocities at the end of the last tick.
 
 Objects fly on straight lines between events. Each keeps its own clock (TLOC: its position is
 valid at that time) and an invalidation counter. A 4-ary heap, in preallocated arrays that grow
@@ -52,6 +54,11 @@ from engine.world import KIND_BOX, Bodies, WorldSpec
 
 # Most wall and pair events one tick may take before the run is stopped as a runaway.
 MAX_EVENTS_PER_TICK = 1_000_000
+# After an event, predict again only the objects it touched ("touched", the model), or every
+# moving object ("all": the same events at the same times up to rounding, at the cost the local
+# re-prediction saves; its heap room grows with n^2, so only for small scenes: tests and
+# `collide2d bench`).
+REPREDICT = ("touched", "all")
 # Heap entries to start with per object (the heap drops stale entries, or doubles, when full).
 HEAP_PER_OBJECT = 4
 # Children per heap node: a 4-ary heap is half as deep as a binary one, and its four children
@@ -61,17 +68,24 @@ ARITY = 4
 # Columns of F (n, 8) float64: position (top-left, px) valid at the object's own clock TLOC (s),
 # velocity (px/s), box size (px), inverse mass (0 for static objects).
 X, Y, VX, VY, TLOC, SW, SH, INV_MASS = range(8)
-# Columns of N (n, 7) int64: invalidation counter, static flag, contact shape kind, grid cell,
-# next / previous object in that cell's list (-1 for none), last query stamp (static objects).
-CNT, STATIC, SHAPE, CELL, NEXT, PREV, STAMP = range(7)
+# Columns of N (n, 8) int64: invalidation counter, static flag, contact shape kind, grid cell,
+# next / previous object in that cell's list (-1 for none), last query stamp (static objects),
+# the partner of its last event if that was a pair (-1 otherwise).
+CNT, STATIC, SHAPE, CELL, NEXT, PREV, STAMP, PARTNER = range(8)
 # Heap: HT (cap,) float64 times; HI (cap, 3) int64 key and the two counters; HN (cap, 2) float64
 # the contact normal (code and normal as contact.py gives them).
 HKEY, HCA, HCB = range(3)
 # Grid cells (gnx·gny, 2) int64: the first moving object filed there (-1: none) and how many.
 C_HEAD, C_COUNT = range(2)
-# A prediction job (one row of `jobs`): the object, the partner to leave out (-1: none), whether
-# to take only static objects and higher ids (the first prediction, each pair once).
+# A prediction job (one row of `jobs`): the object, the partner to leave out (-1: none), and its
+# mode: JOB_EVENT (after an event of the object), JOB_FIRST (the first prediction: only static
+# objects and higher ids, each pair once), JOB_CONTACTS (only contacts, no horizon: the extra
+# predictions of `repredict="all"`).
 J_OBJ, J_SKIP, J_HIGHER = range(3)
+JOB_EVENT, JOB_FIRST, JOB_CONTACTS = range(3)
+# Rows of `jobs`: the (at most two) objects an event touched, and one for the extra predictions.
+JOB_ROWS = 3
+J_EXTRA = 2
 
 # Heap keys: rank, a, b (or a wall side / crossing direction) and contact code in one int64, so that
 # ties in time resolve as crossings, then walls by (id, side), then pairs by (a, b).
@@ -475,10 +489,13 @@ def _predict(jobs, k, t_now, F, N, C, cells, s_start, s_items, HT, HI, HN, st, w
     """Run prediction job k for object i: push its horizon (the first of its next wall contact
     and its next cell crossing) and its contacts with the objects in the 3×3 cells around it
     that come no later than that."""
-    i, skip, higher = jobs[k, J_OBJ], jobs[k, J_SKIP], jobs[k, J_HIGHER] != 0
+    i, skip, mode = jobs[k, J_OBJ], jobs[k, J_SKIP], jobs[k, J_HIGHER]
+    higher = mode == JOB_FIRST
     t_wall, side = _wall_time(i, F, world)
     t_cross, d = _cross_time(i, F, N, world)
-    if t_cross <= t_wall and t_cross < INF:
+    if mode == JOB_CONTACTS:
+        pass
+    elif t_cross <= t_wall and t_cross < INF:
         key = _key(RANK_CROSS, i, d, d)
         _push(HT, HI, HN, st, max(t_cross, t_now), key, N[i, CNT], 0, 0.0, 0.0)
     elif t_wall < INF:
@@ -529,7 +546,8 @@ def _on_cross(i, d, N, cells, world, jobs):
     gy = N[i, CELL] // gnx + (1 if d == DIR_DOWN else -1 if d == DIR_UP else 0)
     _cell_remove(N, cells, i)
     _cell_insert(N, cells, i, gy * gnx + gx)
-    _job(jobs, 0, i, -1, 0)
+    N[i, PARTNER] = -1
+    _job(jobs, 0, i, -1, JOB_EVENT)
     return 1
 
 
@@ -545,7 +563,8 @@ def _on_wall(i, side, t, F, N, world, jobs):
         F[i, VY] = -F[i, VY]
         F[i, Y] = 0.0 if side == SIDE_TOP else world[1] - F[i, SH]
     N[i, CNT] += 1
-    _job(jobs, 0, i, -1, 0)
+    N[i, PARTNER] = -1
+    _job(jobs, 0, i, -1, JOB_EVENT)
     return 1
 
 
@@ -565,7 +584,8 @@ def _on_pair(a, b, code, nx, ny, t, F, N, jobs):
     for i, other in ((a, b), (b, a)):
         if N[i, STATIC] == 0:
             N[i, CNT] += 1
-            _job(jobs, n_jobs, i, other, 0)
+            N[i, PARTNER] = other
+            _job(jobs, n_jobs, i, other, JOB_EVENT)
             n_jobs += 1
     return n_jobs
 
@@ -586,6 +606,7 @@ def _run(
     tick_to,
     log,
     cap,
+    everyone,
     F,
     N,
     C,
@@ -605,9 +626,16 @@ def _run(
     events in order, apply each, predict again for the objects it touched. (Objects not touched
     keep their clocks; positions() moves them to the tick's end.)
 
+    With `everyone` (the `repredict="all"` option) every other moving object is predicted again
+    as well after each event (contacts only, against all but the partner of its last pair
+    event): the work the local re-prediction saves. The events are the same; a time asked again
+    may differ in its last bits, since an object's clock moves by one rounded step when a pair
+    it is in turns out not to approach.
+
     Returns a status: STATUS_DONE; STATUS_HEAP_FULL / STATUS_LOG_FULL (grow, call again: nothing
     was lost); STATUS_CAP (a runaway; stops mid-tick). st[_LOGGED] counts the rows written.
     """
+    extra_room = F.shape[0] * F.shape[0] if everyone else 0
     while st[_FIRST] < F.shape[0]:  # the first predictions, at time 0: each pair once
         i = st[_FIRST]
         if N[i, STATIC] == 0:
@@ -616,7 +644,7 @@ def _run(
             )
             if not _has_room(room, HT, HI, HN, st, N):
                 return STATUS_HEAP_FULL
-            _job(jobs, 0, i, -1, 1)
+            _job(jobs, 0, i, -1, JOB_FIRST)
             for k in range(1):  # (as below: typed arguments, so that one compiled _predict serves)
                 _predict(
                     jobs, k, stf[_T_NOW], F, N, C, cells, s_start, s_items, HT, HI, HN, st, world
@@ -631,7 +659,7 @@ def _run(
                 continue
             k = _first_of_instant(HT, HI, st, N, stack)
             rank, a, b, code = _unkey(HI[k, HKEY])
-            room = _room_needed(rank, a, b, HT, st, N, cells, s_start, world)
+            room = _room_needed(rank, a, b, HT, st, N, cells, s_start, world) + extra_room
             if HT.shape[0] - st[_HEAP_N] < room:
                 if _compact(HT, HI, HN, st, N) < room:
                     return STATUS_HEAP_FULL
@@ -657,6 +685,30 @@ def _run(
                     st[_LOGGED] += 1
             for k in range(n_jobs):
                 _predict(jobs, k, t, F, N, C, cells, s_start, s_items, HT, HI, HN, st, world)
+            if everyone and n_jobs > 0:
+                for i in range(F.shape[0]):
+                    if (
+                        N[i, STATIC] == 0
+                        and i != jobs[0, J_OBJ]
+                        and (n_jobs < 2 or i != jobs[1, J_OBJ])
+                    ):
+                        _job(jobs, J_EXTRA, i, N[i, PARTNER], JOB_CONTACTS)
+                        _predict(
+                            jobs,
+                            J_EXTRA,
+                            t,
+                            F,
+                            N,
+                            C,
+                            cells,
+                            s_start,
+                            s_items,
+                            HT,
+                            HI,
+                            HN,
+                            st,
+                            world,
+                        )
         stf[_T_NOW] = t_end
         st[_TICK] = tick
         st[_TICK_EVENTS] = 0
@@ -674,6 +726,7 @@ class Model:
         geometry: str | None = None,
         max_events_per_tick: int = MAX_EVENTS_PER_TICK,
         cell_size: float | None = None,
+        repredict: str = "touched",
     ):
         if int(substeps) != substeps or substeps < 1:
             raise ValueError(f"substeps must be a whole number >= 1, got {substeps!r}")
@@ -686,6 +739,9 @@ class Model:
             raise ValueError(f"the exact model handles fewer than {MAX_OBJECTS} objects")
         if cell_size is not None and not cell_size > 0:
             raise ValueError(f"cell_size must be > 0 px, got {cell_size!r}")
+        if repredict not in REPREDICT:
+            raise ValueError(f"repredict must be one of {REPREDICT}, got {repredict!r}")
+        self.repredict = repredict
         self.world = world
         self.geometry = geometry
         self.max_events_per_tick = int(max_events_per_tick)
@@ -699,7 +755,8 @@ class Model:
         self._F[:, VX : VY + 1] = np.where(static[:, None], 0.0, bodies.vel)
         self._F[:, SW : SH + 1] = bodies.size
         self._F[:, INV_MASS] = bodies.inv_mass
-        self._N = np.zeros((n, 7), np.int64)
+        self._N = np.zeros((n, 8), np.int64)
+        self._N[:, PARTNER] = -1
         self._N[:, STATIC] = static
         self._N[:, SHAPE] = cores.shape
         self._C = (cores.radius, cores.start, cores.verts, cores.normals)
@@ -720,7 +777,7 @@ class Model:
         self._heap = [np.empty(cap), np.empty((cap, 3), np.int64), np.empty((cap, 2))]
         self._st = np.zeros(6, np.int64)
         self._stf = np.zeros(1)
-        self._jobs = np.zeros((2, 3), np.int64)  # scratch: the prediction jobs of one event
+        self._jobs = np.zeros((JOB_ROWS, 3), np.int64)  # scratch: the prediction jobs of one event
         self._stack = np.zeros(INSTANT_STACK, np.int64)  # scratch: walking one instant's entries
 
     def _state(self):
@@ -742,6 +799,7 @@ class Model:
                 target,
                 bool(log),
                 self.max_events_per_tick,
+                self.repredict == "all",
                 F,
                 N,
                 C,

@@ -21,7 +21,8 @@ pair overlapping now was on the list (each box moved less than the margin), so e
 tests the listed pairs on the current boxes, sorts the few that overlap by (a, b), and takes them
 in that order: exactly the pairs, in exactly the order, of testing every pair. Pairs of two static
 objects are never listed, and with no movable object (or fewer than two objects) the pair stage is
-skipped; the `skip=False` option turns both skips off (for tests and `collide2d bench`).
+skipped; the `skip=False` option turns both skips off, and `broadphase` ("sweep", "grid",
+"cells") forces a method instead of the scene's choice (for tests and `collide2d bench`).
 
 The event log helpers (`log_event`, `event_records`) serve the exact model too.
 """
@@ -29,6 +30,7 @@ The event log helpers (`log_event`, `event_records`) serve the exact model too.
 from __future__ import annotations
 
 import math
+import time
 
 import numpy as np
 from numba import njit
@@ -41,6 +43,7 @@ from engine.broadphase import (
     candidates,
     choose,
     heap_argsort,
+    workspace,
 )
 from engine.contact import box_overlap_axis, penetration
 from engine.events import (
@@ -244,7 +247,7 @@ def _relist(S, margin, method, cell, bp):
     from it (on average more than REORDER_ROWS rows of the grid). Returns (the key buffer, possibly
     grown; how many keys)."""
     pos, vel, size, inv_mass, static, movable, span, ext, rank, anchor = S
-    keys, near, order, lo, hi, folds, state, params = bp
+    keys, near, order, lo, hi, folds, state, params, ws = bp
     n = pos.shape[0]
     for _ in range(2):
         for i in range(n):
@@ -254,7 +257,7 @@ def _relist(S, margin, method, cell, bp):
             hi[i, 1] = pos[i, 1] + size[i, 1] + margin
             anchor[i, 0] = pos[i, 0]
             anchor[i, 1] = pos[i, 1]
-        k = candidates(method, lo, hi, movable, cell, order, keys)
+        k = candidates(method, lo, hi, movable, cell, order, keys, ws)
         if method == METHOD_GRID:
             break
         stray = 0
@@ -265,7 +268,7 @@ def _relist(S, margin, method, cell, bp):
         _reorder(S, order)
     if k > keys.shape[0]:
         keys = np.empty(2 * k, np.int64)
-        k = candidates(method, lo, hi, movable, cell, order, keys)
+        k = candidates(method, lo, hi, movable, cell, order, keys, ws)
     return keys, k
 
 
@@ -373,12 +376,12 @@ def _run(world, substeps, tick0, ticks, log, S, exact, cores, rows, times, bp):
     """Run ticks tick0+1 ... tick0+ticks; returns (event buffers, how many events, candidate
     keys, overlap buffer): the buffers that grew replace the caller's.
 
-    S: the state arrays (see `Model`). bp = (keys, near, order, lo, hi, folds, state, params):
+    S: the state arrays (see `Model`). bp = (keys, near, order, lo, hi, folds, state, params, ws):
     the candidate list kept between calls (see the module docstring) and scratch; state = [keys
     listed (-1: no list yet), method, whether pairs can happen at all]; params = [margin px,
     grid cell px, drift slack px].
     """
-    keys, near, order, lo, hi, folds, state, params = bp
+    keys, near, order, lo, hi, folds, state, params, ws = bp
     pos, size, ext = S[0], S[2], S[7]
     width, height, fps = world
     margin, cell, slack = params[0], params[1], params[2]
@@ -400,11 +403,11 @@ def _run(world, substeps, tick0, ticks, log, S, exact, cores, rows, times, bp):
             # pairs that overlap, in (a, b) order
             if state[0] < 0 or drift >= margin - slack:
                 keys, state[0] = _relist(S, margin, method, cell, bp)
-                bp = (keys, near, order, lo, hi, folds, state, params)
+                bp = (keys, near, order, lo, hi, folds, state, params, ws)
             n_near = _overlapping(pos, size, ext, keys, state[0], near)
             if n_near > near.shape[0]:
                 near = np.empty(2 * n_near, np.int64)
-                bp = (keys, near, order, lo, hi, folds, state, params)
+                bp = (keys, near, order, lo, hi, folds, state, params, ws)
                 n_near = _overlapping(pos, size, ext, keys, state[0], near)
             rows, times, n_ev = _pairs(
                 S, width, height, exact, cores, near, n_near, tick, t, log, rows, times, n_ev
@@ -428,6 +431,7 @@ class Model:
         substeps: int = 1,
         geometry: str | None = None,
         skip: bool = True,
+        broadphase: str | None = None,
     ):
         if int(substeps) != substeps or substeps < 1:
             raise ValueError(f"substeps must be a whole number >= 1, got {substeps!r}")
@@ -460,7 +464,7 @@ class Model:
         )
         cores = build_cores(bodies, geometry)
         self._cores = (cores.shape, cores.radius, cores.start, cores.verts, cores.normals)
-        self._bp = _broad_phase(world, pos, vel, size, movable, substeps, skip)
+        self._bp = _broad_phase(world, pos, vel, size, movable, substeps, skip, broadphase)
 
     def advance(self, ticks: int, log: bool = True) -> np.ndarray:
         """Run `ticks` ticks; the events in the order they happened (empty when log is False)."""
@@ -483,6 +487,61 @@ class Model:
         self.tick += int(ticks)
         return event_records(rows, times, n)
 
+    def profile(self, ticks: int) -> dict[str, float]:
+        """Run `ticks` ticks with the event log off, one stage at a time, and return the seconds
+        spent in each: "move" (motion and walls), "broad" (making the candidate list), "narrow"
+        (testing the listed pairs), "response" (exchange and separation). The state ends exactly
+        as `advance(ticks, log=False)` would leave it. Each stage is timed from Python, so each
+        count includes a call's overhead (microseconds), which dominates in small scenes."""
+        width, height, fps = float(self.world.width), float(self.world.height), self.world.fps
+        keys, near, order, lo, hi, folds, state, params, ws = self._bp
+        margin, cell, slack = float(params[0]), float(params[1]), float(params[2])
+        dt = 1.0 / (fps * self.substeps)
+        exact = self.geometry == "exact"
+        rows, times = new_log(False)
+        spent = {"move": 0.0, "broad": 0.0, "narrow": 0.0, "response": 0.0}
+        clock = time.perf_counter
+        for tick in range(self.tick + 1, self.tick + int(ticks) + 1):
+            t = tick / fps
+            for _ in range(self.substeps):
+                t0 = clock()
+                n_folds, drift = _move_walls(self._S, dt, folds)
+                t1 = clock()
+                spent["move"] += t1 - t0
+                if not state[2]:
+                    continue
+                if state[0] < 0 or drift >= margin - slack:
+                    bp = (keys, near, order, lo, hi, folds, state, params, ws)
+                    keys, state[0] = _relist(self._S, margin, state[1], cell, bp)
+                t2 = clock()
+                n_near = _overlapping(self._S[0], self._S[2], self._S[7], keys, state[0], near)
+                if n_near > near.shape[0]:
+                    near = np.empty(2 * n_near, np.int64)
+                    n_near = _overlapping(self._S[0], self._S[2], self._S[7], keys, state[0], near)
+                t3 = clock()
+                _pairs(
+                    self._S,
+                    width,
+                    height,
+                    exact,
+                    self._cores,
+                    near,
+                    n_near,
+                    tick,
+                    t,
+                    False,
+                    rows,
+                    times,
+                    0,
+                )
+                t4 = clock()
+                spent["broad"] += t2 - t1
+                spent["narrow"] += t3 - t2
+                spent["response"] += t4 - t3
+        self._bp = (keys, near, order, lo, hi, folds, state, params, ws)
+        self.tick += int(ticks)
+        return spent
+
     def positions(self) -> np.ndarray:
         """(n, 2) float64 top-left corners, px."""
         return self._by_id(self._S[0])
@@ -497,16 +556,16 @@ class Model:
         return out
 
 
-def _broad_phase(world, pos, vel, size, movable, substeps, skip):
+def _broad_phase(world, pos, vel, size, movable, substeps, skip, broadphase):
     """The candidate list's state and scratch (see `_run`): its margin from the fastest step and
-    the box sizes, the method and cell from the scene (broadphase.choose)."""
+    the box sizes, the method and cell from the scene or `broadphase` (broadphase.choose)."""
     n = pos.shape[0]
     possible = n >= 2 and (bool(movable.any()) or not skip)
     fastest = float(np.abs(vel).max()) / (world.fps * substeps) if n else 0.0
     median_side = float(np.median(size.max(axis=1))) if n else 1.0
     margin = min(MARGIN_STEPS * fastest, MARGIN_MAX_SIDES * median_side)
     margin = max(margin, MARGIN_MIN_PX) if np.isfinite(margin) else MARGIN_MIN_PX
-    method, cell = choose(world.width, world.height, size + 2.0 * margin)
+    method, cell = choose(world.width, world.height, size + 2.0 * margin, broadphase)
     slack = DRIFT_SLACK_PX + DRIFT_SLACK_REL * max(world.width, world.height)
     order = np.arange(n, dtype=np.int64)
     if method == METHOD_SWEEP:
@@ -520,4 +579,5 @@ def _broad_phase(world, pos, vel, size, movable, substeps, skip):
         np.empty((2 * n, 4), np.int64),  # folds
         np.array([-1, method, int(possible)], np.int64),
         np.array([margin, cell, slack]),
+        workspace(n),
     )

@@ -316,3 +316,67 @@ def test_refuses_fractional_positions_and_other_geometry():
         model([[1.5, 2]], 10, [[0, 0]])
     with pytest.raises(ValueError, match="geometry"):
         Model(WorldSpec(100, 100, 10), Bodies.boxes([[0, 0]], 10, [[0, 0]]), geometry="exact")
+
+
+# --- every broad phase, the skips and the resumable kernel change nothing
+
+
+@settings(max_examples=15, deadline=None)
+@given(scene, st.sampled_from(["sweep", "grid", "cells"]), st.booleans())
+def test_every_broad_phase_and_no_skip_equal_the_reference(data, broadphase, skip):
+    cells, size, vel, static = data
+    pos = [[6 * cx, 6 * cy] for cx, cy in cells]
+    vel = [[0, 0] if s else list(v) for v, s in zip(vel, static, strict=True)]
+    world = (306, 222)
+    ref_pos, ref_step, ref_log = reference(pos, size, vel, 10, world, 60, static)
+    bodies = Bodies.boxes(pos, size, vel, static=static)
+    m = Model(WorldSpec(*world, 10), bodies, broadphase=broadphase, skip=skip)
+    assert logged(m.advance(60)) == ref_log
+    assert m.positions().astype(int).tolist() == ref_pos
+    assert m.step.tolist() == ref_step
+
+
+def test_a_crowd_in_a_wide_world_agrees_across_methods_and_chunks():
+    # 3,000 boxes in a wide world (the scene picks the grid); big steps at 60 fps make the list
+    # anew nearly every tick; events large enough to outgrow the buffers several times
+    rng = np.random.default_rng(12)
+    n = 3000
+    cells = rng.choice(150 * 110, size=n, replace=False)
+    pos = np.stack([cells % 150 * 12, cells // 150 * 12], axis=1)
+    vel = rng.integers(-100, 101, size=(n, 2))
+    bodies = Bodies.boxes(pos, 10, vel)
+    world = WorldSpec(1800, 1320, 60)
+    runs = []
+    for broadphase in (None, "sweep", "grid", "cells"):
+        m = Model(world, bodies, broadphase=broadphase)
+        events = m.advance(150)
+        runs.append((events.tobytes(), m.pos.tobytes(), m.step.tobytes()))
+    m = Model(world, bodies)
+    events = np.concatenate([m.advance(k) for k in (1, 1, 48, 100)])
+    runs.append((events.tobytes(), m.pos.tobytes(), m.step.tobytes()))
+    assert all(r == runs[0] for r in runs)
+    assert len(events) > 2000
+
+
+def test_static_pairs_are_skipped_and_a_frozen_scene_has_no_pair_stage():
+    # two static boxes that overlap would flip nothing but log a pair each tick; they are never
+    # paired, while skip=False pairs them
+    pos = [[10, 10], [15, 12], [100, 100]]
+    bodies = Bodies.boxes(pos, 10, [[0, 0], [0, 0], [10, 0]], static=[True, True, False])
+    world = WorldSpec(320, 240, 10)
+    assert pairs_of(Model(world, bodies).advance(5)) == []
+    assert len(pairs_of(Model(world, bodies, skip=False).advance(5))) == 5
+
+
+def test_profile_runs_the_same_ticks_as_advance():
+    rng = np.random.default_rng(4)
+    cells = rng.choice(30 * 20, size=120, replace=False)
+    pos = np.stack([cells % 30 * 10, cells // 30 * 10], axis=1)
+    vel = rng.choice([-30, -10, 10, 20, 30], size=(120, 2))
+    bodies = Bodies.boxes(pos, 8, vel)
+    a, b = Model(WorldSpec(300, 200, 10), bodies), Model(WorldSpec(300, 200, 10), bodies)
+    a.advance(80, log=False)
+    spent = b.profile(80)
+    assert set(spent) == {"move", "broad", "narrow", "response"} and b.tick == 80
+    assert a.pos.tolist() == b.pos.tolist() and a.step.tolist() == b.step.tolist()
+    assert logged(a.advance(30)) == logged(b.advance(30))
