@@ -581,3 +581,41 @@ def static_cells(pos, size, static, cell, nx, ny):
                     items[fill[c]] = i
                     fill[c] += 1
     return start, items
+
+
+# Pair-key lists up to this long are sorted by insertion, faster than a heap sort there.
+INSERTION_SORT_MAX = 64
+
+
+@njit(cache=True)
+def sort_keys(keys, n):
+    """Sort keys[:n] in place, allocating nothing: insertion sort for the usual handful (the
+    pairs that overlap in one step), a heap sort past INSERTION_SORT_MAX."""
+    if n > INSERTION_SORT_MAX:
+        for root in range(n // 2 - 1, -1, -1):
+            _sift_keys(keys, root, n)
+        for end in range(n - 1, 0, -1):
+            keys[0], keys[end] = keys[end], keys[0]
+            _sift_keys(keys, 0, end)
+        return
+    for i in range(1, n):
+        key = keys[i]
+        j = i - 1
+        while j >= 0 and keys[j] > key:
+            keys[j + 1] = keys[j]
+            j -= 1
+        keys[j + 1] = key
+
+
+@njit(cache=True)
+def _sift_keys(keys, root, n):
+    while True:
+        c = 2 * root + 1
+        if c >= n:
+            return
+        if c + 1 < n and keys[c + 1] > keys[c]:
+            c += 1
+        if keys[root] >= keys[c]:
+            return
+        keys[root], keys[c] = keys[c], keys[root]
+        root = c

@@ -39,7 +39,7 @@ import time
 import numpy as np
 from numba import njit
 
-from engine.broadphase import KEY_MASK, KEY_SHIFT, candidates, choose, workspace
+from engine.broadphase import KEY_MASK, KEY_SHIFT, candidates, choose, sort_keys, workspace
 from engine.events import (
     AXIS_X,
     AXIS_XY,
@@ -60,8 +60,6 @@ _TICK, _TYPE, _A, _B, _CODE, _XDIFF, _YDIFF = range(7)
 _EVENT_COLS = 7
 # Room for events and candidate pairs before the buffers grow (rows; they double when full).
 _INITIAL_ROWS = 1024
-# Lists of near pairs up to this long are sorted by insertion (faster there), longer by heap sort.
-_INSERTION_SORT_MAX = 64
 # The candidate list is made with every reach box grown by a margin (px) and kept until some object
 # has drifted that far from where it was made: a few of the fastest steps, within these bounds.
 _MARGIN_STEPS = 8
@@ -149,39 +147,6 @@ def _relist(pos, size, disp, movable, margin, method, cell, order, lo, hi, keys,
     return candidates(method, lo, hi, movable, cell, order, keys, ws)
 
 
-@njit(cache=True)
-def _sort_keys(keys, n):
-    """Sort keys[:n] in place: insertion sort for the usual handful, heap sort past that."""
-    if n > _INSERTION_SORT_MAX:
-        for root in range(n // 2 - 1, -1, -1):
-            _sift(keys, root, n)
-        for end in range(n - 1, 0, -1):
-            keys[0], keys[end] = keys[end], keys[0]
-            _sift(keys, 0, end)
-        return
-    for i in range(1, n):
-        key = keys[i]
-        j = i - 1
-        while j >= 0 and keys[j] > key:
-            keys[j + 1] = keys[j]
-            j -= 1
-        keys[j + 1] = key
-
-
-@njit(cache=True)
-def _sift(keys, root, n):
-    while True:
-        c = 2 * root + 1
-        if c >= n:
-            return
-        if c + 1 < n and keys[c + 1] > keys[c]:
-            c += 1
-        if keys[root] >= keys[c]:
-            return
-        keys[root], keys[c] = keys[c], keys[root]
-        root = c
-
-
 @njit(cache=True, inline="always")
 def _near(pos, size, disp, keys, n_keys, near):
     """The listed pairs whose reach boxes overlap now, into `near` (as long as `keys`), sorted by
@@ -199,7 +164,7 @@ def _near(pos, size, disp, keys, n_keys, near):
             meet &= (lo_b < lo_a + abs(da) + size[a, ax]) & (lo_a < lo_b + abs(db) + size[b, ax])
         near[k] = keys[c]
         k += meet
-    _sort_keys(near, k)
+    sort_keys(near, k)
     return k
 
 

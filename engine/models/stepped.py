@@ -43,6 +43,7 @@ from engine.broadphase import (
     candidates,
     choose,
     heap_argsort,
+    sort_keys,
     workspace,
 )
 from engine.contact import box_overlap_axis, penetration
@@ -73,8 +74,6 @@ DRIFT_SLACK_PX = 1e-6
 DRIFT_SLACK_REL = 1e-12
 # Candidate slots to start with per object (the buffers double when full).
 CANDIDATES_PER_OBJECT = 4
-# Lists of overlapping pairs up to this long are sorted by insertion (faster there).
-INSERTION_SORT_MAX = 32
 # The objects inside are put back in the broad phase's order once they have strayed from it by
 # more than this many rows of the grid on average (a row holds about sqrt(n) objects in a
 # squarish world; see the kernels' section).
@@ -273,21 +272,6 @@ def _relist(S, margin, method, cell, bp):
 
 
 @njit(cache=True)
-def _sort_keys(keys):
-    """Sort in place: insertion sort for the usual handful, a heap sort past that."""
-    if keys.shape[0] > INSERTION_SORT_MAX:
-        keys[:] = keys[heap_argsort(keys.copy())]
-        return
-    for i in range(1, keys.shape[0]):
-        key = keys[i]
-        j = i - 1
-        while j >= 0 and keys[j] > key:
-            keys[j + 1] = keys[j]
-            j -= 1
-        keys[j + 1] = key
-
-
-@njit(cache=True)
 def _overlapping(pos, size, ext, keys, n_keys, near):
     """The listed pairs whose boxes overlap now with positive area, as keys of object ids
     ascending, written to `near` when they fit; returns how many (the caller grows `near` and
@@ -309,7 +293,7 @@ def _overlapping(pos, size, ext, keys, n_keys, near):
                 near[k] = (min(ea, eb) << KEY_SHIFT) | max(ea, eb)
             k += 1
     if k <= room:
-        _sort_keys(near[:k])
+        sort_keys(near, k)
     return k
 
 
