@@ -136,6 +136,33 @@ class _StreamFile:
             _remove(self.tmp)
 
 
+class _StreamWriter:
+    """A writer streaming into one _StreamFile (`self._file`): `close` renames the file into place,
+    `abort` removes it; as a context manager it closes on success and aborts on an exception."""
+
+    _file: _StreamFile
+
+    @property
+    def path(self) -> Path:
+        return self._file.path
+
+    def close(self) -> None:
+        self._file.commit()
+
+    def abort(self) -> None:
+        """Drop the unfinished file; an older file at `path` stays as it was."""
+        self._file.abort()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        if exc_type is None:
+            self.close()
+        else:
+            self.abort()
+
+
 def clean_temporaries(folder: str | os.PathLike) -> int:
     """Remove temporary files this module left in `folder` (not below it) after a killed run.
 
@@ -253,7 +280,7 @@ def _gif_palette(palette: np.ndarray) -> bytes:
     return table.tobytes()
 
 
-class GifWriter:
+class GifWriter(_StreamWriter):
     """Streams an animated GIF of palette-index frames to `path`, one frame at a time.
 
     palette (k, 3) uint8 with 1 <= k <= 256 is the scenario's palette; frames are (height, width)
@@ -307,10 +334,6 @@ class GifWriter:
             self._file.abort()
             raise
 
-    @property
-    def path(self) -> Path:
-        return self._file.path
-
     def _image(self, frame: np.ndarray) -> Image.Image:
         data = np.ascontiguousarray(enlarge(frame, self.scale))
         im = Image.frombuffer("P", self._size, data, "raw", "P", 0, 1)
@@ -362,25 +385,12 @@ class GifWriter:
         self._file.write(b";")
         self._file.commit()
 
-    def abort(self) -> None:
-        """Drop the unfinished GIF; an older file at `path` stays as it was."""
-        self._file.abort()
-
-    def __enter__(self) -> GifWriter:
-        return self
-
-    def __exit__(self, exc_type, exc, tb) -> None:
-        if exc_type is None:
-            self.close()
-        else:
-            self.abort()
-
 
 # --------------------------------------------------------------------------------------------
 # Text outputs
 
 
-class EventsWriter:
+class EventsWriter(_StreamWriter):
     """Streams events.jsonl: one `engine.events.format_event` line per event, in the order given.
 
     `write(events)` appends an EVENT_DTYPE array; `close` renames the file into place, `abort`
@@ -391,31 +401,12 @@ class EventsWriter:
         self._file = _StreamFile(path)
         self.count = 0
 
-    @property
-    def path(self) -> Path:
-        return self._file.path
-
     def write(self, events: np.ndarray) -> None:
         if len(events) == 0:
             return
         text = "".join(format_event(rec) + "\n" for rec in events)
         self._file.write(text.encode("utf-8"))
         self.count += len(events)
-
-    def close(self) -> None:
-        self._file.commit()
-
-    def abort(self) -> None:
-        self._file.abort()
-
-    def __enter__(self) -> EventsWriter:
-        return self
-
-    def __exit__(self, exc_type, exc, tb) -> None:
-        if exc_type is None:
-            self.close()
-        else:
-            self.abort()
 
 
 def final_csv_text(pos: np.ndarray, vel: np.ndarray) -> str:
