@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 import pytest
+from engine_refs import pixel_corners, ref_hull
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -31,32 +32,6 @@ from engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON
 INF = math.inf
 
 # --- independent references ---------------------------------------------------------------------
-
-
-def ref_hull(points):
-    """Convex hull (positive order, no collinear points) by a plain monotone chain."""
-    pts = sorted(set(map(tuple, np.asarray(points, float).tolist())))
-    if len(pts) < 3:
-        return np.array(pts)
-
-    def cross(o, a, b):
-        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-
-    lower, upper = [], []
-    for p in pts:
-        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
-            lower.pop()
-        lower.append(p)
-    for p in reversed(pts):
-        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
-            upper.pop()
-        upper.append(p)
-    return np.array(lower[:-1] + upper[:-1])
-
-
-def pixel_corners(verts):
-    v = np.asarray(verts, float)
-    return (v[:, None, :] + np.array([[0, 0], [1, 0], [0, 1], [1, 1]])[None]).reshape(-1, 2)
 
 
 def strictly_inside(poly, p):

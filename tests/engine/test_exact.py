@@ -9,6 +9,7 @@ from fractions import Fraction
 
 import numpy as np
 import pytest
+from engine_refs import pixel_corners, random_boxes, ref_hull
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
@@ -30,18 +31,6 @@ from engine.models.exact import MAX_EVENTS_PER_TICK, EventCapExceeded
 from engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies, WorldSpec, kinetic_energy
 
 # --- helpers --------------------------------------------------------------------------------------
-
-
-def random_boxes(n, seed, world, size=8.0, speed=60.0, mass_range=(0.2, 5.0)):
-    """n boxes on a jittered grid (no overlap), random velocities and masses."""
-    rng = np.random.default_rng(seed)
-    k = int(np.ceil(np.sqrt(n)))
-    pitch = np.array([world.width, world.height]) / k
-    idx = np.arange(n)
-    cells = np.stack([idx % k, idx // k], axis=1)
-    pos = cells * pitch + rng.uniform(0, 1, (n, 2)) * (pitch - size)
-    vel = rng.uniform(-speed, speed, (n, 2))
-    return Bodies.boxes(pos, size, vel, mass=rng.uniform(*mass_range, n))
 
 
 def shapes(kind, pos, size, vel, mass=None, polys=None, static=None):
@@ -68,30 +57,6 @@ def shapes(kind, pos, size, vel, mass=None, polys=None, static=None):
         vert_start=np.array(starts, np.int64),
         verts=np.array(verts, np.int64).reshape(-1, 2),
     )
-
-
-def ref_hull(points):
-    """Convex hull (positive order, no collinear points) by a plain monotone chain."""
-    pts = sorted(set(map(tuple, np.asarray(points, float).tolist())))
-
-    def cross(o, a, b):
-        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-
-    lower, upper = [], []
-    for p in pts:
-        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
-            lower.pop()
-        lower.append(p)
-    for p in reversed(pts):
-        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
-            upper.pop()
-        upper.append(p)
-    return np.array(lower[:-1] + upper[:-1])
-
-
-def pixel_corners(verts):
-    v = np.asarray(verts, float)
-    return (v[:, None, :] + np.array([[0, 0], [1, 0], [0, 1], [1, 1]])[None]).reshape(-1, 2)
 
 
 def distance_to_boundary(poly, p):

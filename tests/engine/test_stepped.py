@@ -3,6 +3,7 @@ the broad phase and skips changing nothing against a plain all-pairs version of 
 
 import numpy as np
 import pytest
+from engine_refs import random_boxes
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -28,18 +29,6 @@ def boxes_overlap(pos, size):
 def inside(model, bodies, world):
     p = model.positions()
     return bool((p >= 0).all() and (p + bodies.size <= [world.width, world.height]).all())
-
-
-def random_boxes(n, seed, world, size=8.0, speed=60.0, mass_range=(0.2, 5.0)):
-    """n boxes on a jittered grid (no overlap), random velocities and masses."""
-    rng = np.random.default_rng(seed)
-    k = int(np.ceil(np.sqrt(n)))
-    pitch = np.array([world.width, world.height]) / k
-    idx = np.arange(n)
-    cells = np.stack([idx % k, idx // k], axis=1)
-    pos = cells * pitch + rng.uniform(0, 1, (n, 2)) * (pitch - size)
-    vel = rng.uniform(-speed, speed, (n, 2))
-    return Bodies.boxes(pos, size, vel, mass=rng.uniform(*mass_range, n))
 
 
 def test_tunnelling_at_one_fps_passes_through_without_a_collision():
