@@ -7,16 +7,9 @@ order), the palette, the output and golden settings. Any problem raises `Scenari
 is `FILE:LINE:COL: error: MESSAGE` (1-based) and points at the offending YAML node. Nothing large is
 allocated before every count has been checked against `Limits`.
 
-Reading goes in three steps. (1) The text is streamed as YAML events (iteratively, so no nesting can
-exhaust a stack): nesting deeper than `MAX_YAML_DEPTH`, a second document, a YAML tag outside the
-plain core types (`!!python/...` and the like) and aliases are checked there; every alias adds the
-size of the node it repeats to a count, and past `Limits.max_alias_nodes` the file is refused at
-that alias, so a "billion laughs" file costs no more than its own length; the file's size
-(`Limits.max_file_bytes`, checked before it is read whole) and its count of YAML values
-(`Limits.max_yaml_nodes`, before any is built) bound the memory the next step takes. (2)
-`yaml.compose` with the safe loader (libyaml's when available) builds the node tree. (3) The tree
-is walked by hand, so every value is checked where it stands and every error carries its node's
-place.
+Reading goes in two steps: `runner.yamlsafe` turns the text into a node tree within the bounds of
+`Limits` (safe tags only, depth, aliases, size, value count); then the tree is walked by hand, so
+every value is checked where it stands and every error carries its node's place.
 
 Values follow YAML 1.1 as PyYAML reads it (`yes` is a boolean, `0x1f` an integer), with one
 addition: an unquoted number in exponent form such as `1e3` or `1.5E-7`, a string to YAML 1.1, is
@@ -56,6 +49,8 @@ from engine.models import MODEL_NAMES
 from engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies, WorldSpec
 from runner import colors
 from runner import generate as gen
+from runner import yamlsafe as ys
+from runner.yamlsafe import ScenarioError
 
 FORMAT_VERSION = 1
 DEFAULT_WIDTH = 320  # px
@@ -68,8 +63,6 @@ DEFAULT_COLOR = (255, 255, 255)
 DEFAULT_MASS = 1.0  # mass units
 MAX_SPEED = 1e9  # px/s, largest velocity component (a larger one crosses any world in a tick)
 MAX_SUBSTEPS = 10_000  # substeps per tick of the stepped model
-MAX_YAML_DEPTH = 64  # nesting levels of YAML collections
-READ_CHUNK_BYTES = 2**16  # a scenario file is read in pieces of this many bytes
 MAX_POINT_OFFSET = 2**24  # px, largest |coordinate| of a polygon point relative to its position
 MAX_NAME_LENGTH = 100  # characters in a scenario name (it names a folder)
 PALETTE_SIZE = 256  # palette rows: the background and up to 255 object colours
@@ -81,14 +74,8 @@ GEOMETRIES = ("box", "exact")
 FRAME_WORDS = ("all", "none", "last")
 
 _NAME_RE = re.compile(NAME_PATTERN + r"\Z")
-_FLOAT12_RE = re.compile(r"[-+]?(\.[0-9]+|[0-9]+(\.[0-9]*)?)[eE][-+]?[0-9]+\Z")
-_CORE = "tag:yaml.org,2002:"
-_ALLOWED_TAGS = {_CORE + t for t in ("str", "int", "float", "bool", "null", "seq", "map")}
-_CONSTRUCTED_TAGS = {_CORE + t for t in ("int", "float", "bool")}  # a tagged text may not fit
 _KIND_OF_SHAPE = {"box": KIND_BOX, "circle": KIND_CIRCLE, "polygon": KIND_POLYGON}
 _SIZE_KEY = {"box": "size", "circle": "diameter", "polygon": "points"}
-_CONSTRUCTOR = yaml.constructor.SafeConstructor()
-_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
 TOP_KEYS = (
     "version",
@@ -137,20 +124,6 @@ EVERY_KEYS = ("every",)
 OUTPUT_KEYS = ("frames", "gif", "events")
 GOLDEN_KEYS = ("frames", "time_tolerance", "max_diff_pixels", "color_threshold")
 OVERRIDE_KEYS = ("model", "fps", "ticks")
-
-
-class ScenarioError(Exception):
-    """A scenario refused, located: str(err) == f"{path}:{line}:{col}: error: {message}"."""
-
-    def __init__(self, path, line, col, message):
-        super().__init__(str(path), int(line), int(col), str(message))
-        self.path = str(path)
-        self.line = int(line)
-        self.col = int(col)
-        self.message = str(message)
-
-    def __str__(self) -> str:
-        return f"{self.path}:{self.line}:{self.col}: error: {self.message}"
 
 
 @dataclass(frozen=True)
@@ -209,19 +182,7 @@ def load(path, *, overrides: dict | None = None, limits: Limits | None = None) -
     """Read and check the scenario file at `path` (str or os.PathLike); ScenarioError if bad."""
     shown = os.fspath(path)
     limits = limits if limits is not None else Limits()
-    chunks: list[bytes] = []
-    size = 0
-    try:
-        with open(path, "rb") as f:
-            while chunk := f.read(READ_CHUNK_BYTES):  # in pieces: an endless file stops here
-                size += len(chunk)
-                _check_length(size, shown, limits)
-                chunks.append(chunk)
-    except OSError as exc:
-        raise ScenarioError(shown, 1, 1, f"cannot read the file: {exc.strerror or exc}") from None
-    data = b"".join(chunks)
-    text = _decode(data, shown)
-    digest = hashlib.sha256(data).hexdigest()
+    text, digest = ys.read_file(path, limits)
     return _Reader(shown, shown, overrides, limits).scenario(text, digest)
 
 
@@ -231,203 +192,9 @@ def loads(text: str, path: str = "<string>", *, overrides=None, limits=None) -> 
     Without a `name`, text read under the default path is named NAME_FOR_TEXT.
     """
     limits = limits if limits is not None else Limits()
-    _check_length(len(text), path, limits)  # characters: never more than the UTF-8 bytes
+    ys.check_length(len(text), path, limits)  # characters: never more than the UTF-8 bytes
     digest = hashlib.sha256(text.encode("utf-8", "surrogatepass")).hexdigest()
     return _Reader(path, None, overrides, limits).scenario(text, digest)
-
-
-def _check_length(length: int, path: str, limits: Limits) -> None:
-    if length > limits.max_file_bytes:
-        raise ScenarioError(
-            path,
-            1,
-            1,
-            f"the file is larger than the limit of {limits.max_file_bytes:,} bytes; "
-            "raise it with --max-file-bytes",
-        )
-
-
-# ----------------------------------------------------------------------------- reading YAML
-
-
-def _decode(data: bytes, path: str) -> str:
-    """The file's text (UTF-8, an initial byte-order mark dropped); a located error otherwise."""
-    try:
-        return data.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        start = exc.start
-        line = data.count(b"\n", 0, start) + 1
-        line_start = data.rfind(b"\n", 0, start) + 1
-        col = len(data[line_start:start].decode("utf-8", "replace")) + 1
-        if line_start == 0 and data.startswith(b"\xef\xbb\xbf"):
-            col -= 1
-        raise ScenarioError(
-            path, line, col, f"the file is not UTF-8 text (byte 0x{data[start]:02x} here)"
-        ) from None
-
-
-def _mark_error(path: str, mark, message: str) -> ScenarioError:
-    if mark is None:
-        return ScenarioError(path, 1, 1, message)
-    return ScenarioError(path, mark.line + 1, mark.column + 1, message)
-
-
-def _yaml_error(exc: yaml.YAMLError, path: str, text: str) -> ScenarioError:
-    """A PyYAML error as a located ScenarioError."""
-    if isinstance(exc, yaml.reader.ReaderError):
-        index = text.find(chr(exc.character)) if isinstance(exc.character, int) else -1
-        index = exc.position if index < 0 else index
-        line = text.count("\n", 0, index) + 1
-        col = index - (text.rfind("\n", 0, index) + 1) + 1
-        char = exc.character if isinstance(exc.character, int) else 0
-        return ScenarioError(path, line, col, f"invalid character U+{char:04X} in YAML text")
-    if isinstance(exc, yaml.MarkedYAMLError):
-        mark = exc.problem_mark or exc.context_mark
-        problem = exc.problem or "unexpected text"
-        context = f" ({exc.context})" if exc.context else ""
-        return _mark_error(path, mark, f"invalid YAML{context}: {problem}")
-    return ScenarioError(path, 1, 1, f"invalid YAML: {exc}")
-
-
-def _tag_name(tag: str) -> str:
-    return "!!" + tag[len(_CORE) :] if tag.startswith(_CORE) else tag
-
-
-def _check_events(text: str, path: str, limits: Limits) -> None:
-    """Stream the YAML events once: depth, one document, plain tags, and the alias bound."""
-    sizes: dict[str, int] = {}  # anchor -> nodes in the node it names, aliases expanded
-    stack: list[list] = []  # per open collection: [nodes so far, anchor]
-    repeated = 0  # nodes reached again through aliases
-    nodes = 0  # nodes written out in the text
-    documents = 0
-
-    def add(n: int) -> None:
-        if stack:
-            stack[-1][0] += n
-
-    try:
-        for ev in yaml.parse(text, Loader=_LOADER):
-            if isinstance(ev, yaml.DocumentStartEvent):
-                documents += 1
-                if documents > 1:
-                    raise _mark_error(
-                        path,
-                        ev.start_mark,
-                        "a scenario file holds one YAML document; this is a second one",
-                    )
-            elif isinstance(ev, yaml.AliasEvent):
-                n = sizes.get(ev.anchor)
-                if n is None:
-                    inside = any(entry[1] == ev.anchor for entry in stack)
-                    what = "refers to a node that contains it" if inside else "has no anchor"
-                    raise _mark_error(path, ev.start_mark, f"alias '*{ev.anchor}' {what}")
-                repeated += n
-                if repeated > limits.max_alias_nodes:
-                    raise _mark_error(
-                        path,
-                        ev.start_mark,
-                        f"aliases repeat more than {limits.max_alias_nodes} YAML nodes "
-                        f"(alias '*{ev.anchor}' repeats {n}); refusing to expand them",
-                    )
-                add(n)
-            elif isinstance(ev, yaml.NodeEvent) and not isinstance(ev, yaml.CollectionEndEvent):
-                tag = getattr(ev, "tag", None)
-                nodes += 1
-                if nodes > limits.max_yaml_nodes:
-                    raise _mark_error(
-                        path,
-                        ev.start_mark,
-                        f"the file holds more than {limits.max_yaml_nodes:,} YAML values, the "
-                        "limit; raise it with --max-yaml-nodes",
-                    )
-                if tag is not None and tag not in _ALLOWED_TAGS:
-                    raise _mark_error(
-                        path,
-                        ev.start_mark,
-                        f"YAML tag '{_tag_name(tag)}' is not "
-                        "allowed; a scenario holds plain values only",
-                    )
-                if isinstance(ev, yaml.ScalarEvent):
-                    if tag in _CONSTRUCTED_TAGS:
-                        _check_tagged(ev, tag, path)
-                    if ev.anchor is not None:
-                        sizes[ev.anchor] = 1
-                    add(1)
-                else:
-                    stack.append([1, ev.anchor])
-                    if len(stack) > MAX_YAML_DEPTH:
-                        raise _mark_error(
-                            path,
-                            ev.start_mark,
-                            f"YAML nested more than {MAX_YAML_DEPTH} levels deep",
-                        )
-            elif isinstance(ev, yaml.CollectionEndEvent):
-                n, anchor = stack.pop()
-                if anchor is not None:
-                    sizes[anchor] = n
-                add(n)
-    except yaml.YAMLError as exc:
-        raise _yaml_error(exc, path, text) from None
-
-
-def _check_tagged(ev, tag: str, path: str) -> None:
-    """A scalar with an explicit `!!int`, `!!float` or `!!bool` tag must be such a value."""
-    try:
-        _value(yaml.ScalarNode(tag, ev.value, style=ev.style))
-    except (ValueError, KeyError, IndexError, TypeError):
-        raise _mark_error(
-            path, ev.start_mark, f"{ev.value!r} is not a valid {_tag_name(tag)} value"
-        ) from None
-
-
-def _compose(text: str, path: str, limits: Limits) -> yaml.Node:
-    _check_events(text, path, limits)
-    try:
-        root = yaml.compose(text, Loader=_LOADER)
-    except yaml.YAMLError as exc:
-        raise _yaml_error(exc, path, text) from None
-    if root is None:
-        raise ScenarioError(path, 1, 1, "the file is empty; a scenario starts with 'version: 1'")
-    return root
-
-
-# ----------------------------------------------------------------------------- scalar values
-
-
-def _plain(node) -> bool:
-    return node.style in (None, "")
-
-
-def _value(node):
-    """The Python value of a scalar node (str, int, float, bool or None)."""
-    tag = node.tag
-    if tag == _CORE + "int":
-        return _CONSTRUCTOR.construct_yaml_int(node)
-    if tag == _CORE + "float":
-        return _CONSTRUCTOR.construct_yaml_float(node)
-    if tag == _CORE + "bool":
-        return _CONSTRUCTOR.construct_yaml_bool(node)
-    if tag == _CORE + "null":
-        return None
-    if tag == _CORE + "str" and _plain(node) and _FLOAT12_RE.match(node.value):
-        return float(node.value)
-    return node.value  # str, and timestamps, "=" and "<<" read as their text
-
-
-def _describe(node) -> str:
-    """A few words naming what a node holds, for messages."""
-    if isinstance(node, yaml.MappingNode):
-        return "a mapping"
-    if isinstance(node, yaml.SequenceNode):
-        return "a list"
-    v = _value(node)
-    if v is None:
-        return "an empty value"
-    if isinstance(v, bool):
-        return f"the boolean {node.value}"
-    if isinstance(v, (int, float)):
-        return f"{node.value}"
-    return f"the text {v!r}"
 
 
 def _is_number(v) -> bool:
@@ -530,7 +297,7 @@ class _Reader:
 
     def error(self, node, message: str) -> ScenarioError:
         mark = node.start_mark if node is not None else None
-        return _mark_error(self.path, mark, message)
+        return ys.mark_error(self.path, mark, message)
 
     @staticmethod
     def prefix(*origins) -> str:
@@ -541,16 +308,16 @@ class _Reader:
         """{key: (key node, value node)} of a mapping; unknown and repeated keys refused."""
         if not isinstance(node, yaml.MappingNode):
             raise self.error(
-                node, f"{where} must be a mapping of keys to values, not {_describe(node)}"
+                node, f"{where} must be a mapping of keys to values, not {ys.describe(node)}"
             )
         out: dict[str, tuple] = {}
         merged = []
         for knode, vnode in node.value:
-            if isinstance(knode, yaml.ScalarNode) and knode.tag == _CORE + "merge":
+            if isinstance(knode, yaml.ScalarNode) and knode.tag == ys.CORE_TAG + "merge":
                 merged.append(vnode)
                 continue
-            if not isinstance(knode, yaml.ScalarNode) or not isinstance(_value(knode), str):
-                raise self.error(knode, f"keys in {where} must be names, not {_describe(knode)}")
+            if not isinstance(knode, yaml.ScalarNode) or not isinstance(ys.value(knode), str):
+                raise self.error(knode, f"keys in {where} must be names, not {ys.describe(knode)}")
             key = knode.value
             if key in out:
                 first = out[key][0].start_mark.line + 1
@@ -571,33 +338,33 @@ class _Reader:
 
     def seq(self, node, what: str, min_len: int = 0) -> list:
         if not isinstance(node, yaml.SequenceNode):
-            raise self.error(node, f"{what} must be a list, not {_describe(node)}")
+            raise self.error(node, f"{what} must be a list, not {ys.describe(node)}")
         if len(node.value) < min_len:
             raise self.error(node, f"{what} needs at least {min_len} items, not {len(node.value)}")
         return node.value
 
     def scalar(self, node, what: str):
         if not isinstance(node, yaml.ScalarNode):
-            raise self.error(node, f"{what} must be a single value, not {_describe(node)}")
-        return _value(node)
+            raise self.error(node, f"{what} must be a single value, not {ys.describe(node)}")
+        return ys.value(node)
 
     def string(self, node, what: str) -> str:
         v = self.scalar(node, what)
         if not isinstance(v, str):
-            raise self.error(node, f"{what} must be text, not {_describe(node)} (quote it)")
+            raise self.error(node, f"{what} must be text, not {ys.describe(node)} (quote it)")
         return v
 
     def boolean(self, node, what: str) -> bool:
         v = self.scalar(node, what)
         if not isinstance(v, bool):
-            raise self.error(node, f"{what} must be true or false, not {_describe(node)}")
+            raise self.error(node, f"{what} must be true or false, not {ys.describe(node)}")
         return v
 
     def number(self, node, what: str, *, lo=None, hi=None, lo_open=False, unit=""):
         """A finite int or float (ints kept exact) in [lo, hi] (or (lo, hi] with lo_open)."""
         v = self.scalar(node, what)
         if not _is_number(v):
-            raise self.error(node, f"{what} must be a number, not {_describe(node)}")
+            raise self.error(node, f"{what} must be a number, not {ys.describe(node)}")
         if isinstance(v, float) and not math.isfinite(v):
             raise self.error(node, f"{what} must be a finite number, not {node.value}")
         if isinstance(v, int) and abs(v) > 1e300:
@@ -618,7 +385,7 @@ class _Reader:
         if isinstance(v, float) and math.isfinite(v) and v.is_integer():
             v = int(v)
         if not _is_number(v) or not isinstance(v, int):
-            raise self.error(node, f"{what} must be a whole number{of}, not {_describe(node)}")
+            raise self.error(node, f"{what} must be a whole number{of}, not {ys.describe(node)}")
         if lo is not None and v < lo:
             raise self.error(node, f"{what} must be at least {lo}{unit}, not {v}")
         if hi is not None and v > hi:
@@ -637,7 +404,7 @@ class _Reader:
         v = self.scalar(node, what)
         if not isinstance(v, str):
             raise self.error(
-                node, f"{what} must be a colour name, #rrggbb or [r, g, b], not {_describe(node)}"
+                node, f"{what} must be a colour name, #rrggbb or [r, g, b], not {ys.describe(node)}"
             )
         try:
             return colors.parse_color_text(v)
@@ -655,7 +422,7 @@ class _Reader:
     def choice(self, node, what: str, options: tuple[str, ...], origin=None) -> str:
         v = self.scalar(node, what)
         if not isinstance(v, str) or v not in options:
-            shown = f"'{v}'" if isinstance(v, str) else _describe(node)
+            shown = f"'{v}'" if isinstance(v, str) else ys.describe(node)
             near = difflib.get_close_matches(v, options, n=1) if isinstance(v, str) else []
             hint = f"did you mean '{near[0]}'?" if near else "expected " + " | ".join(options)
             raise self.error(node, f"{self.prefix(origin)}unknown {what} {shown}; {hint}")
@@ -664,7 +431,7 @@ class _Reader:
     # -- the document
 
     def scenario(self, text: str, digest: str) -> Scenario:
-        root = _compose(text, self.path, self.limits)
+        root = ys.compose(text, self.path, self.limits)
         self.root = root
         top = self.mapping(root, "the scenario", TOP_KEYS)
         self.version(top, root)
@@ -711,7 +478,7 @@ class _Reader:
             raise self.error(
                 node,
                 f"version must be {FORMAT_VERSION} (the only format version "
-                f"this collide2d reads), not {_describe(node)}",
+                f"this collide2d reads), not {ys.describe(node)}",
             )
 
     def name(self, top: dict) -> str:
@@ -1083,7 +850,7 @@ class _Reader:
                 raise self.error(
                     vnode,
                     f"{what}.velocity must be {{min: [vx, vy], max: [vx, vy]}}"
-                    f", not {_describe(vnode)}",
+                    f", not {ys.describe(vnode)}",
                 )
             r = self.mapping(vnode, "velocity", RANGE_KEYS)
             ends = []
@@ -1189,7 +956,7 @@ class _Reader:
             raise self.error(
                 node,
                 f"{what} must be all, none, last, a list of frame numbers or "
-                f"{{every: k}}, not {_describe(node)}{hint}",
+                f"{{every: k}}, not {ys.describe(node)}{hint}",
             )
         if v == "all":
             if ticks + 1 > self.limits.max_frames:

@@ -1,0 +1,253 @@
+"""Reading scenario YAML safely: bytes in, a located node tree out, or a located ScenarioError.
+
+The text is streamed as YAML events first (iteratively, so no nesting can exhaust a stack): nesting
+deeper than MAX_YAML_DEPTH, a second document, a tag outside the plain core types (`!!python/...`
+and the like) and aliases are checked there; every alias adds the size of the node it repeats to a
+count, and past `limits.max_alias_nodes` the file is refused at that alias, so a "billion laughs"
+file costs no more than its own length; the file's size (`limits.max_file_bytes`, checked while it
+is read) and its count of values (`limits.max_yaml_nodes`, before any is built) bound the memory of
+the next step. Then `yaml.compose` with the safe loader (libyaml's when available) builds the node
+tree that `runner.scenario` walks by hand. `value` and `describe` read scalar nodes for it.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import re
+from typing import TYPE_CHECKING
+
+import yaml
+
+if TYPE_CHECKING:
+    from runner.scenario import Limits
+
+MAX_YAML_DEPTH = 64  # nesting levels of YAML collections
+READ_CHUNK_BYTES = 2**16  # a scenario file is read in pieces of this many bytes
+CORE_TAG = "tag:yaml.org,2002:"
+
+_FLOAT12_RE = re.compile(r"[-+]?(\.[0-9]+|[0-9]+(\.[0-9]*)?)[eE][-+]?[0-9]+\Z")
+_ALLOWED_TAGS = {CORE_TAG + t for t in ("str", "int", "float", "bool", "null", "seq", "map")}
+_CONSTRUCTED_TAGS = {CORE_TAG + t for t in ("int", "float", "bool")}  # a tagged text may not fit
+_CONSTRUCTOR = yaml.constructor.SafeConstructor()
+_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
+
+class ScenarioError(Exception):
+    """A scenario refused, located: str(err) == f"{path}:{line}:{col}: error: {message}"."""
+
+    def __init__(self, path, line, col, message):
+        super().__init__(str(path), int(line), int(col), str(message))
+        self.path = str(path)
+        self.line = int(line)
+        self.col = int(col)
+        self.message = str(message)
+
+    def __str__(self) -> str:
+        return f"{self.path}:{self.line}:{self.col}: error: {self.message}"
+
+
+def read_file(path, limits: Limits) -> tuple[str, str]:
+    """(text, SHA-256 of the bytes) of the file at `path`, read in pieces within
+    `limits.max_file_bytes`; a located ScenarioError when it cannot be read or is not UTF-8."""
+    shown = os.fspath(path)
+    chunks: list[bytes] = []
+    size = 0
+    try:
+        with open(path, "rb") as f:
+            while chunk := f.read(READ_CHUNK_BYTES):  # in pieces: an endless file stops here
+                size += len(chunk)
+                check_length(size, shown, limits)
+                chunks.append(chunk)
+    except OSError as exc:
+        raise ScenarioError(shown, 1, 1, f"cannot read the file: {exc.strerror or exc}") from None
+    data = b"".join(chunks)
+    return decode(data, shown), hashlib.sha256(data).hexdigest()
+
+
+def check_length(length: int, path: str, limits: Limits) -> None:
+    if length > limits.max_file_bytes:
+        raise ScenarioError(
+            path,
+            1,
+            1,
+            f"the file is larger than the limit of {limits.max_file_bytes:,} bytes; "
+            "raise it with --max-file-bytes",
+        )
+
+
+def decode(data: bytes, path: str) -> str:
+    """The file's text (UTF-8, an initial byte-order mark dropped); a located error otherwise."""
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        start = exc.start
+        line = data.count(b"\n", 0, start) + 1
+        line_start = data.rfind(b"\n", 0, start) + 1
+        col = len(data[line_start:start].decode("utf-8", "replace")) + 1
+        if line_start == 0 and data.startswith(b"\xef\xbb\xbf"):
+            col -= 1
+        raise ScenarioError(
+            path, line, col, f"the file is not UTF-8 text (byte 0x{data[start]:02x} here)"
+        ) from None
+
+
+def mark_error(path: str, mark, message: str) -> ScenarioError:
+    if mark is None:
+        return ScenarioError(path, 1, 1, message)
+    return ScenarioError(path, mark.line + 1, mark.column + 1, message)
+
+
+def _yaml_error(exc: yaml.YAMLError, path: str, text: str) -> ScenarioError:
+    """A PyYAML error as a located ScenarioError."""
+    if isinstance(exc, yaml.reader.ReaderError):
+        index = text.find(chr(exc.character)) if isinstance(exc.character, int) else -1
+        index = exc.position if index < 0 else index
+        line = text.count("\n", 0, index) + 1
+        col = index - (text.rfind("\n", 0, index) + 1) + 1
+        char = exc.character if isinstance(exc.character, int) else 0
+        return ScenarioError(path, line, col, f"invalid character U+{char:04X} in YAML text")
+    if isinstance(exc, yaml.MarkedYAMLError):
+        mark = exc.problem_mark or exc.context_mark
+        problem = exc.problem or "unexpected text"
+        context = f" ({exc.context})" if exc.context else ""
+        return mark_error(path, mark, f"invalid YAML{context}: {problem}")
+    return ScenarioError(path, 1, 1, f"invalid YAML: {exc}")
+
+
+def _tag_name(tag: str) -> str:
+    return "!!" + tag[len(CORE_TAG) :] if tag.startswith(CORE_TAG) else tag
+
+
+def _check_events(text: str, path: str, limits: Limits) -> None:
+    """Stream the YAML events once: depth, one document, plain tags, and the alias bound."""
+    sizes: dict[str, int] = {}  # anchor -> nodes in the node it names, aliases expanded
+    stack: list[list] = []  # per open collection: [nodes so far, anchor]
+    repeated = 0  # nodes reached again through aliases
+    nodes = 0  # nodes written out in the text
+    documents = 0
+
+    def add(n: int) -> None:
+        if stack:
+            stack[-1][0] += n
+
+    try:
+        for ev in yaml.parse(text, Loader=_LOADER):
+            if isinstance(ev, yaml.DocumentStartEvent):
+                documents += 1
+                if documents > 1:
+                    raise mark_error(
+                        path,
+                        ev.start_mark,
+                        "a scenario file holds one YAML document; this is a second one",
+                    )
+            elif isinstance(ev, yaml.AliasEvent):
+                n = sizes.get(ev.anchor)
+                if n is None:
+                    inside = any(entry[1] == ev.anchor for entry in stack)
+                    what = "refers to a node that contains it" if inside else "has no anchor"
+                    raise mark_error(path, ev.start_mark, f"alias '*{ev.anchor}' {what}")
+                repeated += n
+                if repeated > limits.max_alias_nodes:
+                    raise mark_error(
+                        path,
+                        ev.start_mark,
+                        f"aliases repeat more than {limits.max_alias_nodes} YAML nodes "
+                        f"(alias '*{ev.anchor}' repeats {n}); refusing to expand them",
+                    )
+                add(n)
+            elif isinstance(ev, yaml.NodeEvent) and not isinstance(ev, yaml.CollectionEndEvent):
+                tag = getattr(ev, "tag", None)
+                nodes += 1
+                if nodes > limits.max_yaml_nodes:
+                    raise mark_error(
+                        path,
+                        ev.start_mark,
+                        f"the file holds more than {limits.max_yaml_nodes:,} YAML values, the "
+                        "limit; raise it with --max-yaml-nodes",
+                    )
+                if tag is not None and tag not in _ALLOWED_TAGS:
+                    raise mark_error(
+                        path,
+                        ev.start_mark,
+                        f"YAML tag '{_tag_name(tag)}' is not "
+                        "allowed; a scenario holds plain values only",
+                    )
+                if isinstance(ev, yaml.ScalarEvent):
+                    if tag in _CONSTRUCTED_TAGS:
+                        _check_tagged(ev, tag, path)
+                    if ev.anchor is not None:
+                        sizes[ev.anchor] = 1
+                    add(1)
+                else:
+                    stack.append([1, ev.anchor])
+                    if len(stack) > MAX_YAML_DEPTH:
+                        raise mark_error(
+                            path,
+                            ev.start_mark,
+                            f"YAML nested more than {MAX_YAML_DEPTH} levels deep",
+                        )
+            elif isinstance(ev, yaml.CollectionEndEvent):
+                n, anchor = stack.pop()
+                if anchor is not None:
+                    sizes[anchor] = n
+                add(n)
+    except yaml.YAMLError as exc:
+        raise _yaml_error(exc, path, text) from None
+
+
+def _check_tagged(ev, tag: str, path: str) -> None:
+    """A scalar with an explicit `!!int`, `!!float` or `!!bool` tag must be such a value."""
+    try:
+        value(yaml.ScalarNode(tag, ev.value, style=ev.style))
+    except (ValueError, KeyError, IndexError, TypeError):
+        raise mark_error(
+            path, ev.start_mark, f"{ev.value!r} is not a valid {_tag_name(tag)} value"
+        ) from None
+
+
+def compose(text: str, path: str, limits: Limits) -> yaml.Node:
+    _check_events(text, path, limits)
+    try:
+        root = yaml.compose(text, Loader=_LOADER)
+    except yaml.YAMLError as exc:
+        raise _yaml_error(exc, path, text) from None
+    if root is None:
+        raise ScenarioError(path, 1, 1, "the file is empty; a scenario starts with 'version: 1'")
+    return root
+
+
+def plain(node) -> bool:
+    return node.style in (None, "")
+
+
+def value(node):
+    """The Python value of a scalar node (str, int, float, bool or None)."""
+    tag = node.tag
+    if tag == CORE_TAG + "int":
+        return _CONSTRUCTOR.construct_yaml_int(node)
+    if tag == CORE_TAG + "float":
+        return _CONSTRUCTOR.construct_yaml_float(node)
+    if tag == CORE_TAG + "bool":
+        return _CONSTRUCTOR.construct_yaml_bool(node)
+    if tag == CORE_TAG + "null":
+        return None
+    if tag == CORE_TAG + "str" and plain(node) and _FLOAT12_RE.match(node.value):
+        return float(node.value)
+    return node.value  # str, and timestamps, "=" and "<<" read as their text
+
+
+def describe(node) -> str:
+    """A few words naming what a node holds, for messages."""
+    if isinstance(node, yaml.MappingNode):
+        return "a mapping"
+    if isinstance(node, yaml.SequenceNode):
+        return "a list"
+    v = value(node)
+    if v is None:
+        return "an empty value"
+    if isinstance(v, bool):
+        return f"the boolean {node.value}"
+    if isinstance(v, (int, float)):
+        return f"{node.value}"
+    return f"the text {v!r}"
