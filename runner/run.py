@@ -120,6 +120,7 @@ def drive(
         progress.close()
 
     end = _energy_momentum(bodies, model.velocities())
+    _check_finite(scenario, model, start, end)
     summary = {
         "name": scenario.name,
         "model": scenario.model,
@@ -303,6 +304,23 @@ def _remove_stale(target: Path, frames_dir: Path, options: RunOptions, written: 
         for path in frames_dir.glob("frame_*.png"):
             if path.name not in written and not path.is_symlink():
                 path.unlink()
+
+
+def _check_finite(scenario: Scenario, model, start, end) -> None:
+    """RunStopped unless the summary's figures and the final state are finite numbers.
+
+    The scenario's bounds (runner.scenario, "Numbers") keep them finite; this makes sure that a
+    model breaking them stops the run with a message instead of writing inf or nan."""
+    figures = np.array([start[0], *start[1], end[0], *end[1]], np.float64)
+    if not (
+        np.isfinite(figures).all()
+        and np.isfinite(model.positions()).all()
+        and np.isfinite(model.velocities()).all()
+    ):
+        raise RunStopped(
+            f"{scenario.path or scenario.name}: error: the {scenario.model} model ended the run "
+            "with a position, velocity, energy or momentum that is not a finite number"
+        )
 
 
 def _energy_momentum(bodies, vel: np.ndarray) -> tuple[float, tuple[float, float]]:

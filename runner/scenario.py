@@ -22,6 +22,19 @@ rounded to the nearest whole tick with halves up and computed exactly from the d
 (`0.05` s at 10 fps is 1 tick); with neither, `DEFAULT_DURATION` seconds. A scenario without a
 `name` takes its file's stem (text read by `loads` without a path is named `NAME_FOR_TEXT`).
 
+Numbers: a number is at most `runner.yamlsafe.MAX_NUMBER_CHARS` characters as written (so it is read
+at a cost linear in its text, whatever its form: decimal, `0x`, `0b`, octal, sexagesimal `1:30`,
+underscores); a whole number is at most MAX_INTEGER unless its field says less (a generate seed at
+most MAX_SEED), and a number in a float field must be finite (`.inf`, `.nan` and `1e999` are
+refused). `-0.0` is read as `0.0`. Masses lie in [MIN_MASS, MAX_MASS] and velocity components in
+[-MAX_SPEED, MAX_SPEED], so with S = MAX_SPEED every object starts with |m v| <= sqrt(2) * 1e24,
+m |v|^2 / 2 <= 1e33 and 1/m <= 1e15, and n objects with a kinetic energy E <= n * 1e33 at most. The
+models keep or lose kinetic energy, never gain it, so no object ever moves faster than sqrt(2 E /
+MIN_MASS) <= sqrt(n) * 1.5e24 px/s: for any n a machine can hold, every velocity, energy, momentum
+and inverse mass of a run stays many orders of magnitude inside float64's range (about 1.8e308).
+Denormal masses such as `5e-324` are refused by the same bound; `static: true` is the way to an
+immovable object.
+
 Every value in the file must be valid on its own. The overrides then replace values (`model`
 replaces the file's whole `model` entry unless it names the same kind, whose settings are kept;
 `fps` replaces `world.fps`, so a `duration` is counted again in ticks; `ticks` replaces `ticks` and
@@ -61,6 +74,10 @@ DEFAULT_DURATION = 10  # s, when neither `ticks` nor `duration` is given
 DEFAULT_BACKGROUND = (0, 0, 0)
 DEFAULT_COLOR = (255, 255, 255)
 DEFAULT_MASS = 1.0  # mass units
+MIN_MASS = 1e-15  # mass units, the lightest movable object (see "Numbers" above)
+MAX_MASS = 1e15  # mass units, the heaviest movable object (`static: true` is heavier than any)
+MAX_INTEGER = 2**63 - 1  # the largest whole number a field takes unless it has its own bound
+MAX_SEED = 2**64 - 1  # the largest generate seed
 MAX_SPEED = 1e9  # px/s, largest velocity component (a larger one crosses any world in a tick)
 MAX_SUBSTEPS = 10_000  # substeps per tick of the stepped model
 MAX_POINT_OFFSET = 2**24  # px, largest |coordinate| of a polygon point relative to its position
@@ -202,8 +219,8 @@ def _is_number(v) -> bool:
 
 
 def _fmt(v) -> str:
-    """A number as a user would write it."""
-    if isinstance(v, float) and v.is_integer() and abs(v) < 2**53:
+    """A number as a user would write it (1e+15 rather than 1000000000000000)."""
+    if isinstance(v, float) and v.is_integer() and abs(v) < 1e15:
         return str(int(v))
     return repr(v) if isinstance(v, float) else str(v)
 
@@ -368,7 +385,9 @@ class _Reader:
         if isinstance(v, float) and not math.isfinite(v):
             raise self.error(node, f"{what} must be a finite number, not {node.value}")
         if isinstance(v, int) and abs(v) > 1e300:
-            raise self.error(node, f"{what} {v} is too large a number")
+            raise self.error(node, f"{what} {node.value} is too large a number")
+        if v == 0:
+            v = v + 0  # -0.0 is read as 0.0
         if lo is not None and (v <= lo if lo_open else v < lo):
             bound = "more than" if lo_open else "at least"
             raise self.error(node, f"{what} must be {bound} {_fmt(lo)}{unit}, not {_fmt(v)}")
@@ -377,7 +396,8 @@ class _Reader:
         return v
 
     def integer(self, node, what: str, *, lo=None, hi=None, of="", unit="") -> int:
-        """A whole number (a float with no fraction counts) in [lo, hi].
+        """A whole number (a float with no fraction counts) in [lo, hi]; hi is MAX_INTEGER unless
+        given, and a given lo is at least -MAX_INTEGER.
 
         `of` completes "a whole number" in messages (" of pixels"), `unit` follows the bounds.
         """
@@ -386,10 +406,13 @@ class _Reader:
             v = int(v)
         if not _is_number(v) or not isinstance(v, int):
             raise self.error(node, f"{what} must be a whole number{of}, not {ys.describe(node)}")
-        if lo is not None and v < lo:
-            raise self.error(node, f"{what} must be at least {lo}{unit}, not {v}")
-        if hi is not None and v > hi:
-            raise self.error(node, f"{what} must be at most {hi}{unit}, not {v}")
+        lo = -MAX_INTEGER if lo is None else lo
+        hi = MAX_INTEGER if hi is None else hi
+        shown = str(v) if len(str(v)) <= 24 else node.value  # 1e300 rather than its 301 digits
+        if v < lo:
+            raise self.error(node, f"{what} must be at least {lo}{unit}, not {shown}")
+        if v > hi:
+            raise self.error(node, f"{what} must be at most {hi}{unit}, not {shown}")
         return v
 
     def color(self, node, what: str) -> tuple[int, int, int]:
@@ -686,7 +709,7 @@ class _Reader:
         static = self.boolean(m["static"][1], f"{what}.static") if "static" in m else False
         mass = DEFAULT_MASS
         if "mass" in m:
-            mass = float(self.number(m["mass"][1], f"{what}.mass", lo=0, lo_open=True))
+            mass = float(self.number(m["mass"][1], f"{what}.mass", lo=MIN_MASS, hi=MAX_MASS))
             if static:
                 raise self.error(
                     m["mass"][0], f"{what} is static, so its mass is infinite; remove 'mass'"
@@ -819,7 +842,7 @@ class _Reader:
         shape = self.shape_of(m, node, what, BLOCK_SHAPES)
         size = self.size_of(shape, m[_SIZE_KEY[shape]][1], what)
         count = self.integer(m["count"][1], f"{what}.count", lo=0)
-        seed = self.integer(m["seed"][1], f"{what}.seed", lo=0) if "seed" in m else 0
+        seed = self.integer(m["seed"][1], f"{what}.seed", lo=0, hi=MAX_SEED) if "seed" in m else 0
         color, color_node, mass, static, fill, name = self.common(m, what)
         if "speed" in m and "velocity" in m:
             raise self.error(

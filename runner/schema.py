@@ -20,9 +20,12 @@ from runner.scenario import (
     FRAME_WORDS,
     GEOMETRIES,
     MAX_FPS,
+    MAX_MASS,
     MAX_NAME_LENGTH,
+    MAX_SEED,
     MAX_SPEED,
     MAX_SUBSTEPS,
+    MIN_MASS,
     NAME_PATTERN,
     SHAPES,
 )
@@ -42,7 +45,12 @@ def json_schema() -> dict:
         "position": {"$ref": "#/$defs/xy", "description": "[x, y] of the top-left corner, px"},
         "velocity": {"$ref": "#/$defs/xy", "description": "[vx, vy] in px/s; default [0, 0]"},
         "color": {"$ref": "#/$defs/color"},
-        "mass": {"type": "number", "exclusiveMinimum": 0, "description": "default 1"},
+        "mass": {
+            "type": "number",
+            "minimum": MIN_MASS,
+            "maximum": MAX_MASS,
+            "description": "default 1",
+        },
         "static": {"type": "boolean", "description": "infinite mass, never moves"},
         "fill": {"type": "boolean", "description": "paint the inside too; default false"},
         "name": {"type": "string", "description": "a label in logs and reports"},
@@ -103,7 +111,7 @@ def json_schema() -> dict:
             "additionalProperties": False,
             "description": "each component drawn uniformly between min and max, px/s",
         },
-        "seed": {"type": "integer", "minimum": 0, "description": "default 0"},
+        "seed": {"type": "integer", "minimum": 0, "maximum": MAX_SEED, "description": "default 0"},
         **{k: v for k, v in common.items() if k not in ("position", "velocity")},
     }
     frames = {

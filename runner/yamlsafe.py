@@ -6,8 +6,15 @@ and the like) and aliases are checked there; every alias adds the size of the no
 count, and past `limits.max_alias_nodes` the file is refused at that alias, so a "billion laughs"
 file costs no more than its own length; the file's size (`limits.max_file_bytes`, checked while it
 is read) and its count of values (`limits.max_yaml_nodes`, before any is built) bound the memory of
-the next step. Then `yaml.compose` with the safe loader (libyaml's when available) builds the node
-tree that `runner.scenario` walks by hand. `value` and `describe` read scalar nodes for it.
+the next step. A number (a scalar YAML reads as an integer or a float, or one in exponent form such
+as `1e3`) longer than MAX_NUMBER_CHARS characters is refused there too, before anything converts it:
+Python's `int()` refuses more than 4,300 digits and YAML 1.1's sexagesimal integers (`190:20:30`)
+cost time quadratic in their length, while no field needs so long a number. So every number is read
+at a cost linear in the text, and every integer a scenario holds is below 16**98 (about 1e118), far
+inside float64's range. Then `yaml.compose` with the safe loader (libyaml's when available) builds
+the node tree that `runner.scenario` walks by hand. `value` and `describe` read scalar nodes for it;
+a plain scalar YAML takes for an integer but cannot make one (`0x_`, digits that are all
+underscores) is read as its text.
 """
 
 from __future__ import annotations
@@ -23,13 +30,17 @@ if TYPE_CHECKING:
     from runner.scenario import Limits
 
 MAX_YAML_DEPTH = 64  # nesting levels of YAML collections
+MAX_SHOWN_CHARS = 40  # characters of a text quoted in a message
+MAX_NUMBER_CHARS = 100  # characters of one number as written (signs, underscores, colons included)
 READ_CHUNK_BYTES = 2**16  # a scenario file is read in pieces of this many bytes
 CORE_TAG = "tag:yaml.org,2002:"
 
 _FLOAT12_RE = re.compile(r"[-+]?(\.[0-9]+|[0-9]+(\.[0-9]*)?)[eE][-+]?[0-9]+\Z")
 _ALLOWED_TAGS = {CORE_TAG + t for t in ("str", "int", "float", "bool", "null", "seq", "map")}
 _CONSTRUCTED_TAGS = {CORE_TAG + t for t in ("int", "float", "bool")}  # a tagged text may not fit
+_NUMBER_TAGS = {CORE_TAG + "int", CORE_TAG + "float"}
 _CONSTRUCTOR = yaml.constructor.SafeConstructor()
+_RESOLVER = yaml.resolver.Resolver()  # the implicit tags the composer gives plain scalars
 _LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
 
@@ -174,6 +185,13 @@ def _check_events(text: str, path: str, limits: Limits) -> None:
                         "allowed; a scenario holds plain values only",
                     )
                 if isinstance(ev, yaml.ScalarEvent):
+                    if len(ev.value) > MAX_NUMBER_CHARS and _is_number(ev):
+                        raise mark_error(
+                            path,
+                            ev.start_mark,
+                            f"this number is {len(ev.value):,} characters long; a number in a "
+                            f"scenario has at most {MAX_NUMBER_CHARS} (quote it if it is text)",
+                        )
                     if tag in _CONSTRUCTED_TAGS:
                         _check_tagged(ev, tag, path)
                     if ev.anchor is not None:
@@ -196,10 +214,21 @@ def _check_events(text: str, path: str, limits: Limits) -> None:
         raise _yaml_error(exc, path, text) from None
 
 
+def _is_number(ev: yaml.ScalarEvent) -> bool:
+    """Whether `value` would read the scalar as a number: tagged or resolved as an int or a float,
+    or plain text in exponent form."""
+    tag = ev.tag
+    if tag is None or tag == "!":
+        tag = _RESOLVER.resolve(yaml.ScalarNode, ev.value, ev.implicit)
+        if tag == CORE_TAG + "str":
+            return ev.implicit[0] and _FLOAT12_RE.match(ev.value) is not None
+    return tag in _NUMBER_TAGS
+
+
 def _check_tagged(ev, tag: str, path: str) -> None:
     """A scalar with an explicit `!!int`, `!!float` or `!!bool` tag must be such a value."""
     try:
-        value(yaml.ScalarNode(tag, ev.value, style=ev.style))
+        _construct(yaml.ScalarNode(tag, ev.value, style=ev.style))
     except (ValueError, KeyError, IndexError, TypeError):
         raise mark_error(
             path, ev.start_mark, f"{ev.value!r} is not a valid {_tag_name(tag)} value"
@@ -222,7 +251,18 @@ def plain(node) -> bool:
 
 
 def value(node):
-    """The Python value of a scalar node (str, int, float, bool or None)."""
+    """The Python value of a scalar node (str, int, float, bool or None).
+
+    A scalar tagged as a number or a boolean whose text makes none is read as its text; the event
+    pass of `compose` has refused such a text when the tag was written out.
+    """
+    try:
+        return _construct(node)
+    except (ValueError, KeyError, IndexError, TypeError):
+        return node.value
+
+
+def _construct(node):
     tag = node.tag
     if tag == CORE_TAG + "int":
         return _CONSTRUCTOR.construct_yaml_int(node)
@@ -250,4 +290,6 @@ def describe(node) -> str:
         return f"the boolean {node.value}"
     if isinstance(v, (int, float)):
         return f"{node.value}"
+    if len(v) > MAX_SHOWN_CHARS:  # a long text is shown by its start and its length
+        return f"the text {v[:MAX_SHOWN_CHARS]!r}... ({len(v):,} characters)"
     return f"the text {v!r}"

@@ -529,12 +529,12 @@ def test_ticks_and_duration_together():
         (
             "{shape: box, size: 10, position: [0, 0], mass: 0}",
             "0}",
-            "objects[0].mass must be more than 0",
+            "objects[0].mass must be at least 1e-15, not 0",
         ),
         (
             "{shape: box, size: 10, position: [0, 0], mass: -1}",
             "-1",
-            "objects[0].mass must be more than 0",
+            "objects[0].mass must be at least 1e-15, not -1",
         ),
         (
             "{shape: box, size: 10, position: [0, 0], velocity: [.nan, 0]}",
