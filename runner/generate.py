@@ -325,7 +325,7 @@ def draw_velocities(rng: np.random.Generator, spec: BlockSpec) -> np.ndarray:
     n = spec.count
     if spec.speed is not None:
         signs = rng.integers(0, 2, size=(n, 2))
-        return (2.0 * signs - 1.0) * float(spec.speed)
+        return (2.0 * signs - 1.0) * float(spec.speed) + 0.0  # speed 0: no negative zeros
     if spec.speed_range is not None:
         a, b = spec.speed_range
         mag = rng.uniform(float(a), float(b), size=n)

@@ -222,6 +222,8 @@ def _fmt(v) -> str:
     """A number as a user would write it (1e+15 rather than 1000000000000000)."""
     if isinstance(v, float) and v.is_integer() and abs(v) < 1e15:
         return str(int(v))
+    if isinstance(v, float) and abs(v) >= 1e15:
+        return np.format_float_scientific(v, trim="-")
     return repr(v) if isinstance(v, float) else str(v)
 
 

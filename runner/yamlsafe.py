@@ -6,15 +6,17 @@ and the like) and aliases are checked there; every alias adds the size of the no
 count, and past `limits.max_alias_nodes` the file is refused at that alias, so a "billion laughs"
 file costs no more than its own length; the file's size (`limits.max_file_bytes`, checked while it
 is read) and its count of values (`limits.max_yaml_nodes`, before any is built) bound the memory of
-the next step. A number (a scalar YAML reads as an integer or a float, or one in exponent form such
-as `1e3`) longer than MAX_NUMBER_CHARS characters is refused there too, before anything converts it:
-Python's `int()` refuses more than 4,300 digits and YAML 1.1's sexagesimal integers (`190:20:30`)
-cost time quadratic in their length, while no field needs so long a number. So every number is read
-at a cost linear in the text, and every integer a scenario holds is below 16**98 (about 1e118), far
-inside float64's range. Then `yaml.compose` with the safe loader (libyaml's when available) builds
-the node tree that `runner.scenario` walks by hand. `value` and `describe` read scalar nodes for it;
-a plain scalar YAML takes for an integer but cannot make one (`0x_`, digits that are all
-underscores) is read as its text.
+the next step. A number longer than MAX_NUMBER_CHARS characters is refused there too, before
+anything converts it: Python's `int()` refuses more than 4,300 digits, YAML 1.1's sexagesimal
+integers (`190:20:30`) cost time quadratic in their length, and no field needs so long a number. A
+long scalar counts as a number when it is tagged `!!int` or `!!float`, or is plain and looks like
+one (`_NUMBER_LIKE_RE`, a superset of YAML 1.1's forms and of the exponent form `1e3`, checked in
+linear time); every other long plain scalar is text, and the loader never tries YAML's number
+patterns on it (see `_Loader`). So every number is read at a cost linear in its text, and every
+integer a scenario holds is below 16**98 (about 1e118), far inside float64's range. Then
+`yaml.compose` with that loader builds the node tree that `runner.scenario` walks by hand. `value`
+and `describe` read scalar nodes for it; a plain scalar YAML takes for an integer but that makes
+none (`0x_`: its digits are all underscores) is read as its text.
 """
 
 from __future__ import annotations
@@ -40,8 +42,25 @@ _ALLOWED_TAGS = {CORE_TAG + t for t in ("str", "int", "float", "bool", "null", "
 _CONSTRUCTED_TAGS = {CORE_TAG + t for t in ("int", "float", "bool")}  # a tagged text may not fit
 _NUMBER_TAGS = {CORE_TAG + "int", CORE_TAG + "float"}
 _CONSTRUCTOR = yaml.constructor.SafeConstructor()
-_RESOLVER = yaml.resolver.Resolver()  # the implicit tags the composer gives plain scalars
-_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+# What a long plain scalar must look like to be taken for a number: a superset of YAML 1.1's
+# integers and floats and of the exponent form, matched in time linear in the text and constant
+# memory (one character class repeated, nothing to backtrack into).
+_NUMBER_LIKE_RE = re.compile(r"[-+]?\.?[0-9][0-9a-fA-Fxob_:.+-]*\Z")
+
+
+class _Loader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):
+    """The safe loader (libyaml's when available), taking every plain scalar longer than
+    MAX_NUMBER_CHARS for text without trying YAML's number patterns on it: the event pass has
+    refused those that look like numbers, and the patterns for sexagesimal numbers keep memory
+    per repetition (tens of bytes per character of a text such as `1:59:59:...:59 x`)."""
+
+    def resolve(self, kind, value, implicit):
+        if kind is yaml.ScalarNode and implicit[0] and len(value) > MAX_NUMBER_CHARS:
+            return CORE_TAG + "str"
+        return super().resolve(kind, value, implicit)
+
+
+_LOADER = _Loader
 
 
 class ScenarioError(Exception):
@@ -215,14 +234,11 @@ def _check_events(text: str, path: str, limits: Limits) -> None:
 
 
 def _is_number(ev: yaml.ScalarEvent) -> bool:
-    """Whether `value` would read the scalar as a number: tagged or resolved as an int or a float,
-    or plain text in exponent form."""
-    tag = ev.tag
-    if tag is None or tag == "!":
-        tag = _RESOLVER.resolve(yaml.ScalarNode, ev.value, ev.implicit)
-        if tag == CORE_TAG + "str":
-            return ev.implicit[0] and _FLOAT12_RE.match(ev.value) is not None
-    return tag in _NUMBER_TAGS
+    """Whether a scalar longer than MAX_NUMBER_CHARS is a number: tagged as an int or a float, or
+    plain and looking like one (_NUMBER_LIKE_RE)."""
+    if ev.tag is None or ev.tag == "!":
+        return ev.implicit[0] and _NUMBER_LIKE_RE.match(ev.value) is not None
+    return ev.tag in _NUMBER_TAGS
 
 
 def _check_tagged(ev, tag: str, path: str) -> None:
@@ -272,7 +288,12 @@ def _construct(node):
         return _CONSTRUCTOR.construct_yaml_bool(node)
     if tag == CORE_TAG + "null":
         return None
-    if tag == CORE_TAG + "str" and plain(node) and _FLOAT12_RE.match(node.value):
+    if (
+        tag == CORE_TAG + "str"
+        and plain(node)
+        and len(node.value) <= MAX_NUMBER_CHARS  # longer ones are text (see _Loader)
+        and _FLOAT12_RE.match(node.value)
+    ):
         return float(node.value)
     return node.value  # str, and timestamps, "=" and "<<" read as their text
 
