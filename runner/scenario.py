@@ -22,18 +22,18 @@ rounded to the nearest whole tick with halves up and computed exactly from the d
 (`0.05` s at 10 fps is 1 tick); with neither, `DEFAULT_DURATION` seconds. A scenario without a
 `name` takes its file's stem (text read by `loads` without a path is named `NAME_FOR_TEXT`).
 
-Numbers: a number is at most `runner.yamlsafe.MAX_NUMBER_CHARS` characters as written (so it is read
-at a cost linear in its text, whatever its form: decimal, `0x`, `0b`, octal, sexagesimal `1:30`,
+Numbers: a number is at most `runner.yamlsafe.MAX_NUMBER_CHARS` characters as written, so it is
+read at a cost linear in its text whatever its form (decimal, `0x`, `0b`, octal, sexagesimal `1:30`,
 underscores); a whole number is at most MAX_INTEGER unless its field says less (a generate seed at
 most MAX_SEED), and a number in a float field must be finite (`.inf`, `.nan` and `1e999` are
 refused). `-0.0` is read as `0.0`. Masses lie in [MIN_MASS, MAX_MASS] and velocity components in
-[-MAX_SPEED, MAX_SPEED], so with S = MAX_SPEED every object starts with |m v| <= sqrt(2) * 1e24,
-m |v|^2 / 2 <= 1e33 and 1/m <= 1e15, and n objects with a kinetic energy E <= n * 1e33 at most. The
-models keep or lose kinetic energy, never gain it, so no object ever moves faster than sqrt(2 E /
-MIN_MASS) <= sqrt(n) * 1.5e24 px/s: for any n a machine can hold, every velocity, energy, momentum
-and inverse mass of a run stays many orders of magnitude inside float64's range (about 1.8e308).
-Denormal masses such as `5e-324` are refused by the same bound; `static: true` is the way to an
-immovable object.
+[-MAX_SPEED, MAX_SPEED], so every object starts with |m v| <= sqrt(2) * 1e24, m |v|^2 / 2 <= 1e33
+and 1/m <= 1e15, and n objects with a kinetic energy E <= n * 1e33. The models keep kinetic energy
+(up to rounding) or lose it, never gain it, so no object ever moves faster than
+sqrt(2 E / MIN_MASS) <= sqrt(n) * 1.5e24 px/s: for any n a machine can hold, every velocity, energy,
+momentum and inverse mass of a run stays many orders of magnitude inside float64's range (about
+1.8e308). Denormal masses such as `5e-324` are refused by the same bound; `static: true` is the way
+to an immovable object.
 
 Every value in the file must be valid on its own. The overrides then replace values (`model`
 replaces the file's whole `model` entry unless it names the same kind, whose settings are kept;
