@@ -120,7 +120,29 @@ def _tag_name(tag: str) -> str:
 
 
 def _check_events(text: str, path: str, limits: Limits) -> None:
-    """Stream the YAML events once: depth, one document, plain tags, and the alias bound."""
+    """Stream the YAML events once: depth, one document, plain tags, and the alias bound.
+
+    The fast parser (libyaml's, when PyYAML has it) reads ahead of the events it hands out and
+    may hold limits of its own (PyYAML 6.0.4's libyaml stops at 1,000 flow levels, found while
+    reading ahead of our 65th). So when it fails, the same pass runs again with PyYAML's pure
+    Python parser, which has no limit of its own: our bounds decide wherever they are passed
+    first, and a file that is invalid YAML is reported in the same words with or without libyaml.
+    Only refused files pay for the second pass, which stops at the first problem it meets.
+    """
+    try:
+        _stream_events(text, path, limits, _LOADER)
+    except yaml.YAMLError as exc:
+        if _LOADER is yaml.SafeLoader:
+            raise _yaml_error(exc, path, text) from None
+        try:
+            _stream_events(text, path, limits, yaml.SafeLoader)
+        except yaml.YAMLError as pure:
+            raise _yaml_error(pure, path, text) from None
+        raise _yaml_error(exc, path, text) from None
+
+
+def _stream_events(text: str, path: str, limits: Limits, loader) -> None:
+    """The checks of `_check_events` over the events of one parser; YAMLError passes through."""
     sizes: dict[str, int] = {}  # anchor -> nodes in the node it names, aliases expanded
     stack: list[list] = []  # per open collection: [nodes so far, anchor]
     repeated = 0  # nodes reached again through aliases
@@ -131,69 +153,66 @@ def _check_events(text: str, path: str, limits: Limits) -> None:
         if stack:
             stack[-1][0] += n
 
-    try:
-        for ev in yaml.parse(text, Loader=_LOADER):
-            if isinstance(ev, yaml.DocumentStartEvent):
-                documents += 1
-                if documents > 1:
+    for ev in yaml.parse(text, Loader=loader):
+        if isinstance(ev, yaml.DocumentStartEvent):
+            documents += 1
+            if documents > 1:
+                raise mark_error(
+                    path,
+                    ev.start_mark,
+                    "a scenario file holds one YAML document; this is a second one",
+                )
+        elif isinstance(ev, yaml.AliasEvent):
+            n = sizes.get(ev.anchor)
+            if n is None:
+                inside = any(entry[1] == ev.anchor for entry in stack)
+                what = "refers to a node that contains it" if inside else "has no anchor"
+                raise mark_error(path, ev.start_mark, f"alias '*{ev.anchor}' {what}")
+            repeated += n
+            if repeated > limits.max_alias_nodes:
+                raise mark_error(
+                    path,
+                    ev.start_mark,
+                    f"aliases repeat more than {limits.max_alias_nodes} YAML nodes "
+                    f"(alias '*{ev.anchor}' repeats {n}); refusing to expand them",
+                )
+            add(n)
+        elif isinstance(ev, yaml.NodeEvent) and not isinstance(ev, yaml.CollectionEndEvent):
+            tag = getattr(ev, "tag", None)
+            nodes += 1
+            if nodes > limits.max_yaml_nodes:
+                raise mark_error(
+                    path,
+                    ev.start_mark,
+                    f"the file holds more than {limits.max_yaml_nodes:,} YAML values, the "
+                    "limit; raise it with --max-yaml-nodes",
+                )
+            if tag is not None and tag not in _ALLOWED_TAGS:
+                raise mark_error(
+                    path,
+                    ev.start_mark,
+                    f"YAML tag '{_tag_name(tag)}' is not "
+                    "allowed; a scenario holds plain values only",
+                )
+            if isinstance(ev, yaml.ScalarEvent):
+                if tag in _CONSTRUCTED_TAGS:
+                    _check_tagged(ev, tag, path)
+                if ev.anchor is not None:
+                    sizes[ev.anchor] = 1
+                add(1)
+            else:
+                stack.append([1, ev.anchor])
+                if len(stack) > MAX_YAML_DEPTH:
                     raise mark_error(
                         path,
                         ev.start_mark,
-                        "a scenario file holds one YAML document; this is a second one",
+                        f"YAML nested more than {MAX_YAML_DEPTH} levels deep",
                     )
-            elif isinstance(ev, yaml.AliasEvent):
-                n = sizes.get(ev.anchor)
-                if n is None:
-                    inside = any(entry[1] == ev.anchor for entry in stack)
-                    what = "refers to a node that contains it" if inside else "has no anchor"
-                    raise mark_error(path, ev.start_mark, f"alias '*{ev.anchor}' {what}")
-                repeated += n
-                if repeated > limits.max_alias_nodes:
-                    raise mark_error(
-                        path,
-                        ev.start_mark,
-                        f"aliases repeat more than {limits.max_alias_nodes} YAML nodes "
-                        f"(alias '*{ev.anchor}' repeats {n}); refusing to expand them",
-                    )
-                add(n)
-            elif isinstance(ev, yaml.NodeEvent) and not isinstance(ev, yaml.CollectionEndEvent):
-                tag = getattr(ev, "tag", None)
-                nodes += 1
-                if nodes > limits.max_yaml_nodes:
-                    raise mark_error(
-                        path,
-                        ev.start_mark,
-                        f"the file holds more than {limits.max_yaml_nodes:,} YAML values, the "
-                        "limit; raise it with --max-yaml-nodes",
-                    )
-                if tag is not None and tag not in _ALLOWED_TAGS:
-                    raise mark_error(
-                        path,
-                        ev.start_mark,
-                        f"YAML tag '{_tag_name(tag)}' is not "
-                        "allowed; a scenario holds plain values only",
-                    )
-                if isinstance(ev, yaml.ScalarEvent):
-                    if tag in _CONSTRUCTED_TAGS:
-                        _check_tagged(ev, tag, path)
-                    if ev.anchor is not None:
-                        sizes[ev.anchor] = 1
-                    add(1)
-                else:
-                    stack.append([1, ev.anchor])
-                    if len(stack) > MAX_YAML_DEPTH:
-                        raise mark_error(
-                            path,
-                            ev.start_mark,
-                            f"YAML nested more than {MAX_YAML_DEPTH} levels deep",
-                        )
-            elif isinstance(ev, yaml.CollectionEndEvent):
-                n, anchor = stack.pop()
-                if anchor is not None:
-                    sizes[anchor] = n
-                add(n)
-    except yaml.YAMLError as exc:
-        raise _yaml_error(exc, path, text) from None
+        elif isinstance(ev, yaml.CollectionEndEvent):
+            n, anchor = stack.pop()
+            if anchor is not None:
+                sizes[anchor] = n
+            add(n)
 
 
 def _check_tagged(ev, tag: str, path: str) -> None:
