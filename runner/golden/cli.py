@@ -106,7 +106,9 @@ def _common(p) -> None:
 
 def _debug_option(parser) -> None:
     """`--debug` for `main` run on its own (the `collide2d` CLI has a global one)."""
-    parser.add_argument("--debug", action="store_true", help="print tracebacks of unexpected errors")
+    parser.add_argument(
+        "--debug", action="store_true", help="print tracebacks of unexpected errors"
+    )
 
 
 def main(argv=None, *, load=None, simulate=None) -> int:

@@ -33,7 +33,7 @@ import warnings
 import zlib
 
 import numpy as np
-from PIL import Image
+from PIL import Image, UnidentifiedImageError
 
 from engine.events import event_dict, format_event
 from runner.outputs import encode_png, final_csv_text
@@ -124,10 +124,12 @@ def decode_png(data: bytes, *, size=None, max_pixels: int | None = None) -> np.n
                 if im.size != (w, h):
                     raise ValueError(f"damaged PNG (header {w}x{h}, image {im.size})")
                 return np.array(im.convert("RGB"), dtype=np.uint8)
+    except UnidentifiedImageError:
+        raise ValueError("damaged PNG (not recognised past its header)") from None
     except (OSError, SyntaxError, EOFError, struct.error, zlib.error, IndexError) as exc:
-        raise ValueError(f"not a readable PNG ({exc})") from None
+        raise ValueError(f"damaged PNG ({exc})") from None
     except Image.DecompressionBombError as exc:
-        raise ValueError(f"not a readable PNG ({exc})") from None
+        raise ValueError(f"refused PNG ({exc})") from None
 
 
 def check_rel(rel) -> str:
@@ -174,7 +176,9 @@ def load_json(data: bytes, what: str = "JSON"):
     except UnicodeDecodeError:
         raise ValueError("not UTF-8 text") from None
     except json.JSONDecodeError as exc:
-        raise ValueError(f"{exc.msg} at line {exc.lineno} column {exc.colno}") from None
+        raise ValueError(f"not JSON: {exc.msg} at line {exc.lineno} column {exc.colno}") from None
+    except _Refused as exc:
+        raise ValueError(str(exc)) from None
     except RecursionError:
         raise ValueError("nested too deep") from None
     except ValueError:  # an integer of thousands of digits
@@ -183,8 +187,12 @@ def load_json(data: bytes, what: str = "JSON"):
     return obj
 
 
+class _Refused(ValueError):
+    """A JSON constant (NaN, Infinity) that no golden holds."""
+
+
 def _refuse_constant(name):
-    raise ValueError(f"{name} is not a number a golden holds")
+    raise _Refused(f"{name} is not a number a golden holds")
 
 
 def _check_numbers(obj) -> None:

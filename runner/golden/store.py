@@ -452,8 +452,7 @@ def _read_folder(name: str, folder: Path, max_frame_pixels: int) -> Golden:
     try:
         manifest = ser.load_json(load(ser.MANIFEST_FILE))
     except ValueError as exc:
-        msg = f"golden {name}: {shown_path(mpath)} is not JSON ({exc})"
-        raise GoldenUnreadable(msg) from None
+        raise unreadable(ser.MANIFEST_FILE, exc) from None
     fmt = manifest.get("format") if isinstance(manifest, dict) else None
     if fmt != ser.FORMAT_VERSION or isinstance(fmt, bool):
         raise GoldenUnreadable(
