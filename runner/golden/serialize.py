@@ -165,14 +165,16 @@ def json_depth(data: bytes) -> int:
     return peak
 
 
-def load_json(data: bytes, what: str = "JSON"):
-    """json.loads of `data`, refusing (ValueError) deep nesting, non-UTF-8 text, numbers past
-    range (non-finite, or integers past 64 bits) and anything that is not JSON."""
-    depth = json_depth(data)
-    if depth > MAX_JSON_DEPTH:
-        raise ValueError(f"nested {depth} levels deep, past {MAX_JSON_DEPTH}")
+def load_json(data: bytes, *, max_depth: int | None = MAX_JSON_DEPTH):
+    """json.loads of `data`, refusing (ValueError) nesting past `max_depth` (None: the caller has
+    bounded it), non-UTF-8 text, numbers past range (non-finite, or integers past 64 bits) and
+    anything that is not JSON."""
+    if max_depth is not None:
+        depth = json_depth(data)
+        if depth > max_depth:
+            raise ValueError(f"nested {depth} levels deep, past {max_depth}")
     try:
-        obj = json.loads(data.decode("utf-8"), parse_constant=_refuse_constant)
+        return _DECODER.decode(data.decode("utf-8"))
     except UnicodeDecodeError:
         raise ValueError("not UTF-8 text") from None
     except json.JSONDecodeError as exc:
@@ -181,36 +183,34 @@ def load_json(data: bytes, what: str = "JSON"):
         raise ValueError(str(exc)) from None
     except RecursionError:
         raise ValueError("nested too deep") from None
-    except ValueError:  # an integer of thousands of digits
-        raise ValueError("a number is out of range") from None
-    _check_numbers(obj)
-    return obj
 
 
 class _Refused(ValueError):
-    """A JSON constant (NaN, Infinity) that no golden holds."""
+    """A number no golden holds: NaN or an infinity, or an integer past 64 bits."""
 
 
 def _refuse_constant(name):
     raise _Refused(f"{name} is not a number a golden holds")
 
 
-def _check_numbers(obj) -> None:
-    """ValueError when `obj` (parsed JSON, depth already bounded) holds a non-finite float or an
-    integer past 64 bits."""
-    if isinstance(obj, dict):
-        for v in obj.values():
-            _check_numbers(v)
-    elif isinstance(obj, list):
-        for v in obj:
-            _check_numbers(v)
-    elif isinstance(obj, bool) or obj is None or isinstance(obj, str):
-        return
-    elif isinstance(obj, int):
-        if abs(obj) > MAX_INT:
-            raise ValueError("a number is out of range (an integer past 64 bits)")
-    elif isinstance(obj, float) and not math.isfinite(obj):
-        raise ValueError("a number is out of range (not finite)")
+def _parse_float(text: str) -> float:
+    value = float(text)
+    if not math.isfinite(value):
+        raise _Refused("a number is out of range (not finite)")
+    return value
+
+
+def _parse_int(text: str) -> int:
+    # Refused by its length before it is converted: no cost grows with the digits.
+    value = int(text) if len(text) <= 20 else MAX_INT + 1
+    if abs(value) > MAX_INT:
+        raise _Refused("a number is out of range (an integer past 64 bits)")
+    return value
+
+
+_DECODER = json.JSONDecoder(
+    parse_float=_parse_float, parse_int=_parse_int, parse_constant=_refuse_constant
+)
 
 
 def _int(obj, what: str, lo: int = 0, hi: int = MAX_INT) -> int:
@@ -272,15 +272,16 @@ def event_dicts(events: np.ndarray) -> list[dict]:
 def parse_events(data: bytes) -> list[dict]:
     """The events of an events.jsonl file, in order; raises ValueError naming a bad line (not
     JSON, nested, not an object, or a number past range)."""
-    if json_depth(data) > 1:
-        k = next(k for k, ln in enumerate(data.splitlines(), 1) if json_depth(ln) > 1)
+    lines = data.splitlines()
+    if json_depth(data) > 1:  # one pass over the file bounds every line
+        k = next(k for k, ln in enumerate(lines, 1) if json_depth(ln) > 1)
         raise ValueError(f"line {k}: an event is one flat JSON object (this line nests)")
     out = []
-    for k, line in enumerate(data.splitlines(), start=1):
+    for k, line in enumerate(lines, start=1):
         if not line.strip():
             continue
         try:
-            obj = load_json(line)
+            obj = load_json(line, max_depth=None)
         except ValueError as exc:
             raise ValueError(f"line {k}: {exc}") from None
         if not isinstance(obj, dict):
