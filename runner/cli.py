@@ -2,7 +2,8 @@
 
 Each subcommand lives with what it drives (`run` here; `validate`/`schema` in runner.validate;
 `check`/`bless` in runner.golden.cli) and registers itself on the parser. Exit status: 0 fine,
-1 a check found a difference, 2 bad input or usage. A refused scenario prints
+1 a check found a difference, 2 bad input or usage, 3 an unexpected error (one line naming the
+scenario; the traceback too with `--debug`). A refused scenario prints
 `FILE:LINE:COL: error: MESSAGE` on stderr and writes nothing.
 """
 
@@ -10,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import traceback
 from importlib import resources
 
 from engine.models import ModelUnavailable
@@ -28,6 +30,7 @@ from runner.scenario import ScenarioError, load
 EXIT_OK = 0
 EXIT_DIFFERENCE = 1
 EXIT_BAD_INPUT = 2
+EXIT_UNEXPECTED = 3
 
 
 def demo_path() -> str:
@@ -111,6 +114,10 @@ def build_parser() -> argparse.ArgumentParser:
     validate.register(subparsers)
     stress.register(subparsers)
     bench.register(subparsers)
+    for sub in subparsers.choices.values():
+        sub.add_argument(
+            "--debug", action="store_true", help="print the traceback of an unexpected error"
+        )
     return parser
 
 
@@ -135,6 +142,25 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("collide2d: interrupted; outputs already written are whole", file=sys.stderr)
         return 130
+    except Exception as err:  # a bug, not the user's input: say so in one line, exit 3
+        return unexpected(err, args)
+
+
+def unexpected(err: Exception, args: argparse.Namespace) -> int:
+    """Report an unexpected error in one line naming what was being run (with the traceback
+    under --debug); the exit status is EXIT_UNEXPECTED."""
+    if getattr(args, "debug", False):
+        traceback.print_exception(type(err), err, err.__traceback__, file=sys.stderr)
+    what = getattr(args, "scenario", None)
+    if isinstance(what, list):
+        what = " ".join(what)
+    where = f" while running {what or args.command}"
+    print(
+        f"collide2d: unexpected error{where}: {type(err).__name__}: {err} "
+        "(this is a bug; --debug shows where)",
+        file=sys.stderr,
+    )
+    return EXIT_UNEXPECTED
 
 
 if __name__ == "__main__":

@@ -2,7 +2,7 @@
 
 `add_limit_arguments` / `limits_from_args` carry SPEC section 8's bounds (`--max-objects`,
 `--max-ticks`, `--max-side`, `--max-frames`, `--max-file-bytes`, `--max-yaml-nodes`, and
-`--max-output-bytes` where frames are written);
+`--max-output-bytes` and `--max-frame-bytes` where frames are written);
 `add_override_arguments` / `overrides_from_args` carry `--model`, `--fps`, `--ticks`, which override
 the scenario file (the loader checks the result again).
 """
@@ -18,11 +18,14 @@ _LIMIT_OPTIONS = (
     ("--max-objects", "max_objects", "objects in a scenario"),
     ("--max-ticks", "max_ticks", "ticks of a run"),
     ("--max-side", "max_side", "pixels per world side"),
-    ("--max-frames", "max_frames", "frame numbers one `frames` entry may ask for"),
+    ("--max-frames", "max_frames", "frames a `frames` entry may ask for, or a run write"),
     ("--max-file-bytes", "max_file_bytes", "bytes in a scenario file"),
     ("--max-yaml-nodes", "max_yaml_nodes", "YAML values in a scenario file"),
 )
-_OUTPUT_OPTION = ("--max-output-bytes", "max_output_bytes", "bytes of frame output")
+_OUTPUT_OPTIONS = (
+    ("--max-output-bytes", "max_output_bytes", "bytes of frame files (PNG and GIF) on disk"),
+    ("--max-frame-bytes", "max_frame_bytes", "bytes of one frame in memory (RGB, scaled)"),
+)
 
 
 def positive_int(text: str) -> int:
@@ -45,7 +48,7 @@ def add_limit_arguments(parser: argparse.ArgumentParser, *, output: bool = False
     """Add the limit options (defaults from Limits); `output` adds --max-output-bytes too."""
     defaults = Limits()
     group = parser.add_argument_group("limits")
-    for flag, field, what in _LIMIT_OPTIONS + ((_OUTPUT_OPTION,) if output else ()):
+    for flag, field, what in _LIMIT_OPTIONS + (_OUTPUT_OPTIONS if output else ()):
         group.add_argument(
             flag,
             dest=field,
@@ -58,7 +61,7 @@ def add_limit_arguments(parser: argparse.ArgumentParser, *, output: bool = False
 
 def limits_from_args(args: argparse.Namespace) -> Limits:
     """The Limits asked for on the command line (defaults for options not present)."""
-    fields = [f for _, f, _ in _LIMIT_OPTIONS + (_OUTPUT_OPTION,)]
+    fields = [f for _, f, _ in _LIMIT_OPTIONS + _OUTPUT_OPTIONS]
     return Limits(**{f: getattr(args, f) for f in fields if getattr(args, f, None)})
 
 

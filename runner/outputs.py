@@ -64,6 +64,21 @@ def _open_temp(path: Path) -> tuple[Path, int]:
             continue
 
 
+def final_name(name: str) -> str:
+    """The name a temporary file of this module will be renamed to (`name` itself otherwise)."""
+    if _TEMP_RE.match(name):
+        return name[1:].rsplit(".", 3)[0]
+    return name
+
+
+def _named(exc: OSError, path: Path) -> OSError:
+    """`exc` naming `path` when it names no file (a failed write names none): the message
+    then says which output could not be written."""
+    if not exc.filename:
+        exc.filename = str(path)
+    return exc
+
+
 def _remove(path: Path) -> None:
     with contextlib.suppress(FileNotFoundError):
         os.unlink(path)
@@ -82,6 +97,9 @@ def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
     try:
         yield tmp
         os.replace(tmp, path)
+    except OSError as exc:
+        _remove(tmp)
+        raise _named(exc, path) from None
     except BaseException:
         _remove(tmp)
         raise
@@ -110,10 +128,16 @@ class _StreamFile:
     def write(self, data: bytes) -> None:
         if self.done:
             raise ValueError(f"{self.path}: already closed")
-        self._file.write(data)
+        try:
+            self._file.write(data)
+        except OSError as exc:
+            raise _named(exc, self.path) from None
 
     def flush(self) -> None:
-        self._file.flush()
+        try:
+            self._file.flush()
+        except OSError as exc:
+            raise _named(exc, self.path) from None
 
     def commit(self) -> None:
         if self.done:
@@ -122,6 +146,9 @@ class _StreamFile:
         try:
             self._file.close()
             os.replace(self.tmp, self.path)
+        except OSError as exc:
+            _remove(self.tmp)
+            raise _named(exc, self.path) from None
         except BaseException:
             _remove(self.tmp)
             raise
@@ -224,8 +251,8 @@ def write_png(path: str | os.PathLike, rgb: np.ndarray, scale: int = 1) -> None:
 # GIF
 
 
-def gif_schedule(n_frames: int, fps: int) -> tuple[np.ndarray, np.ndarray, str | None]:
-    """Which frames the GIF shows and for how long: (kept (m,) int64, delays_cs (m,) int64, note).
+class GifSchedule:
+    """Which frames the GIF shows and for how long, by arithmetic (nothing sized by the run).
 
     Frame i of n is due at t_i = i / fps seconds and the animation ends at t_n. GIF delays are
     whole centiseconds, so each kept frame starts at a rounded time and lasts until the next kept
@@ -240,33 +267,57 @@ def gif_schedule(n_frames: int, fps: int) -> tuple[np.ndarray, np.ndarray, str |
     2 cs. The last kept frame lasts until the end; if that leaves it under 2 cs, it is dropped and
     the one before lasts until the end (2 or 3 cs). A whole animation shorter than 2 cs is one frame
     of 2 cs. `note` says, for people, that frames were dropped; it is None when none were.
+
+    `count` is the number of frames shown; `kept(j)` the run frame shown j-th, `delay_cs(j)` how
+    long it lasts, for 0 <= j < count.
     """
-    n = int(n_frames)
-    fps = int(fps)
-    if fps < 1:
-        raise ValueError(f"fps must be >= 1, got {fps}")
-    if n <= 0:
-        return np.zeros(0, np.int64), np.zeros(0, np.int64), None
-    end_cs = (200 * n + fps) // (2 * fps)
-    if fps <= GIF_MAX_FPS:
-        i = np.arange(n + 1, dtype=np.int64)
-        starts = (200 * i + fps) // (2 * fps)
-        return np.arange(n, dtype=np.int64), np.diff(starts), None
-    slots = (n - 1) * GIF_MAX_FPS // fps + 1
-    m = np.arange(slots, dtype=np.int64)
-    kept = (m * fps + GIF_MAX_FPS - 1) // GIF_MAX_FPS  # ceil(m * fps / 50): first frame of slot m
-    starts = GIF_MIN_DELAY_CS * m
-    if slots >= 2 and end_cs - starts[-1] < GIF_MIN_DELAY_CS:
-        kept = kept[:-1]
-        starts = starts[:-1]
-    delays = np.diff(np.append(starts, max(end_cs, GIF_MIN_DELAY_CS)))
-    if len(kept) == n:
-        return kept, delays, None
-    note = (
-        f"GIF shows {GIF_MAX_FPS} of {fps} frames per second "
-        f"(delays under {GIF_MIN_DELAY_CS} cs are stretched by browsers)"
-    )
-    return kept, delays, note
+
+    def __init__(self, n_frames: int, fps: int):
+        self.n = n = max(int(n_frames), 0)
+        self.fps = fps = int(fps)
+        if fps < 1:
+            raise ValueError(f"fps must be >= 1, got {fps}")
+        self.end_cs = (200 * n + fps) // (2 * fps)
+        self.dropping = fps > GIF_MAX_FPS
+        if n == 0 or not self.dropping:
+            self.count = n
+        else:
+            slots = (n - 1) * GIF_MAX_FPS // fps + 1
+            last_start = GIF_MIN_DELAY_CS * (slots - 1)
+            drop_last = slots >= 2 and self.end_cs - last_start < GIF_MIN_DELAY_CS
+            self.count = slots - 1 if drop_last else slots
+        self.note = None
+        if self.count != n:
+            self.note = (
+                f"GIF shows {GIF_MAX_FPS} of {fps} frames per second "
+                f"(delays under {GIF_MIN_DELAY_CS} cs are stretched by browsers)"
+            )
+
+    def kept(self, j: int) -> int:
+        """The run frame shown j-th: the first frame of 2 cs slot j when dropping."""
+        if not self.dropping:
+            return j
+        return (j * self.fps + GIF_MAX_FPS - 1) // GIF_MAX_FPS  # ceil(j * fps / 50)
+
+    def _start_cs(self, j: int) -> int:
+        if j >= self.count:
+            return max(self.end_cs, GIF_MIN_DELAY_CS) if self.dropping else self.end_cs
+        if self.dropping:
+            return GIF_MIN_DELAY_CS * j
+        return (200 * j + self.fps) // (2 * self.fps)
+
+    def delay_cs(self, j: int) -> int:
+        """How long the j-th shown frame lasts, in centiseconds."""
+        return self._start_cs(j + 1) - self._start_cs(j)
+
+
+def gif_schedule(n_frames: int, fps: int) -> tuple[np.ndarray, np.ndarray, str | None]:
+    """`GifSchedule` written out: (kept (m,) int64, delays_cs (m,) int64, note); for tests and
+    short runs only, as its arrays are as long as the GIF."""
+    sched = GifSchedule(n_frames, fps)
+    kept = np.array([sched.kept(j) for j in range(sched.count)], dtype=np.int64)
+    delays = np.array([sched.delay_cs(j) for j in range(sched.count)], dtype=np.int64)
+    return kept, delays, sched.note
 
 
 def _gif_palette(palette: np.ndarray) -> bytes:
@@ -319,7 +370,8 @@ class GifWriter(_StreamWriter):
             raise ValueError(f"a GIF is at most 65535 px a side, got {out_w}x{out_h}")
         self.n_frames = int(n_frames)
         self.n_colors = int(palette.shape[0])
-        self.kept, self.delays_cs, self.note = gif_schedule(self.n_frames, int(fps))
+        self.schedule = GifSchedule(self.n_frames, int(fps))
+        self.note = self.schedule.note
         self._palette = _gif_palette(palette)
         self._size = (out_w, out_h)
         self._seen = 0  # frames given to add
@@ -348,7 +400,7 @@ class GifWriter(_StreamWriter):
             raise ValueError(f"{self.path}: more than the {self.n_frames} frames announced")
         i = self._seen
         self._seen += 1
-        if self._next >= len(self.kept) or self.kept[self._next] != i:
+        if self._next >= self.schedule.count or self.schedule.kept(self._next) != i:
             return
         frame = np.asarray(frame)
         if frame.shape != (self.height, self.width) or frame.dtype != np.uint8:
@@ -360,7 +412,7 @@ class GifWriter(_StreamWriter):
             raise ValueError(
                 f"frame uses colour {int(frame.max())}; the palette has {self.n_colors}"
             )
-        delay = int(self.delays_cs[self._next])
+        delay = self.schedule.delay_cs(self._next)
         if delay > GIF_MAX_DELAY_CS:
             raise ValueError(f"a GIF frame lasts at most {GIF_MAX_DELAY_CS} cs, needed {delay}")
         self._next += 1

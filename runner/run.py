@@ -4,14 +4,17 @@
 at every frame someone needs (and often enough to show progress and stream events), rasterises only
 those frames, and calls back with events and frames as they come. Two front ends sit on it:
 `simulate` keeps everything in memory (goldens, tests), `run_to_dir` streams the files of SPEC
-section 5 into `OUT/NAME/`, each through a temporary name and a rename (temporaries a killed run
-left there are removed first). A model that stops a run as a runaway (the exact model's event cap,
-the stepped model's fold limit) raises `RunStopped` with a message for the user.
+section 5 into a staging folder that replaces `OUT/NAME/` whole when the run is done, under a lock
+(`runner.rundir`), after `runner.budget` has checked what its frames will cost. Frames are a
+`FrameRule`, so nothing sized by the number of ticks is built. A model that stops a run as a
+runaway (the exact model's event cap, the stepped model's fold limit) raises `RunStopped` with a
+message for the user.
 """
 
 from __future__ import annotations
 
 import os
+import shutil
 import sys
 import time
 from collections.abc import Callable, Iterable
@@ -25,22 +28,14 @@ from engine.events import EV_PAIR, EV_WALL, empty_events
 from engine.models.exact import EventCapExceeded
 from engine.raster import Renderer
 from engine.world import kinetic_energy, momentum
-from runner import outputs
+from runner import budget, outputs, rundir
+from runner.frames import FrameRule
 from runner.progress import Progress
 from runner.scenario import Limits, Scenario, ScenarioError
 
 # Ticks per model call when nothing else ends a chunk: large enough that the kernel dominates,
 # small enough that events stream out and progress moves.
 CHUNK_TICKS = 65_536
-# Upper bound of a frame's bytes on disk used to refuse runs whose output would be too big:
-# PNG and GIF frames are compressed, so raw RGB (PNG) and raw indices (GIF) bound them.
-PNG_BYTES_PER_PIXEL = 3
-GIF_BYTES_PER_PIXEL = 1
-# The largest side of a GIF picture, px (its header holds 16-bit sizes).
-GIF_MAX_SIDE_PX = 65535
-# The output files `run_to_dir` knows; any of them not written by a run is removed, so the folder
-# always shows one run.
-OUTPUT_FILES = ("animation.gif", "events.jsonl", "final.csv", "summary.json")
 
 
 class RunStopped(Exception):
@@ -63,7 +58,7 @@ class RunResult:
 def drive(
     scenario: Scenario,
     *,
-    frames: Iterable[int] = (),
+    frames: FrameRule | Iterable[int] = (),
     on_frame: Callable[[int, np.ndarray], None] | None = None,
     log_events: bool = False,
     on_events: Callable[[np.ndarray], None] | None = None,
@@ -71,8 +66,9 @@ def drive(
 ) -> tuple[object, dict]:
     """Run the scenario; returns (the model at the end, the summary).
 
-    frames: frame numbers (0..ticks) to rasterise; each is passed to `on_frame(k, index_frame)` as
-    an (H, W) uint8 palette-index image that is only valid during the call.
+    frames: the frames (0..ticks) to rasterise, a FrameRule or frame numbers; each is passed to
+    `on_frame(k, index_frame)` as an (H, W) uint8 palette-index image that is only valid during
+    the call.
     log_events: record events and pass each chunk's array to `on_events`.
     """
     bodies = scenario.bodies
@@ -83,20 +79,21 @@ def drive(
         substeps=scenario.substeps,
         geometry=scenario.geometry,
     )
-    wanted = sorted({int(k) for k in frames if 0 <= k <= scenario.ticks})
-    renderer = Renderer(scenario.world, bodies) if wanted else None
+    if not isinstance(frames, FrameRule):
+        frames = FrameRule.of(frames, scenario.ticks)
+    renderer = Renderer(scenario.world, bodies) if frames else None
     counts = {"wall": 0, "pair": 0}
     start = _energy_momentum(bodies, model.velocities())
     began = time.perf_counter()
 
-    next_frame = 0
-    if wanted and wanted[0] == 0:
+    next_frame = frames.next_from(0)
+    if next_frame == 0:
         on_frame(0, renderer.draw(model.positions()))
-        next_frame = 1
+        next_frame = frames.next_from(1)
     while model.tick < scenario.ticks:
         stop = min(scenario.ticks, model.tick + CHUNK_TICKS)
-        if next_frame < len(wanted):
-            stop = min(stop, wanted[next_frame])
+        if next_frame is not None:
+            stop = min(stop, next_frame)
         try:
             events = model.advance(stop - model.tick, log_events)
         except (EventCapExceeded, ValueError) as exc:
@@ -110,9 +107,9 @@ def drive(
             counts["pair"] += int(np.count_nonzero(events["type"] == EV_PAIR))
             if on_events is not None:
                 on_events(events)
-        if next_frame < len(wanted) and model.tick == wanted[next_frame]:
+        if model.tick == next_frame:
             on_frame(model.tick, renderer.draw(model.positions()))
-            next_frame += 1
+            next_frame = frames.next_from(model.tick + 1)
         if progress is not None:
             progress.update(model.tick)
     run_time = time.perf_counter() - began
@@ -172,53 +169,12 @@ class RunOptions:
 
 def output_dir(out_root: str | os.PathLike, scenario: Scenario) -> Path:
     """OUT/NAME, refusing a path that would lead outside OUT (a link in the way)."""
-    root = Path(out_root)
-    target = root / scenario.name
-    for path in (target, target / "frames"):
-        if path.is_symlink():
-            raise ScenarioError(
-                scenario.path or "<scenario>",
-                1,
-                1,
-                f"output folder {path} is a symbolic link; refusing to write through it",
-            )
+    target = Path(out_root) / scenario.name
+    try:
+        rundir.check_replaceable(target)
+    except rundir.OutputRefused as exc:
+        raise ScenarioError(scenario.path or "<scenario>", 1, 1, str(exc)) from None
     return target
-
-
-def check_output_size(scenario: Scenario, options: RunOptions, limits: Limits) -> None:
-    """Refuse before running when the frames asked for could pass limits.max_output_bytes, or a
-    GIF would be larger than a GIF can be."""
-    pixels = scenario.world.width * scenario.world.height * options.scale**2
-    side = max(scenario.world.width, scenario.world.height) * options.scale
-    if options.gif and side > GIF_MAX_SIDE_PX:
-        raise ScenarioError(
-            scenario.path or "<scenario>",
-            1,
-            1,
-            f"a GIF is at most {GIF_MAX_SIDE_PX} px a side, and this world at scale "
-            f"{options.scale} needs {side} px; use a smaller --scale or --no-gif",
-        )
-    total = 0
-    if options.png:
-        total += len(png_frames(scenario)) * pixels * PNG_BYTES_PER_PIXEL
-    if options.gif:
-        total += (scenario.ticks + 1) * pixels * GIF_BYTES_PER_PIXEL
-    if total > limits.max_output_bytes:
-        raise ScenarioError(
-            scenario.path or "<scenario>",
-            1,
-            1,
-            f"the frames asked for could take up to {total:,} bytes, past the output limit of "
-            f"{limits.max_output_bytes:,} bytes; ask for fewer frames (output.frames, --no-png, "
-            f"--no-gif, a smaller --scale) or raise --max-output-bytes",
-        )
-
-
-def png_frames(scenario: Scenario) -> tuple[int, ...]:
-    """The frames written as PNG when PNGs are on: the scenario's choice, or all if none."""
-    if scenario.output.frames:
-        return scenario.output.frames
-    return tuple(range(scenario.ticks + 1))
 
 
 def run_to_dir(
@@ -227,23 +183,57 @@ def run_to_dir(
     options: RunOptions,
     limits: Limits | None = None,
 ) -> tuple[Path, dict]:
-    """Run and write SPEC section 5's files under OUT/NAME; returns (that folder, the summary)."""
+    """Run and write SPEC section 5's files as OUT/NAME; returns (that folder, the summary).
+
+    The frames are planned and checked against the limits first; then, holding OUT/NAME's lock,
+    everything is written into a staging folder that replaces OUT/NAME whole at the end (see
+    `runner.rundir`). On any failure the staging folder goes and the previous run stays.
+    """
     limits = limits or Limits()
-    check_output_size(scenario, options, limits)
-    target = output_dir(out_root, scenario)
-    frames_dir = target / "frames"
-    target.mkdir(parents=True, exist_ok=True)
-    png_set = set(png_frames(scenario)) if options.png else set()
-    if png_set:
-        frames_dir.mkdir(exist_ok=True)
-    for folder in (target, frames_dir):  # what a killed run left (`.NAME.PID.XXXXXXXX.tmp`)
-        outputs.clean_temporaries(folder)
-    wanted = set(png_set)
+    plan = budget.plan_frames(
+        scenario, png=options.png, gif=options.gif, scale=options.scale, limits=limits
+    )
+    root = Path(out_root)
+    target = output_dir(root, scenario)
+    root.mkdir(parents=True, exist_ok=True)
+    try:
+        with rundir.RunLock(root, scenario.name):
+            rundir.clean_leftovers(root, scenario.name)
+            output_dir(root, scenario)  # again, now that no other run can change it
+            stage = rundir.new_stage(root, scenario.name)
+            try:
+                summary = _write_run(scenario, stage, options, plan)
+                rundir.swap_in(stage, target)
+            except BaseException as exc:
+                shutil.rmtree(stage, ignore_errors=True)
+                if isinstance(exc, OSError) and exc.filename:
+                    exc.filename = _shown(exc.filename, stage, target)
+                raise
+    except rundir.OutputBusy as exc:
+        raise ScenarioError(scenario.path or "<scenario>", 1, 1, str(exc)) from None
+    return target, summary
+
+
+def _shown(filename, stage: Path, target: Path) -> str:
+    """A path inside the staging folder as the user will know it: under OUT/NAME."""
+    path = Path(os.fsdecode(filename))
+    try:
+        inside = path.relative_to(stage)
+    except ValueError:
+        return str(path)
+    final = inside.with_name(outputs.final_name(inside.name))
+    return str(target / final)
+
+
+def _write_run(scenario: Scenario, folder: Path, options: RunOptions, plan) -> dict:
+    """Run the scenario, writing its files into the empty `folder`; returns the summary."""
+    frames_dir = folder / "frames"
+    if plan.png:
+        frames_dir.mkdir()
     gif = None
-    if options.gif:
-        wanted.update(range(scenario.ticks + 1))
+    if plan.gif:
         gif = outputs.GifWriter(
-            target / "animation.gif",
+            folder / "animation.gif",
             scenario.palette,
             scenario.world.width,
             scenario.world.height,
@@ -253,57 +243,36 @@ def run_to_dir(
         )
         if gif.note and not options.quiet:
             print(f"{scenario.name}: {gif.note}", file=sys.stderr)
-    log = outputs.EventsWriter(target / "events.jsonl") if options.events else None
+    log = outputs.EventsWriter(folder / "events.jsonl") if options.events else None
     digits = max(6, len(str(scenario.ticks)))
-    written: set[str] = set()
 
     def on_frame(k: int, idx: np.ndarray) -> None:
         if gif is not None:
             gif.add(idx)
-        if k in png_set:
+        if k in plan.png:
             name = f"frame_{k:0{digits}d}.png"
             outputs.write_png(frames_dir / name, scenario.palette[idx], scale=options.scale)
-            written.add(name)
 
     progress = None if options.quiet else Progress.for_terminal(scenario.ticks, scenario.name)
+    writers = [w for w in (gif, log) if w is not None]
     try:
         model, summary = drive(
             scenario,
-            frames=sorted(wanted),
+            frames=plan.draw,
             on_frame=on_frame,
             log_events=options.events,
             on_events=log.write if log else None,
             progress=progress,
         )
-    except BaseException:
-        for writer in (gif, log):
-            if writer is not None:
-                writer.abort()
-        raise
-    for writer in (gif, log):
-        if writer is not None:
+        for writer in writers:
             writer.close()
-    outputs.write_final_csv(target / "final.csv", model.positions(), model.velocities())
-    outputs.write_json(target / "summary.json", summary)
-    _remove_stale(target, frames_dir, options, written)
-    return target, summary
-
-
-def _remove_stale(target: Path, frames_dir: Path, options: RunOptions, written: set[str]) -> None:
-    """Remove outputs of an earlier run that this run did not write (only names we own)."""
-    keep = {"final.csv", "summary.json"}
-    if options.gif:
-        keep.add("animation.gif")
-    if options.events:
-        keep.add("events.jsonl")
-    for name in OUTPUT_FILES:
-        path = target / name
-        if name not in keep and path.is_file() and not path.is_symlink():
-            path.unlink()
-    if frames_dir.is_dir() and not frames_dir.is_symlink():
-        for path in frames_dir.glob("frame_*.png"):
-            if path.name not in written and not path.is_symlink():
-                path.unlink()
+    except BaseException:
+        for writer in writers:
+            writer.abort()
+        raise
+    outputs.write_final_csv(folder / "final.csv", model.positions(), model.velocities())
+    outputs.write_json(folder / "summary.json", summary)
+    return summary
 
 
 def _check_finite(scenario: Scenario, model, start, end) -> None:

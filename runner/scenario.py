@@ -63,6 +63,7 @@ from engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies, WorldSpec
 from runner import colors
 from runner import generate as gen
 from runner import yamlsafe as ys
+from runner.frames import FrameRule
 from runner.yamlsafe import ScenarioError
 
 FORMAT_VERSION = 1
@@ -151,15 +152,16 @@ class Limits:
     max_ticks: int = 10**9
     max_side: int = 16384  # px per world side
     max_alias_nodes: int = 10_000  # YAML nodes reached a second time or more through aliases
-    max_output_bytes: int = 4 * 2**30  # used by the run, carried here so all bounds live together
-    max_frames: int = 1_000_000  # frame numbers one `frames` entry may list (output or golden)
+    max_output_bytes: int = 4 * 2**30  # bytes of frame files on disk (PNG and GIF), at most
+    max_frame_bytes: int = 2**30  # bytes of one frame in memory: width x height x scale^2 x 3
+    max_frames: int = 1_000_000  # frames one `frames` entry may ask for, and a run may write
     max_file_bytes: int = 64 * 2**20  # bytes of a scenario file (it is read whole)
     max_yaml_nodes: int = 2_000_000  # YAML values in a file: each costs memory when composed
 
 
 @dataclass(frozen=True)
 class Output:
-    frames: tuple[int, ...]  # the frame numbers (0..ticks) asked for, sorted, unique
+    frames: FrameRule  # the frames (0..ticks) asked for
     frames_spec: (
         object  # what the file said, normalised: "all" | "none" | "last" | list | {"every": k}
     )
@@ -941,12 +943,13 @@ class _Reader:
 
     # -- output and golden
 
-    def frames(self, node, what: str, ticks: int) -> tuple[tuple[int, ...], object]:
-        """(frame numbers, normalised spec) of a `frames` entry."""
+    def frames(self, node, what: str, ticks: int) -> tuple[FrameRule, object]:
+        """(the frame rule, normalised spec) of a `frames` entry; its count is checked against
+        limits.max_frames by arithmetic, so no list sized by `ticks` is ever built."""
         origin = self.prefix(self.ticks_from)
         too_many = (
-            f"{origin}{what} asks for {{n}} frames, past the limit of "
-            f"{self.limits.max_frames} frames; raise it with --max-frames"
+            f"{origin}{what} asks for {{n:,}} frames, past the limit of "
+            f"{self.limits.max_frames:,} frames; raise it with --max-frames"
         )
         if isinstance(node, yaml.SequenceNode):
             given = []
@@ -961,19 +964,19 @@ class _Reader:
                         f"{ticks} (ticks: {ticks})",
                     )
                 given.append(f)
-            frames = tuple(sorted(set(given)))
-            if len(frames) > self.limits.max_frames:
-                raise self.error(node, too_many.format(n=len(frames)))
-            return frames, given
+            rule = FrameRule.of(given, ticks)
+            if len(rule) > self.limits.max_frames:
+                raise self.error(node, too_many.format(n=len(rule)))
+            return rule, given
         if isinstance(node, yaml.MappingNode):
             m = self.mapping(node, what, EVERY_KEYS)
             if "every" not in m:
                 raise self.error(node, f"{what} as a mapping must be {{every: k}}")
             k = self.integer(m["every"][1], f"{what}.every", lo=1, of=" of ticks")
-            n = ticks // k + 1
-            if n > self.limits.max_frames:
-                raise self.error(node, too_many.format(n=n))
-            return tuple(range(0, ticks + 1, k)), {"every": k}
+            rule = FrameRule.every_k(k, ticks)
+            if len(rule) > self.limits.max_frames:
+                raise self.error(node, too_many.format(n=len(rule)))
+            return rule, {"every": k}
         v = self.scalar(node, what)
         if v not in FRAME_WORDS or not isinstance(v, str):
             near = difflib.get_close_matches(v, FRAME_WORDS, n=1) if isinstance(v, str) else []
@@ -983,15 +986,14 @@ class _Reader:
                 f"{what} must be all, none, last, a list of frame numbers or "
                 f"{{every: k}}, not {ys.describe(node)}{hint}",
             )
-        if v == "all":
-            if ticks + 1 > self.limits.max_frames:
-                raise self.error(node, too_many.format(n=ticks + 1))
-            return tuple(range(ticks + 1)), v
-        return ((ticks,) if v == "last" else ()), v
+        rule = {"all": FrameRule.all, "last": FrameRule.last, "none": FrameRule.none}[v](ticks)
+        if len(rule) > self.limits.max_frames:
+            raise self.error(node, too_many.format(n=len(rule)))
+        return rule, v
 
     def output(self, top: dict, ticks: int) -> Output:
         m = self.mapping(top["output"][1], "output", OUTPUT_KEYS) if "output" in top else {}
-        frames, spec = (), "none"
+        frames, spec = FrameRule.none(ticks), "none"
         if "frames" in m:
             frames, spec = self.frames(m["frames"][1], "output.frames", ticks)
         gif = self.boolean(m["gif"][1], "output.gif") if "gif" in m else True
@@ -1002,7 +1004,8 @@ class _Reader:
         m = self.mapping(top["golden"][1], "golden", GOLDEN_KEYS) if "golden" in top else {}
         frames = tuple(sorted({0, ticks // 2, ticks}))
         if "frames" in m:
-            frames, _ = self.frames(m["frames"][1], "golden.frames", ticks)
+            rule, _ = self.frames(m["frames"][1], "golden.frames", ticks)
+            frames = tuple(rule)  # within limits.max_frames: goldens store each one
         tol = 0.0
         if "time_tolerance" in m:
             tol = float(

@@ -11,16 +11,17 @@ anything converts it: Python's `int()` refuses more than 4,300 digits, YAML 1.1'
 integers (`190:20:30`) cost time quadratic in their length, and no field needs so long a number. A
 long scalar counts as a number when it is tagged `!!int` or `!!float`, or is plain and looks like
 one (`_NUMBER_LIKE_RE`, a superset of YAML 1.1's forms and of the exponent form `1e3`, checked in
-linear time); every other long plain scalar is text, and the loader never tries YAML's number
-patterns on it (see `_Loader`). So every number is read at a cost linear in its text, and every
-integer a scenario holds is below 16**98 (about 1e118), far inside float64's range. Then
-`yaml.compose` with that loader builds the node tree that `runner.scenario` walks by hand. `value`
-and `describe` read scalar nodes for it; a plain scalar YAML takes for an integer but that makes
-none (`0x_`: its digits are all underscores) is read as its text.
+linear time); every other long plain scalar is text, and YAML's number patterns are never tried on
+it (see `_composing`). So every number is read at a cost linear in its text, and every integer a
+scenario holds is below 16**98 (about 1e118), far inside float64's range. Then `yaml.compose` with
+the safe loader (libyaml's when available) builds the node tree that `runner.scenario` walks by
+hand. `value` and `describe` read scalar nodes for it; a plain scalar YAML takes for an integer but
+that makes none (`0x_`: its digits are all underscores) is read as its text.
 """
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import os
 import re
@@ -48,19 +49,23 @@ _CONSTRUCTOR = yaml.constructor.SafeConstructor()
 _NUMBER_LIKE_RE = re.compile(r"[-+]?\.?[0-9][0-9a-fA-Fxob_:.+-]*\Z")
 
 
-class _Loader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):
-    """The safe loader (libyaml's when available), taking every plain scalar longer than
-    MAX_NUMBER_CHARS for text without trying YAML's number patterns on it: the event pass has
-    refused those that look like numbers, and the patterns for sexagesimal numbers keep memory
-    per repetition (tens of bytes per character of a text such as `1:59:59:...:59 x`)."""
-
-    def resolve(self, kind, value, implicit):
-        if kind is yaml.ScalarNode and implicit[0] and len(value) > MAX_NUMBER_CHARS:
-            return CORE_TAG + "str"
-        return super().resolve(kind, value, implicit)
+_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
 
-_LOADER = _Loader
+@functools.cache
+def _composing(loader: type) -> type:
+    """`loader` taking every plain scalar longer than MAX_NUMBER_CHARS for text without trying
+    YAML's number patterns on it: the event pass has refused those that look like numbers, and the
+    patterns for sexagesimal numbers keep memory per repetition (tens of bytes per character of a
+    text such as `1:59:59:...:59 x`)."""
+
+    class Composing(loader):
+        def resolve(self, kind, value, implicit):
+            if kind is yaml.ScalarNode and implicit[0] and len(value) > MAX_NUMBER_CHARS:
+                return CORE_TAG + "str"
+            return super().resolve(kind, value, implicit)
+
+    return Composing
 
 
 class ScenarioError(Exception):
@@ -150,7 +155,29 @@ def _tag_name(tag: str) -> str:
 
 
 def _check_events(text: str, path: str, limits: Limits) -> None:
-    """Stream the YAML events once: depth, one document, plain tags, and the alias bound."""
+    """Stream the YAML events once: depth, one document, plain tags, and the alias bound.
+
+    The fast parser (libyaml's, when PyYAML has it) reads ahead of the events it hands out and
+    may hold limits of its own (PyYAML 6.0.4's libyaml stops at 1,000 flow levels, found while
+    reading ahead of our 65th). So when it fails, the same pass runs again with PyYAML's pure
+    Python parser, which has no limit of its own: our bounds decide wherever they are passed
+    first, and a file that is invalid YAML is reported in the same words with or without libyaml.
+    Only refused files pay for the second pass, which stops at the first problem it meets.
+    """
+    try:
+        _stream_events(text, path, limits, _LOADER)
+    except yaml.YAMLError as exc:
+        if _LOADER is yaml.SafeLoader:
+            raise _yaml_error(exc, path, text) from None
+        try:
+            _stream_events(text, path, limits, yaml.SafeLoader)
+        except yaml.YAMLError as pure:
+            raise _yaml_error(pure, path, text) from None
+        raise _yaml_error(exc, path, text) from None
+
+
+def _stream_events(text: str, path: str, limits: Limits, loader) -> None:
+    """The checks of `_check_events` over the events of one parser; YAMLError passes through."""
     sizes: dict[str, int] = {}  # anchor -> nodes in the node it names, aliases expanded
     stack: list[list] = []  # per open collection: [nodes so far, anchor]
     repeated = 0  # nodes reached again through aliases
@@ -161,76 +188,73 @@ def _check_events(text: str, path: str, limits: Limits) -> None:
         if stack:
             stack[-1][0] += n
 
-    try:
-        for ev in yaml.parse(text, Loader=_LOADER):
-            if isinstance(ev, yaml.DocumentStartEvent):
-                documents += 1
-                if documents > 1:
+    for ev in yaml.parse(text, Loader=loader):
+        if isinstance(ev, yaml.DocumentStartEvent):
+            documents += 1
+            if documents > 1:
+                raise mark_error(
+                    path,
+                    ev.start_mark,
+                    "a scenario file holds one YAML document; this is a second one",
+                )
+        elif isinstance(ev, yaml.AliasEvent):
+            n = sizes.get(ev.anchor)
+            if n is None:
+                inside = any(entry[1] == ev.anchor for entry in stack)
+                what = "refers to a node that contains it" if inside else "has no anchor"
+                raise mark_error(path, ev.start_mark, f"alias '*{ev.anchor}' {what}")
+            repeated += n
+            if repeated > limits.max_alias_nodes:
+                raise mark_error(
+                    path,
+                    ev.start_mark,
+                    f"aliases repeat more than {limits.max_alias_nodes} YAML nodes "
+                    f"(alias '*{ev.anchor}' repeats {n}); refusing to expand them",
+                )
+            add(n)
+        elif isinstance(ev, yaml.NodeEvent) and not isinstance(ev, yaml.CollectionEndEvent):
+            tag = getattr(ev, "tag", None)
+            nodes += 1
+            if nodes > limits.max_yaml_nodes:
+                raise mark_error(
+                    path,
+                    ev.start_mark,
+                    f"the file holds more than {limits.max_yaml_nodes:,} YAML values, the "
+                    "limit; raise it with --max-yaml-nodes",
+                )
+            if tag is not None and tag not in _ALLOWED_TAGS:
+                raise mark_error(
+                    path,
+                    ev.start_mark,
+                    f"YAML tag '{_tag_name(tag)}' is not "
+                    "allowed; a scenario holds plain values only",
+                )
+            if isinstance(ev, yaml.ScalarEvent):
+                if len(ev.value) > MAX_NUMBER_CHARS and _is_number(ev):
                     raise mark_error(
                         path,
                         ev.start_mark,
-                        "a scenario file holds one YAML document; this is a second one",
+                        f"this number is {len(ev.value):,} characters long; a number in a "
+                        f"scenario has at most {MAX_NUMBER_CHARS} (quote it if it is text)",
                     )
-            elif isinstance(ev, yaml.AliasEvent):
-                n = sizes.get(ev.anchor)
-                if n is None:
-                    inside = any(entry[1] == ev.anchor for entry in stack)
-                    what = "refers to a node that contains it" if inside else "has no anchor"
-                    raise mark_error(path, ev.start_mark, f"alias '*{ev.anchor}' {what}")
-                repeated += n
-                if repeated > limits.max_alias_nodes:
+                if tag in _CONSTRUCTED_TAGS:
+                    _check_tagged(ev, tag, path)
+                if ev.anchor is not None:
+                    sizes[ev.anchor] = 1
+                add(1)
+            else:
+                stack.append([1, ev.anchor])
+                if len(stack) > MAX_YAML_DEPTH:
                     raise mark_error(
                         path,
                         ev.start_mark,
-                        f"aliases repeat more than {limits.max_alias_nodes} YAML nodes "
-                        f"(alias '*{ev.anchor}' repeats {n}); refusing to expand them",
+                        f"YAML nested more than {MAX_YAML_DEPTH} levels deep",
                     )
-                add(n)
-            elif isinstance(ev, yaml.NodeEvent) and not isinstance(ev, yaml.CollectionEndEvent):
-                tag = getattr(ev, "tag", None)
-                nodes += 1
-                if nodes > limits.max_yaml_nodes:
-                    raise mark_error(
-                        path,
-                        ev.start_mark,
-                        f"the file holds more than {limits.max_yaml_nodes:,} YAML values, the "
-                        "limit; raise it with --max-yaml-nodes",
-                    )
-                if tag is not None and tag not in _ALLOWED_TAGS:
-                    raise mark_error(
-                        path,
-                        ev.start_mark,
-                        f"YAML tag '{_tag_name(tag)}' is not "
-                        "allowed; a scenario holds plain values only",
-                    )
-                if isinstance(ev, yaml.ScalarEvent):
-                    if len(ev.value) > MAX_NUMBER_CHARS and _is_number(ev):
-                        raise mark_error(
-                            path,
-                            ev.start_mark,
-                            f"this number is {len(ev.value):,} characters long; a number in a "
-                            f"scenario has at most {MAX_NUMBER_CHARS} (quote it if it is text)",
-                        )
-                    if tag in _CONSTRUCTED_TAGS:
-                        _check_tagged(ev, tag, path)
-                    if ev.anchor is not None:
-                        sizes[ev.anchor] = 1
-                    add(1)
-                else:
-                    stack.append([1, ev.anchor])
-                    if len(stack) > MAX_YAML_DEPTH:
-                        raise mark_error(
-                            path,
-                            ev.start_mark,
-                            f"YAML nested more than {MAX_YAML_DEPTH} levels deep",
-                        )
-            elif isinstance(ev, yaml.CollectionEndEvent):
-                n, anchor = stack.pop()
-                if anchor is not None:
-                    sizes[anchor] = n
-                add(n)
-    except yaml.YAMLError as exc:
-        raise _yaml_error(exc, path, text) from None
+        elif isinstance(ev, yaml.CollectionEndEvent):
+            n, anchor = stack.pop()
+            if anchor is not None:
+                sizes[anchor] = n
+            add(n)
 
 
 def _is_number(ev: yaml.ScalarEvent) -> bool:
@@ -254,7 +278,7 @@ def _check_tagged(ev, tag: str, path: str) -> None:
 def compose(text: str, path: str, limits: Limits) -> yaml.Node:
     _check_events(text, path, limits)
     try:
-        root = yaml.compose(text, Loader=_LOADER)
+        root = yaml.compose(text, Loader=_composing(_LOADER))
     except yaml.YAMLError as exc:
         raise _yaml_error(exc, path, text) from None
     if root is None:
@@ -291,7 +315,7 @@ def _construct(node):
     if (
         tag == CORE_TAG + "str"
         and plain(node)
-        and len(node.value) <= MAX_NUMBER_CHARS  # longer ones are text (see _Loader)
+        and len(node.value) <= MAX_NUMBER_CHARS  # longer ones are text (see _composing)
         and _FLOAT12_RE.match(node.value)
     ):
         return float(node.value)

@@ -19,7 +19,13 @@ from dataclasses import dataclass
 
 from runner.golden import compare, report
 from runner.golden import serialize as ser
-from runner.golden.store import GoldenMissing, GoldenStore, GoldenUnreadable, shown_path
+from runner.golden.store import (
+    DEFAULT_MAX_FRAME_PIXELS,
+    GoldenMissing,
+    GoldenStore,
+    GoldenUnreadable,
+    shown_path,
+)
 
 CREATED = "created"
 UPDATED = "updated"
@@ -36,6 +42,13 @@ def golden_frames(scenario) -> list[int]:
     return sorted({int(k) for k in scenario.golden.frames})
 
 
+def frame_pixel_bound(frames: dict) -> int:
+    """The most pixels a golden frame may claim before it is decoded: the run's largest frame, or
+    `store.DEFAULT_MAX_FRAME_PIXELS` when that is more (memory stays within what the run used)."""
+    sizes = [int(rgb.shape[0]) * int(rgb.shape[1]) for rgb in frames.values()]
+    return max([DEFAULT_MAX_FRAME_PIXELS, *sizes])
+
+
 def check_run(scenario, result, store: GoldenStore, *, path=None, report_dir=None):
     """Compare `result` (a RunResult of `scenario`) with the scenario's golden in `store`.
 
@@ -47,7 +60,7 @@ def check_run(scenario, result, store: GoldenStore, *, path=None, report_dir=Non
     outcome = report.Outcome(scenario.name, shown_path(path), bless_command(path))
     run_frames = {k: result.frames[k] for k in golden_frames(scenario) if k in result.frames}
     try:
-        golden = store.read(scenario.name)
+        golden = store.read(scenario.name, max_frame_pixels=frame_pixel_bound(run_frames))
     except GoldenMissing as exc:
         outcome.status = report.STATUS_MISSING
         outcome.problems.append(str(exc))
@@ -159,10 +172,11 @@ def golden_files(scenario, result, old=None) -> dict:
 
 
 def bless_run(scenario, result, store: GoldenStore) -> Blessed:
-    """Write the golden of `scenario` from `result` (atomically, see `store`); say what changed."""
+    """Write the golden of `scenario` from `result` (the folder swapped in whole, see `store`);
+    say what changed. Raises store.GoldenError when a symbolic link stands in the way."""
     old, note = None, ""
     try:
-        old = store.read(scenario.name)
+        old = store.read(scenario.name, max_frame_pixels=frame_pixel_bound(result.frames))
     except GoldenMissing:
         pass
     except GoldenUnreadable as exc:

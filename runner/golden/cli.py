@@ -4,7 +4,11 @@ Inputs: command-line arguments — scenario files or names (none: every file in 
 project root (`--root`, default the nearest folder upward with `scenarios/`), `--report DIR`,
 `--prune`, `--quiet`. Outputs: console text (stdout: one block per scenario and a closing count;
 stderr: errors and, on a terminal, progress), report folders, golden folders, and the exit status:
-0 fine, 1 a check found a difference (or a golden is missing), 2 bad input or usage.
+0 fine, 1 a check found a difference (or a golden is missing, damaged or hostile), 2 bad input or
+usage (a scenario refused, a symbolic link in the way), 3 an unexpected error. Each scenario is
+checked or blessed on its own: whatever goes wrong in one is reported (an unexpected error as one
+line naming the scenario, its traceback with `--debug`) and the others still run; the exit status
+is the worst seen (3 over 2 over 1).
 
 `register(subparsers)` adds both commands to the `collide2d` parser; each sets `func(args) -> int`.
 The scenario loader and the simulator can be handed in (tests use synthetic ones); by default they
@@ -15,6 +19,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import traceback
 from functools import partial
 from pathlib import Path
 
@@ -33,6 +38,7 @@ from runner.golden.store import (
 EXIT_OK = 0
 EXIT_DIFFERENT = 1
 EXIT_USAGE = 2
+EXIT_UNEXPECTED = 3
 
 
 class _Usage(Exception):
@@ -98,31 +104,50 @@ def _common(p) -> None:
     p.add_argument("--quiet", action="store_true", help="no progress output")
 
 
+def _debug_option(parser) -> None:
+    """`--debug` for `main` run on its own (the `collide2d` CLI has a global one)."""
+    parser.add_argument(
+        "--debug", action="store_true", help="print tracebacks of unexpected errors"
+    )
+
+
 def main(argv=None, *, load=None, simulate=None) -> int:
     """Run `check` or `bless` from `argv` on their own (the `collide2d` CLI adds the others)."""
     parser = argparse.ArgumentParser(prog="collide2d")
+    _debug_option(parser)
     register(parser.add_subparsers(dest="command", required=True), load=load, simulate=simulate)
     args = parser.parse_args(argv)
     return args.func(args)
 
 
 def check_command(args, *, load=default_load, simulate=default_simulate) -> int:
-    """`collide2d check`: 0 when every scenario matches its golden, 1 if not, 2 on bad input."""
+    """`collide2d check`: 0 when every scenario matches its golden, 1 if not, 2 on bad input,
+    3 on an unexpected error in any scenario (the others are still checked)."""
     try:
         root, scenarios = _prepare(args, load)
         report_dir = Path(args.report) if args.report else None
         store = GoldenStore(root)
         if report_dir is not None and _inside(report_dir, store.dir):
             raise _Usage(f"--report {args.report} is inside {GOLDENS_DIR}/; name another folder")
+        if report_dir is not None:
+            try:
+                report.check_target(report_dir, [scn.name for _p, scn in scenarios])
+            except GoldenError as exc:
+                raise _Usage(str(exc)) from None
         # Unused goldens are only known when every scenario is checked.
         used = None if args.scenarios else [scn.name for _p, scn in scenarios]
     except _Usage as exc:
         return exc.exit()
-    outcomes = []
+    outcomes, status, errors = [], EXIT_OK, 0
     for i, (path, scn) in enumerate(scenarios, start=1):
         _progress(args, f"[{i}/{len(scenarios)}] checking {scn.name}")
-        result = run_scenario(scn, simulate, progress=_show_progress(args))
-        outcome = check_run(scn, result, store, path=path, report_dir=report_dir)
+        try:
+            result = run_scenario(scn, simulate, progress=_show_progress(args))
+            outcome = check_run(scn, result, store, path=path, report_dir=report_dir)
+        except Exception as exc:  # one scenario never stops the others
+            status = max(status, _scenario_failed(args, "checking", path, scn, exc))
+            errors += 1
+            continue
         outcomes.append(outcome)
         print(outcome.message(), flush=True)
     unused = store.unused(used) if used is not None else []
@@ -134,12 +159,46 @@ def check_command(args, *, load=default_load, simulate=default_simulate) -> int:
     if report_dir is not None:
         print(f"report: {shown_path(report.write_index(report_dir, outcomes, unused))}")
     failed = [o for o in outcomes if not o.ok]
-    print(f"{len(outcomes) - len(failed)} passed, {len(failed)} failed")
-    return EXIT_DIFFERENT if failed else EXIT_OK
+    said = f", {errors} not checked (errors above)" if errors else ""
+    print(f"{len(outcomes) - len(failed)} passed, {len(failed)} failed{said}")
+    return max(status, EXIT_DIFFERENT if failed else EXIT_OK)
+
+
+def _scenario_failed(args, doing: str, path, scn, exc: Exception) -> int:
+    """Report what stopped one scenario on stderr; returns its exit status: EXIT_USAGE for a
+    refusal (a bad scenario or run, a link in the way), EXIT_UNEXPECTED for anything else (one
+    line naming the scenario; the traceback too with --debug)."""
+    if isinstance(exc, _refusals()):
+        text = str(exc)
+        if isinstance(exc, GoldenError):
+            text = f"collide2d: error: {scn.name}: {text}"
+        print(text, file=sys.stderr, flush=True)
+        return EXIT_USAGE
+    detail = " ".join(str(exc).split())[:300]
+    print(
+        f"collide2d: unexpected error while {doing} {scn.name} ({shown_path(path)}): "
+        f"{type(exc).__name__}{': ' + detail if detail else ''}"
+        + ("" if getattr(args, "debug", False) else " (run with --debug for the traceback)"),
+        file=sys.stderr,
+        flush=True,
+    )
+    if getattr(args, "debug", False):
+        traceback.print_exception(type(exc), exc, exc.__traceback__, file=sys.stderr)
+    return EXIT_UNEXPECTED
+
+
+def _refusals() -> tuple:
+    """The exception types that refuse one scenario as bad input rather than a bug."""
+    from engine.models import ModelUnavailable
+    from runner.run import RunStopped
+
+    return (GoldenError, ModelUnavailable, RunStopped, *scenario_errors())
 
 
 def bless_command(args, *, load=default_load, simulate=default_simulate) -> int:
-    """`collide2d bless`: write the named goldens (all with no argument); 2 on bad input, in CI."""
+    """`collide2d bless`: write the named goldens (all with no argument); 2 on bad input, in CI
+    or when a symbolic link stands in the way, 3 on an unexpected error (the other scenarios are
+    still blessed)."""
     try:
         if ci_active():
             raise _Usage(
@@ -150,19 +209,30 @@ def bless_command(args, *, load=default_load, simulate=default_simulate) -> int:
         used = _all_names(root, scenarios, load) if args.prune else []
     except _Usage as exc:
         return exc.exit()
-    for i, (_path, scn) in enumerate(scenarios, start=1):
+    status = EXIT_OK
+    for i, (path, scn) in enumerate(scenarios, start=1):
         _progress(args, f"[{i}/{len(scenarios)}] running {scn.name}")
-        result = run_scenario(scn, simulate, progress=_show_progress(args))
-        print(bless_run(scn, result, store).line(), flush=True)
+        try:
+            result = run_scenario(scn, simulate, progress=_show_progress(args))
+            line = bless_run(scn, result, store).line()
+        except Exception as exc:  # one scenario never stops the others
+            status = max(status, _scenario_failed(args, "blessing", path, scn, exc))
+            continue
+        print(line, flush=True)
     if args.prune:
         for name in store.unused(used):
-            store.remove(name)
+            try:
+                store.remove(name)
+            except GoldenError as exc:
+                print(f"collide2d: error: {exc}", file=sys.stderr, flush=True)
+                status = max(status, EXIT_USAGE)
+                continue
             print(f"{'removed':<9} {name}: no scenario uses it")
     elif not args.scenarios:
         unused = store.unused(scn.name for _p, scn in scenarios)
         if unused:
             print(f"unused goldens kept: {', '.join(unused)} (remove them with --prune)")
-    return EXIT_OK
+    return status
 
 
 def _prepare(args, load):
@@ -174,6 +244,10 @@ def _prepare(args, load):
         raise _Usage(str(exc)) from None
     if args.root and not (root / SCENARIOS_DIR).is_dir():
         raise _Usage(f"--root {args.root} has no {SCENARIOS_DIR}/ folder")
+    try:
+        GoldenStore(root).check_dir()
+    except GoldenError as exc:
+        raise _Usage(str(exc)) from None
     paths = [_resolve(a, root) for a in args.scenarios] or scenario_files(root)
     if not paths:
         raise _Usage(f"no scenario files in {shown_path(root / SCENARIOS_DIR)}")

@@ -119,7 +119,7 @@ def golden_check(request, golden_root, golden_load, golden_simulate, tmp_path_fa
     --update-goldens, bless it); fails the test with the text `collide2d check` prints."""
     from runner.golden import bless_run, check_run, shown_path
     from runner.golden.cli import run_scenario, scenario_errors
-    from runner.golden.store import SCENARIOS_DIR, GoldenStore
+    from runner.golden.store import SCENARIOS_DIR, GoldenError, GoldenStore
 
     config = request.config
 
@@ -134,12 +134,18 @@ def golden_check(request, golden_root, golden_load, golden_simulate, tmp_path_fa
         result = run_scenario(scenario, golden_simulate)
         store = GoldenStore(golden_root)
         if config.getoption("update_goldens"):
-            blessed = bless_run(scenario, result, store)
+            try:
+                blessed = bless_run(scenario, result, store)
+            except GoldenError as exc:  # a symbolic link in the way
+                pytest.fail(str(exc), pytrace=False)
             request.node.user_properties.append((PROP_BLESSED, blessed.line()))
             return
         given = config.getoption("golden_report")
         report_dir = Path(given) if given else tmp_path_factory.getbasetemp() / "golden-report"
-        outcome = check_run(scenario, result, store, path=path, report_dir=report_dir)
+        try:
+            outcome = check_run(scenario, result, store, path=path, report_dir=report_dir)
+        except GoldenError as exc:  # the report folder refused (a symbolic link)
+            pytest.fail(str(exc), pytrace=False)
         if not outcome.ok:
             pytest.fail(outcome.message(), pytrace=False)
 
@@ -170,7 +176,10 @@ def pytest_terminal_summary(terminalreporter, exitstatus, config) -> None:
         return
     # Unused goldens are only known when every scenario ran.
     if len(names) == len(scenario_files(root)):
-        unused = GoldenStore(root).unused(names)
+        try:
+            unused = GoldenStore(root).unused(names)
+        except GoldenError:  # goldens/ is a link: every golden test already failed saying so
+            return
         if unused:
             terminalreporter.section("unused goldens")
             terminalreporter.write_line(

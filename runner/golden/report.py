@@ -13,20 +13,23 @@ texts of events and final state when those differ. Outputs:
 - `write_index(DIR, outcomes, unused)`: `DIR/summary.json` and `DIR/index.html` over all scenarios.
 
 Pages reference their images by relative paths and load nothing from the network, so a report
-folder can be zipped, kept as a CI artifact and opened anywhere.
+folder can be zipped, kept as a CI artifact and opened anywhere. A report is written only into real
+folders: a report folder, scenario folder or file that is a symbolic link is refused
+(`ReportRefused`, naming it), never followed or replaced, and nothing in a report folder is deleted.
 """
 
 from __future__ import annotations
 
 import html
 import os
+import stat
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from runner.golden.compare import FrameDiff
-from runner.golden.store import shown_path
+from runner.golden.store import GoldenError, link_message, shown_path
 from runner.outputs import atomic_write_bytes, encode_png, write_json
 
 REPORT_FORMAT = 1
@@ -41,6 +44,44 @@ STATUS_PASSED = "passed"
 STATUS_FAILED = "failed"
 STATUS_MISSING = "missing"
 STATUS_UNREADABLE = "unreadable"
+INDEX_FILE = "index.html"
+SUMMARY_FILE = "summary.json"
+
+
+class ReportRefused(GoldenError):
+    """A report cannot be written where asked (a symbolic link stands in the way)."""
+
+
+def _refuse_link(path: Path) -> None:
+    try:
+        st = os.lstat(path)
+    except (FileNotFoundError, NotADirectoryError):
+        return
+    if stat.S_ISLNK(st.st_mode):
+        raise ReportRefused(link_message(path, "reports"))
+
+
+def check_target(report_dir, names=()) -> None:
+    """ReportRefused when the report folder, a scenario folder `names` would use in it, or a file
+    the report writes at its top is a symbolic link; checked before anything runs."""
+    folder = Path(report_dir)
+    _refuse_link(folder)
+    for entry in (SUMMARY_FILE, INDEX_FILE, *names):
+        _refuse_link(folder / entry)
+
+
+def _write(path: Path, data: bytes) -> None:
+    """Write a report file, refusing a link in its place."""
+    _refuse_link(path)
+    atomic_write_bytes(path, data)
+
+
+def _real_folder(folder: Path) -> Path:
+    """Make `folder` (and its parents) and check that it is a real folder, not a link."""
+    _refuse_link(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    _refuse_link(folder)
+    return folder
 
 
 @dataclass
@@ -148,30 +189,30 @@ def diff_image(fr: FrameReport) -> np.ndarray | None:
 def write_scenario(report_dir, outcome: Outcome) -> Path:
     """Write `report_dir/NAME/` for a failed outcome (images, texts, summary.json, index.html);
     sets `outcome.report` and each frame's `paths`; returns the index.html path."""
-    folder = Path(report_dir) / outcome.name
-    folder.mkdir(parents=True, exist_ok=True)
+    _refuse_link(Path(report_dir))
+    folder = _real_folder(Path(report_dir) / outcome.name)
     for fr in outcome.frames:
         stem = f"frame_{fr.frame:06d}"
         images = {"expected": fr.expected, "actual": fr.actual, "diff": diff_image(fr)}
         for kind, rgb in images.items():
             if rgb is not None:
                 path = folder / f"{stem}_{kind}.png"
-                atomic_write_bytes(path, encode_png(np.ascontiguousarray(rgb)))
+                _write(path, encode_png(np.ascontiguousarray(rgb)))
                 fr.paths[kind] = path
     for fname, data in sorted(outcome.texts.items()):
-        atomic_write_bytes(folder / fname, data)
-    outcome.report = folder / "index.html"
-    write_json(folder / "summary.json", outcome.summary(folder))
+        _write(folder / fname, data)
+    outcome.report = folder / INDEX_FILE
+    _refuse_link(folder / SUMMARY_FILE)
+    write_json(folder / SUMMARY_FILE, outcome.summary(folder))
     page = _page(f"collide2d golden: {outcome.name}", [outcome], folder, [])
-    atomic_write_bytes(outcome.report, page)
+    _write(outcome.report, page)
     return outcome.report
 
 
 def write_index(report_dir, outcomes, unused=()) -> Path:
     """Write `report_dir/summary.json` and `report_dir/index.html` over `outcomes` (sorted by
     name) and the unused goldens; returns the index.html path."""
-    folder = Path(report_dir)
-    folder.mkdir(parents=True, exist_ok=True)
+    folder = _real_folder(Path(report_dir))
     outcomes = sorted(outcomes, key=lambda o: o.name)
     summary = {
         "format": REPORT_FORMAT,
@@ -180,9 +221,10 @@ def write_index(report_dir, outcomes, unused=()) -> Path:
         "scenarios": [o.summary(folder) for o in outcomes],
         "unused_goldens": list(unused),
     }
-    write_json(folder / "summary.json", summary)
-    index = folder / "index.html"
-    atomic_write_bytes(index, _page("collide2d golden check", outcomes, folder, list(unused)))
+    _refuse_link(folder / SUMMARY_FILE)
+    write_json(folder / SUMMARY_FILE, summary)
+    index = folder / INDEX_FILE
+    _write(index, _page("collide2d golden check", outcomes, folder, list(unused)))
     return index
 
 

@@ -13,6 +13,12 @@ change in a diff viewer and the same results always give the same bytes:
 A frame is identified by its decoded pixels, never by its PNG bytes (zlib builds differ across
 platforms): `pixel_sha256` hashes the width, the height and the RGB bytes. The manifest carries no
 timestamps, so blessing the same results twice writes the same bytes.
+
+Reading back treats every file as possibly hostile: JSON nested deeper than `MAX_JSON_DEPTH` is
+refused before it is parsed, numbers must be finite and integers within 64 bits, the manifest must
+have the exact shape written here (its paths plain, relative and inside the golden), and a PNG's
+header is read and checked against the manifest's size and a pixel bound before any pixel is
+decoded. Every refusal is a ValueError whose text says what is wrong.
 """
 
 from __future__ import annotations
@@ -20,10 +26,14 @@ from __future__ import annotations
 import hashlib
 import io
 import json
+import math
+import re
 import struct
+import warnings
+import zlib
 
 import numpy as np
-from PIL import Image
+from PIL import Image, UnidentifiedImageError
 
 from engine.events import event_dict, format_event
 from runner.outputs import encode_png, final_csv_text
@@ -36,6 +46,16 @@ EVENTS_FILE = "events.jsonl"
 FINAL_FILE = "final.csv"
 FRAMES_DIR = "frames"
 FINAL_HEADER = "id,x,y,vx,vy"
+# Reading limits: JSON nesting (a manifest is 3 levels deep, an event line 1) and integers.
+MAX_JSON_DEPTH = 32
+MAX_INT = 2**63 - 1
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+# A PNG side may be 1 to 2^31 - 1 pixels (PNG specification).
+PNG_MAX_SIDE = 2**31 - 1
+_HEX64_RE = re.compile(r"[0-9a-f]{64}")
+# A JSON string literal (its brackets do not nest) and the bytes that are not brackets.
+_JSON_STRING_RE = re.compile(rb'"(?:[^"\\]|\\.)*"')
+_NOT_BRACKETS = bytes(b for b in range(256) if b not in b"[]{}")
 
 
 def frame_file(frame: int) -> str:
@@ -70,10 +90,173 @@ def png_bytes(rgb: np.ndarray) -> bytes:
     return encode_png(_as_rgb(rgb))
 
 
-def decode_png(data: bytes) -> np.ndarray:
-    """The decoded pixels of a PNG as (H, W, 3) uint8 RGB (other modes are converted to RGB)."""
-    with Image.open(io.BytesIO(data)) as im:
-        return np.array(im.convert("RGB"), dtype=np.uint8)
+def png_size(data: bytes) -> tuple[int, int]:
+    """(width, height) from a PNG's header (its IHDR chunk), without decoding anything; raises
+    ValueError when `data` does not start as a PNG."""
+    if data[:8] != PNG_SIGNATURE:
+        raise ValueError("not a PNG file (no PNG signature)")
+    if len(data) < 33 or data[8:16] != struct.pack(">I", 13) + b"IHDR":
+        raise ValueError("damaged PNG (no IHDR header)")
+    w, h = struct.unpack(">II", data[16:24])
+    if not (1 <= w <= PNG_MAX_SIDE and 1 <= h <= PNG_MAX_SIDE):
+        raise ValueError(f"damaged PNG (header size {w}x{h})")
+    return w, h
+
+
+def decode_png(data: bytes, *, size=None, max_pixels: int | None = None) -> np.ndarray:
+    """The decoded pixels of a PNG as (H, W, 3) uint8 RGB (other modes are converted to RGB).
+
+    size: the (width, height) the PNG must have; max_pixels: the most pixels it may have. Both are
+    checked on the header before any pixel is decoded, so a small file claiming a huge picture
+    costs nothing. Raises ValueError on anything that is not such a PNG.
+    """
+    w, h = png_size(data)
+    if size is not None and (w, h) != (int(size[0]), int(size[1])):
+        raise ValueError(f"the PNG is {w}x{h}, the manifest says {int(size[0])}x{int(size[1])}")
+    if max_pixels is not None and w * h > max_pixels:
+        raise ValueError(
+            f"the PNG claims {w}x{h} pixels, past the {max_pixels} a golden frame may have here"
+        )
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", Image.DecompressionBombWarning)
+            with Image.open(io.BytesIO(data), formats=["PNG"]) as im:
+                if im.size != (w, h):
+                    raise ValueError(f"damaged PNG (header {w}x{h}, image {im.size})")
+                return np.array(im.convert("RGB"), dtype=np.uint8)
+    except UnidentifiedImageError:
+        raise ValueError("damaged PNG (not recognised past its header)") from None
+    except (OSError, SyntaxError, EOFError, struct.error, zlib.error, IndexError) as exc:
+        raise ValueError(f"damaged PNG ({exc})") from None
+    except Image.DecompressionBombError as exc:
+        raise ValueError(f"refused PNG ({exc})") from None
+
+
+def check_rel(rel) -> str:
+    """`rel` if it is a plain relative path inside a golden folder (`/`-separated, no `..`, `.`,
+    empty part, backslash or NUL), else ValueError."""
+    if (
+        not isinstance(rel, str)
+        or not rel
+        or rel.startswith("/")
+        or "\\" in rel
+        or "\0" in rel
+        or ":" in rel
+        or any(part in ("", ".", "..") for part in rel.split("/"))
+    ):
+        raise ValueError(
+            f"the path {json.dumps(rel)[:80]} is not a plain relative path inside the golden"
+        )
+    return rel
+
+
+def json_depth(data: bytes) -> int:
+    """The deepest bracket nesting of JSON text (brackets inside strings left out), in linear
+    time and bounded memory, without parsing it."""
+    brackets = _JSON_STRING_RE.sub(b'""', data).translate(None, _NOT_BRACKETS)
+    level = peak = 0
+    step = 1 << 20
+    for i in range(0, len(brackets), step):
+        chunk = np.frombuffer(brackets[i : i + step], dtype=np.uint8)
+        delta = np.where((chunk == ord("[")) | (chunk == ord("{")), 1, -1).astype(np.int64)
+        run = np.cumsum(delta) + level
+        peak = max(peak, int(run.max()))
+        level = int(run[-1])
+    return peak
+
+
+def load_json(data: bytes, *, max_depth: int | None = MAX_JSON_DEPTH):
+    """json.loads of `data`, refusing (ValueError) nesting past `max_depth` (None: the caller has
+    bounded it), non-UTF-8 text, numbers past range (non-finite, or integers past 64 bits) and
+    anything that is not JSON."""
+    if max_depth is not None:
+        depth = json_depth(data)
+        if depth > max_depth:
+            raise ValueError(f"nested {depth} levels deep, past {max_depth}")
+    try:
+        return _DECODER.decode(data.decode("utf-8"))
+    except UnicodeDecodeError:
+        raise ValueError("not UTF-8 text") from None
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"not JSON: {exc.msg} at line {exc.lineno} column {exc.colno}") from None
+    except _Refused as exc:
+        raise ValueError(str(exc)) from None
+    except RecursionError:
+        raise ValueError("nested too deep") from None
+
+
+class _Refused(ValueError):
+    """A number no golden holds: NaN or an infinity, or an integer past 64 bits."""
+
+
+def _refuse_constant(name):
+    raise _Refused(f"{name} is not a number a golden holds")
+
+
+def _parse_float(text: str) -> float:
+    value = float(text)
+    if not math.isfinite(value):
+        raise _Refused("a number is out of range (not finite)")
+    return value
+
+
+def _parse_int(text: str) -> int:
+    # Refused by its length before it is converted: no cost grows with the digits.
+    value = int(text) if len(text) <= 20 else MAX_INT + 1
+    if abs(value) > MAX_INT:
+        raise _Refused("a number is out of range (an integer past 64 bits)")
+    return value
+
+
+_DECODER = json.JSONDecoder(
+    parse_float=_parse_float, parse_int=_parse_int, parse_constant=_refuse_constant
+)
+
+
+def _int(obj, what: str, lo: int = 0, hi: int = MAX_INT) -> int:
+    if not isinstance(obj, int) or isinstance(obj, bool) or not lo <= obj <= hi:
+        raise ValueError(f"{what} must be an integer from {lo} to {hi}")
+    return obj
+
+
+def _hex64(obj, what: str) -> str:
+    if not isinstance(obj, str) or not _HEX64_RE.fullmatch(obj):
+        raise ValueError(f"{what} must be a SHA-256 in hex")
+    return obj
+
+
+def check_manifest(obj) -> dict:
+    """`obj` (a parsed manifest.json of this format) if it has the shape `manifest` writes, with
+    every path plain and the one this format uses; else ValueError naming what is wrong."""
+    if not isinstance(obj, dict):
+        raise ValueError("the manifest must be a JSON object")
+    for key, rel in (("events", EVENTS_FILE), ("final", FINAL_FILE)):
+        entry = obj.get(key)
+        if not isinstance(entry, dict):
+            raise ValueError(f"{key!r} must be an object")
+        check_rel(entry.get("file"))
+        if entry["file"] != rel:
+            raise ValueError(f"{key}.file is {json.dumps(entry['file'])[:80]}, not {rel!r}")
+        _hex64(entry.get("sha256"), f"{key}.sha256")
+    frames = obj.get("frames")
+    if not isinstance(frames, list):
+        raise ValueError("'frames' must be a list")
+    seen = set()
+    for i, entry in enumerate(frames):
+        if not isinstance(entry, dict):
+            raise ValueError(f"frames[{i}] must be an object")
+        k = _int(entry.get("frame"), f"frames[{i}].frame")
+        check_rel(entry.get("file"))
+        if entry["file"] != frame_file(k) or k in seen:
+            raise ValueError(
+                f"frames[{i}].file is {json.dumps(entry['file'])[:80]}, not {frame_file(k)!r} "
+                "(or the frame is listed twice)"
+            )
+        seen.add(k)
+        _int(entry.get("width"), f"frames[{i}].width", 1, PNG_MAX_SIDE)
+        _int(entry.get("height"), f"frames[{i}].height", 1, PNG_MAX_SIDE)
+        _hex64(entry.get("pixels_sha256"), f"frames[{i}].pixels_sha256")
+    return obj
 
 
 def events_jsonl(events: np.ndarray) -> bytes:
@@ -87,17 +270,22 @@ def event_dicts(events: np.ndarray) -> list[dict]:
 
 
 def parse_events(data: bytes) -> list[dict]:
-    """The events of an events.jsonl file, in order; raises ValueError naming a bad line."""
+    """The events of an events.jsonl file, in order; raises ValueError naming a bad line (not
+    JSON, nested, not an object, or a number past range)."""
+    lines = data.splitlines()
+    if json_depth(data) > 1:  # one pass over the file bounds every line
+        k = next(k for k, ln in enumerate(lines, 1) if json_depth(ln) > 1)
+        raise ValueError(f"line {k}: an event is one flat JSON object (this line nests)")
     out = []
-    for k, line in enumerate(data.decode("utf-8").splitlines(), start=1):
+    for k, line in enumerate(lines, start=1):
         if not line.strip():
             continue
         try:
-            obj = json.loads(line)
-        except json.JSONDecodeError as exc:
-            raise ValueError(f"{EVENTS_FILE} line {k}: {exc.msg}") from None
+            obj = load_json(line, max_depth=None)
+        except ValueError as exc:
+            raise ValueError(f"line {k}: {exc}") from None
         if not isinstance(obj, dict):
-            raise ValueError(f"{EVENTS_FILE} line {k}: not a JSON object")
+            raise ValueError(f"line {k}: not a JSON object")
         out.append(obj)
     return out
 
@@ -120,18 +308,24 @@ def final_state(pos: np.ndarray, vel: np.ndarray) -> np.ndarray:
 
 def parse_final(data: bytes) -> np.ndarray:
     """The (n, 4) float64 state (x, y, vx, vy) of a final.csv; raises ValueError on a bad row."""
-    lines = data.decode("utf-8").splitlines()
+    try:
+        lines = data.decode("utf-8").splitlines()
+    except UnicodeDecodeError:
+        raise ValueError(f"{FINAL_FILE} is not UTF-8 text") from None
     if not lines or lines[0].strip() != FINAL_HEADER:
-        raise ValueError(f"{FINAL_FILE} must start with the header {FINAL_HEADER!r}")
+        raise ValueError(f"the file must start with the header {FINAL_HEADER!r}")
     rows = []
     for k, line in enumerate(lines[1:], start=2):
         cells = line.split(",")
         if len(cells) != 5 or cells[0] != str(len(rows)):
-            raise ValueError(f"{FINAL_FILE} line {k}: expected '{len(rows)},x,y,vx,vy'")
+            raise ValueError(f"line {k}: expected '{len(rows)},x,y,vx,vy'")
         try:
-            rows.append([float(c) for c in cells[1:]])
+            row = [float(c) for c in cells[1:]]
         except ValueError:
-            raise ValueError(f"{FINAL_FILE} line {k}: not a number") from None
+            raise ValueError(f"line {k}: not a number") from None
+        if not all(math.isfinite(v) for v in row):
+            raise ValueError(f"line {k}: a number is out of range (not finite)")
+        rows.append(row)
     return np.array(rows, dtype=np.float64).reshape(-1, 4)
 
 

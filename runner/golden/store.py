@@ -1,16 +1,25 @@
-"""Golden storage: find the project, read a golden folder whole, write one atomically (SPEC §7).
+"""Golden storage: find the project, read a golden folder whole, swap one in whole (SPEC §7, §8).
 
 Inputs: the project root (the nearest folder upward that has `scenarios/`) and, for a write, the
 files of one golden as relative path -> bytes (from `serialize`). Outputs: `Golden` records read
 back and checked against their manifest, and the list of files a write changed.
 
-A write is queued and flushed in two phases. First every changed file goes to a temporary name next
-to its target (flushed to disk); a failure here removes the temporaries and leaves the old golden
-untouched. Then the temporaries are renamed into place, the manifest last; should a rename fail, the
-files already replaced get their old bytes back. The manifest holds the hash of every other file, so
-a golden torn some other way (the process killed between two renames) is reported as unreadable by
-`read`, never trusted. Nothing is ever written when the `CI` environment variable is set, and a
-golden folder is only removed by `remove` (the `--prune` of `bless`).
+Confinement. Everything stays inside ROOT/goldens/NAME/: nothing is read, written or removed
+through a symbolic link (goldens/ itself, a golden folder, or any entry in one), the paths that
+manifest.json names must be plain relative paths inside the golden, and every file is read with a
+size bound. A link is refused with a message naming it, never followed. Hostile content (deep JSON,
+numbers past range, a frame that is not a PNG or whose header claims more pixels than the manifest
+or the bound allow) makes the golden `GoldenUnreadable` with a clear message, read before decoding.
+
+A write builds the whole new golden in a sibling temporary folder `goldens/.NAME.PID.HEX.new.tmp/`
+(every file flushed to disk), then swaps it in with two renames: the old folder aside to
+`.NAME.PID.HEX.old.tmp`, the new one into place; only then is the old one removed. A kill at any
+instant leaves either the old golden whole or the new one whole: between the two renames the old
+golden waits whole under its aside name, where `read` finds it and the next write puts it back.
+Leftovers are recognised by that exact name pattern, only as real folders, and a live process's own
+temporaries are left alone. A golden whose files all equal what is on disk is not rewritten.
+Nothing is ever written when the `CI` environment variable is set, and a golden folder is only
+removed by `remove` (the `--prune` of `bless`).
 """
 
 from __future__ import annotations
@@ -18,7 +27,9 @@ from __future__ import annotations
 import json
 import os
 import re
+import secrets
 import shutil
+import stat
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -29,12 +40,24 @@ from runner.golden import serialize as ser
 GOLDENS_DIR = "goldens"
 SCENARIOS_DIR = "scenarios"
 SCENARIO_SUFFIXES = (".yaml", ".yml")
-# Temporary files of a write: `.NAME.PID.tmp` next to their target.
+# A write's temporary folders next to goldens/NAME: `.NAME.PID.HEX.new.tmp` (the new golden being
+# built) and `.NAME.PID.HEX.old.tmp` (the old golden moved aside during the swap).
 TMP_SUFFIX = ".tmp"
+NEW, OLD = "new", "old"
+_LEFTOVER_RE = re.compile(r"(?P<pid>\d+)\.[0-9a-f]{8}\.(?P<kind>new|old)\.tmp")
 # A golden folder's name: a scenario name that cannot leave goldens/ or hide as a dot-folder.
 _NAME_RE = re.compile(r"[a-z0-9_-][a-z0-9._-]*")
 # Values of CI that mean "not in CI".
 _CI_OFF = ("", "0", "false", "no")
+# The largest golden file read, in bytes (a golden folder stays within a few MB, SPEC §7).
+MAX_FILE_BYTES = 64 * 1024 * 1024
+# The most pixels a golden frame may have when the run's own frames are smaller: a PNG header
+# past this (or past the run's largest frame) is refused before anything is decoded.
+DEFAULT_MAX_FRAME_PIXELS = 1 << 24
+
+_O_NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
+_O_BINARY = getattr(os, "O_BINARY", 0)
+_O_NONBLOCK = getattr(os, "O_NONBLOCK", 0)
 
 
 class GoldenError(Exception):
@@ -46,7 +69,7 @@ class GoldenMissing(GoldenError):
 
 
 class GoldenUnreadable(GoldenError):
-    """The golden folder exists but is damaged, torn or of another format."""
+    """The golden folder exists but is damaged, torn, of another format or refused (a link)."""
 
 
 class WritesRefused(GoldenError):
@@ -86,6 +109,14 @@ def check_name(name: str) -> str:
     return name
 
 
+def link_message(path, what: str = "goldens") -> str:
+    """The refusal of a symbolic link at `path`."""
+    return (
+        f"{shown_path(path)} is a symbolic link; {what} are never read, written or removed "
+        "through a link (replace it with a real folder or file)"
+    )
+
+
 @dataclass(frozen=True)
 class Golden:
     """One golden read back whole and checked against its manifest.
@@ -115,129 +146,182 @@ class GoldenStore:
     def folder(self, name: str) -> Path:
         return self.dir / check_name(name)
 
+    def check_dir(self) -> None:
+        """GoldenError when goldens/ is a symbolic link or not a folder (absent is fine)."""
+        st = _lstat(self.dir)
+        if st is not None and stat.S_ISLNK(st.st_mode):
+            raise GoldenError(link_message(self.dir))
+        if st is not None and not stat.S_ISDIR(st.st_mode):
+            raise GoldenError(f"{shown_path(self.dir)} is not a folder")
+
     def names(self) -> list[str]:
-        """The golden folders present, sorted (temporary and hidden entries left out)."""
-        if not self.dir.is_dir():
+        """The golden folders present, sorted (temporary and hidden entries left out; a link
+        with a golden's name is listed, and refused by whatever then uses it)."""
+        self.check_dir()
+        if _lstat(self.dir) is None:
             return []
-        return sorted(
-            p.name for p in self.dir.iterdir() if p.is_dir() and _NAME_RE.fullmatch(p.name)
-        )
+        out = []
+        for entry in os.scandir(self.dir):
+            if _NAME_RE.fullmatch(entry.name) and (
+                entry.is_symlink() or entry.is_dir(follow_symlinks=False)
+            ):
+                out.append(entry.name)
+        return sorted(out)
 
     def unused(self, used) -> list[str]:
         """The golden folders that no name in `used` claims, sorted."""
         used = set(used)
         return [n for n in self.names() if n not in used]
 
-    def read(self, name: str) -> Golden:
+    # ---------------------------------------------------------------------------------- reading
+
+    def read(self, name: str, *, max_frame_pixels: int = DEFAULT_MAX_FRAME_PIXELS) -> Golden:
         """Golden `name`, every file checked against the manifest's hashes.
 
-        Raises GoldenMissing when there is no golden, GoldenUnreadable when it cannot be trusted.
+        max_frame_pixels: a frame whose PNG header claims more pixels is refused undecoded.
+        Raises GoldenMissing when there is no golden, GoldenUnreadable when it cannot be trusted
+        (damaged, torn, hostile, or reached through a symbolic link).
         """
         folder = self.folder(name)
-        mpath = folder / ser.MANIFEST_FILE
-        if not folder.is_dir():
-            raise GoldenMissing(f"no golden for {name}: {shown_path(folder)} does not exist")
-        if not mpath.is_file():
-            raise GoldenMissing(
-                f"no golden for {name}: {shown_path(folder)} has no {ser.MANIFEST_FILE} "
-                "(an interrupted first bless?)"
-            )
-        files = {ser.MANIFEST_FILE: mpath.read_bytes()}
         try:
-            manifest = json.loads(files[ser.MANIFEST_FILE])
-        except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-            msg = f"golden {name}: {shown_path(mpath)} is not JSON ({exc})"
-            raise GoldenUnreadable(msg) from None
-        fmt = manifest.get("format") if isinstance(manifest, dict) else None
-        if fmt != ser.FORMAT_VERSION:
-            raise GoldenUnreadable(
-                f"golden {name} has format {fmt!r}; this collide2d reads format "
-                f"{ser.FORMAT_VERSION}: bless it again"
-            )
-        try:
-            events = ser.parse_events(self._checked(name, folder, manifest["events"], files))
-            final = ser.parse_final(self._checked(name, folder, manifest["final"], files))
-            frames = {}
-            for entry in manifest["frames"]:
-                data = self._file(name, folder, entry["file"], files)
-                rgb = ser.decode_png(data)
-                if ser.pixel_sha256(rgb) != entry["pixels_sha256"]:
-                    raise GoldenUnreadable(_torn(name, folder / entry["file"]))
-                frames[int(entry["frame"])] = rgb
-        except (KeyError, TypeError, ValueError, OSError) as exc:
-            raise GoldenUnreadable(f"golden {name} cannot be read: {exc}") from None
-        return Golden(name, folder, manifest, events, final, frames, files)
+            self.check_dir()
+        except GoldenError as exc:
+            raise GoldenUnreadable(f"golden {name}: {exc}") from None
+        st = _lstat(folder)
+        if st is None:
+            # A write killed between its two renames left the old golden whole, aside.
+            aside = [p for p, pid, kind in self._leftovers(name) if kind == OLD]
+            if not aside:
+                raise GoldenMissing(f"no golden for {name}: {shown_path(folder)} does not exist")
+            folder = max(aside, key=_mtime)
+        elif stat.S_ISLNK(st.st_mode):
+            raise GoldenUnreadable(f"golden {name}: {link_message(folder)}")
+        elif not stat.S_ISDIR(st.st_mode):
+            raise GoldenUnreadable(f"golden {name}: {shown_path(folder)} is not a folder")
+        return _read_folder(name, folder, max_frame_pixels)
 
-    def _file(self, name, folder, rel, files) -> bytes:
-        path = folder / rel
-        if not path.is_file():
-            raise GoldenUnreadable(f"golden {name}: {shown_path(path)} is missing; bless it again")
-        files[rel] = path.read_bytes()
-        return files[rel]
-
-    def _checked(self, name, folder, entry, files) -> bytes:
-        data = self._file(name, folder, entry["file"], files)
-        if ser.sha256_bytes(data) != entry["sha256"]:
-            raise GoldenUnreadable(_torn(name, folder / entry["file"]))
-        return data
+    # ---------------------------------------------------------------------------------- writing
 
     def write(self, name: str, files: dict) -> list[str]:
         """Write golden `name` from `files` (relative path -> bytes, which must include the
-        manifest); returns the relative paths whose bytes changed, sorted. Files equal to what is
-        on disk are left alone; frame PNGs the manifest no longer names are removed afterwards.
+        manifest); returns the relative paths whose bytes changed, sorted. When every file equals
+        what is on disk and nothing else is there, nothing is touched; otherwise the whole folder
+        is swapped in (see the module's notes), so files the manifest no longer names go away.
+        Raises GoldenError when a link stands in the way.
         """
         if ci_active():
             raise WritesRefused(_ci_message())
         if ser.MANIFEST_FILE not in files:
             raise ValueError(f"a golden write needs {ser.MANIFEST_FILE}")
-        folder = self.folder(name)
         for rel in files:
-            _check_rel(rel)
-        folder.mkdir(parents=True, exist_ok=True)
-        _remove_temporaries(folder)
-        order = sorted(r for r in files if r != ser.MANIFEST_FILE) + [ser.MANIFEST_FILE]
-        old = {}
-        for rel in order:
-            path = folder / rel
-            old[rel] = path.read_bytes() if path.is_file() else None
-        changed = [rel for rel in order if old[rel] != files[rel]]
-        # Phase 1: every changed file to a temporary name; on failure nothing in place changed.
-        temps = {}
+            ser.check_rel(rel)
+        folder = self.folder(name)
+        self.check_dir()
+        self.dir.mkdir(parents=True, exist_ok=True)
+        self.check_dir()
+        self.recover(name)
+        st = _lstat(folder)
+        if st is not None and stat.S_ISLNK(st.st_mode):
+            raise GoldenError(link_message(folder))
+        if st is not None and not stat.S_ISDIR(st.st_mode):
+            raise GoldenError(f"{shown_path(folder)} is not a folder; remove it and bless again")
+        old, extra = _current_files(folder, files) if st is not None else ({}, False)
+        changed = sorted(rel for rel in files if old.get(rel) != files[rel])
+        if not changed and not extra:
+            return []
+        new = self._temp(name, NEW)
         try:
-            for rel in changed:
-                target = folder / rel
-                target.parent.mkdir(parents=True, exist_ok=True)
-                temps[rel] = _temp_name(target)
-                _write_temp(temps[rel], files[rel])
+            _build(new, files)
         except BaseException:
-            _discard(temps.values())
+            _remove_tree(new)
             raise
-        # Phase 2: rename into place, the manifest last; on failure put the old bytes back.
-        done = []
+        self._swap(folder, new, name, exists=st is not None)
+        return changed
+
+    def _swap(self, folder: Path, new: Path, name: str, *, exists: bool) -> None:
+        """Rename `new` into place at `folder`, the old folder (when `exists`) aside first."""
+        aside = None
         try:
-            for rel in changed:
-                os.replace(temps[rel], folder / rel)
-                done.append(rel)
+            if exists:
+                aside = self._temp(name, OLD, create=False)
+                os.rename(folder, aside)
+            os.rename(new, folder)
         except BaseException:
-            _discard(temps[rel] for rel in changed if rel not in done)
-            for rel in reversed(done):
-                _restore(folder / rel, old[rel])
+            if aside is not None and _lstat(folder) is None and _lstat(aside) is not None:
+                try:
+                    os.rename(aside, folder)
+                    aside = None
+                except OSError:
+                    pass  # the next write or read recovers it
+            _remove_tree(new)
             raise
-        keep = set(files)
-        frames_dir = folder / ser.FRAMES_DIR
-        if frames_dir.is_dir():
-            for png in sorted(frames_dir.glob("frame_*.png")):
-                if f"{ser.FRAMES_DIR}/{png.name}" not in keep:
-                    png.unlink()
-        return sorted(changed)
+        _fsync_dir(self.dir)
+        if aside is not None:
+            _remove_tree(aside)
 
     def remove(self, name: str) -> None:
         """Delete golden folder `name` (what `bless --prune` does to an unused golden)."""
         if ci_active():
             raise WritesRefused(_ci_message())
         folder = self.folder(name)
-        if folder.is_dir():
-            shutil.rmtree(folder)
+        self.check_dir()
+        st = _lstat(folder)
+        if st is None:
+            return
+        if stat.S_ISLNK(st.st_mode):
+            raise GoldenError(link_message(folder))
+        if not stat.S_ISDIR(st.st_mode):
+            raise GoldenError(f"{shown_path(folder)} is not a folder; remove it by hand")
+        aside = self._temp(name, OLD, create=False)
+        os.rename(folder, aside)
+        _remove_tree(aside)
+
+    def recover(self, name: str) -> None:
+        """Tidy what interrupted writes of golden `name` left: put an old golden moved aside back
+        when no golden is in place, then remove the leftover temporary folders (only real folders
+        named as ours, never a live process's)."""
+        if ci_active() or _lstat(self.dir) is None:
+            return
+        self.check_dir()
+        folder = self.folder(name)
+        leftovers = [x for x in self._leftovers(name) if x[1] == os.getpid() or not _alive(x[1])]
+        if _lstat(folder) is None:
+            aside = [p for p, _pid, kind in leftovers if kind == OLD]
+            if aside:
+                back = max(aside, key=_mtime)
+                os.rename(back, folder)
+                leftovers = [x for x in leftovers if x[0] != back]
+        for path, _pid, _kind in leftovers:
+            _remove_tree(path)
+
+    def _leftovers(self, name: str) -> list[tuple[Path, int, str]]:
+        """(path, pid, kind) of the temporary folders of golden `name` in goldens/, real folders
+        only."""
+        prefix = f".{check_name(name)}."
+        out = []
+        try:
+            entries = list(os.scandir(self.dir))
+        except FileNotFoundError:
+            return []
+        for entry in entries:
+            m = _LEFTOVER_RE.fullmatch(entry.name[len(prefix) :])
+            if entry.name.startswith(prefix) and m and entry.is_dir(follow_symlinks=False):
+                out.append((Path(entry.path), int(m["pid"]), m["kind"]))
+        return sorted(out)
+
+    def _temp(self, name: str, kind: str, *, create: bool = True) -> Path:
+        """A fresh temporary folder name of ours for golden `name` (created when `create`)."""
+        while True:
+            path = self.dir / f".{name}.{os.getpid()}.{secrets.token_hex(4)}.{kind}{TMP_SUFFIX}"
+            if not create:
+                if _lstat(path) is None:
+                    return path
+                continue
+            try:
+                os.mkdir(path)
+                return path
+            except FileExistsError:
+                continue
 
 
 def _ci_message() -> str:
@@ -256,53 +340,219 @@ def _torn(name: str, path: Path) -> str:
 
 def shown_path(path) -> str:
     """A path as the user would type it, with forward slashes: relative to the current directory
-    when it lies inside it, else as given."""
+    when it lies inside it, else as given. The last component is shown as it is named (a link is
+    not replaced by its target)."""
     path = Path(path)
     try:
-        rel = Path(os.path.relpath(path.resolve()))
+        real = Path(os.path.realpath(path.parent)) / path.name
+        rel = Path(os.path.relpath(real))
     except ValueError:
         return path.as_posix()
     return path.as_posix() if rel.parts[:1] == ("..",) else rel.as_posix()
 
 
-def _check_rel(rel: str) -> None:
-    parts = Path(rel).parts
-    if Path(rel).is_absolute() or not parts or any(p in ("..", ".") for p in parts):
-        raise ValueError(f"golden file {rel!r} must be a plain relative path")
+# ---------------------------------------------------------------------------------- safe files
 
 
-def _temp_name(target: Path) -> Path:
-    return target.with_name(f".{target.name}.{os.getpid()}{TMP_SUFFIX}")
+def _lstat(path):
+    try:
+        return os.lstat(path)
+    except (FileNotFoundError, NotADirectoryError):
+        return None
 
 
-def _write_temp(path: Path, data: bytes) -> None:
-    """Write `data` to `path` and flush it to disk."""
-    with open(path, "wb") as fh:
-        fh.write(data)
-        fh.flush()
-        os.fsync(fh.fileno())
+def _mtime(path: Path) -> int:
+    st = _lstat(path)
+    return st.st_mtime_ns if st is not None else 0
 
 
-def _discard(paths) -> None:
-    for p in paths:
+def _alive(pid: int) -> bool:
+    """True when process `pid` runs (POSIX); elsewhere every other process counts as gone."""
+    if os.name != "posix":
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    except OSError:
+        return False
+    return True
+
+
+def _below(base: Path, rel: str, name: str) -> Path:
+    """base/rel, after checking that no component below `base` is a symbolic link."""
+    path = base
+    for part in rel.split("/"):
+        path = path / part
+        st = _lstat(path)
+        if st is not None and stat.S_ISLNK(st.st_mode):
+            raise GoldenUnreadable(f"golden {name}: {link_message(path)}")
+    return path
+
+
+def _read_regular(path: Path, name: str, limit: int = MAX_FILE_BYTES) -> bytes:
+    """The bytes of the regular file `path` (opened without following a link), at most `limit`."""
+    try:
+        fd = os.open(path, os.O_RDONLY | _O_NOFOLLOW | _O_BINARY | _O_NONBLOCK)
+    except FileNotFoundError:
+        raise GoldenUnreadable(
+            f"golden {name}: {shown_path(path)} is missing; bless it again"
+        ) from None
+    except OSError as exc:
+        if _lstat(path) is not None and stat.S_ISLNK(os.lstat(path).st_mode):
+            raise GoldenUnreadable(f"golden {name}: {link_message(path)}") from None
+        raise GoldenUnreadable(f"golden {name}: {shown_path(path)}: {exc.strerror}") from None
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            raise GoldenUnreadable(f"golden {name}: {shown_path(path)} is not a regular file")
+        if st.st_size > limit:
+            raise GoldenUnreadable(
+                f"golden {name}: {shown_path(path)} has {st.st_size} bytes, past the "
+                f"{limit} a golden file may have"
+            )
+        chunks, size = [], 0
+        while size <= limit:
+            chunk = os.read(fd, 1 << 20)
+            if not chunk:
+                break
+            chunks.append(chunk)
+            size += len(chunk)
+        if size > limit:
+            raise GoldenUnreadable(f"golden {name}: {shown_path(path)} grew past {limit} bytes")
+        return b"".join(chunks)
+    finally:
+        os.close(fd)
+
+
+def _read_folder(name: str, folder: Path, max_frame_pixels: int) -> Golden:
+    mpath = folder / ser.MANIFEST_FILE
+    if _lstat(mpath) is None:
+        raise GoldenMissing(
+            f"no golden for {name}: {shown_path(folder)} has no {ser.MANIFEST_FILE} "
+            "(an interrupted first bless?)"
+        )
+    files = {}
+
+    def load(rel: str) -> bytes:
+        files[rel] = _read_regular(_below(folder, rel, name), name)
+        return files[rel]
+
+    def checked(entry: dict) -> bytes:
+        data = load(entry["file"])
+        if ser.sha256_bytes(data) != entry["sha256"]:
+            raise GoldenUnreadable(_torn(name, folder / entry["file"]))
+        return data
+
+    def unreadable(rel: str, exc: Exception) -> GoldenUnreadable:
+        return GoldenUnreadable(f"golden {name}: {shown_path(folder / rel)}: {exc}; bless it again")
+
+    try:
+        manifest = ser.load_json(load(ser.MANIFEST_FILE))
+    except ValueError as exc:
+        raise unreadable(ser.MANIFEST_FILE, exc) from None
+    fmt = manifest.get("format") if isinstance(manifest, dict) else None
+    if fmt != ser.FORMAT_VERSION or isinstance(fmt, bool):
+        raise GoldenUnreadable(
+            f"golden {name} has format {json.dumps(fmt)[:40]}; this collide2d reads format "
+            f"{ser.FORMAT_VERSION}: bless it again"
+        )
+    try:
+        ser.check_manifest(manifest)
+    except ValueError as exc:
+        raise unreadable(ser.MANIFEST_FILE, exc) from None
+    try:
+        events = ser.parse_events(checked(manifest["events"]))
+    except ValueError as exc:
+        raise unreadable(ser.EVENTS_FILE, exc) from None
+    try:
+        final = ser.parse_final(checked(manifest["final"]))
+    except ValueError as exc:
+        raise unreadable(ser.FINAL_FILE, exc) from None
+    frames = {}
+    for entry in manifest["frames"]:
+        rel = entry["file"]
         try:
-            os.unlink(p)
-        except FileNotFoundError:
-            pass
+            rgb = ser.decode_png(
+                load(rel),
+                size=(entry["width"], entry["height"]),
+                max_pixels=max_frame_pixels,
+            )
+        except ValueError as exc:
+            raise unreadable(rel, exc) from None
+        if ser.pixel_sha256(rgb) != entry["pixels_sha256"]:
+            raise GoldenUnreadable(_torn(name, folder / rel))
+        frames[entry["frame"]] = rgb
+    return Golden(name, folder, manifest, events, final, frames, files)
 
 
-def _restore(path: Path, data: bytes | None) -> None:
-    """Put `data` back at `path` (None: the file did not exist before)."""
-    if data is None:
-        _discard([path])
+def _current_files(folder: Path, wanted: dict) -> tuple[dict, bool]:
+    """({rel: bytes} of the files of `wanted` present in `folder`, whether anything else is
+    there). GoldenError when a symbolic link is inside."""
+    found, extra = {}, False
+    for dirpath, dirnames, filenames in os.walk(folder, followlinks=False):
+        for entry in (*dirnames, *filenames):
+            path = Path(dirpath) / entry
+            st = os.lstat(path)
+            if stat.S_ISLNK(st.st_mode):
+                raise GoldenError(link_message(path))
+            rel = path.relative_to(folder).as_posix()
+            if stat.S_ISDIR(st.st_mode):
+                extra = extra or not any(w.startswith(rel + "/") for w in wanted)
+            elif rel in wanted and stat.S_ISREG(st.st_mode) and st.st_size <= MAX_FILE_BYTES:
+                found[rel] = _read_regular(path, folder.name)
+            else:
+                extra = True
+    return found, extra
+
+
+def _build(folder: Path, files: dict) -> None:
+    """Write `files` into the new empty `folder`, each flushed to disk, then the folders."""
+    dirs = {folder}
+    for rel in sorted(files):
+        path = folder / rel
+        if path.parent not in dirs:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            dirs.add(path.parent)
+        _write_new(path, files[rel])
+    for d in sorted(dirs, key=lambda p: -len(p.parts)):
+        _fsync_dir(d)
+
+
+def _write_new(path: Path, data: bytes) -> None:
+    """Create `path` (never through a link: it must not exist) with `data`, flushed to disk."""
+    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | _O_NOFOLLOW | _O_BINARY
+    fd = os.open(path, flags, 0o666)
+    try:
+        view = memoryview(data)
+        while view:
+            view = view[os.write(fd, view) :]
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+def _fsync_dir(path: Path) -> None:
+    """Flush a folder's entries to disk (where the platform allows opening a folder)."""
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0))
+    except OSError:
         return
-    tmp = _temp_name(path)
-    _write_temp(tmp, data)
-    os.replace(tmp, path)
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
 
 
-def _remove_temporaries(folder: Path) -> None:
-    """Remove temporaries an interrupted write of this folder left behind."""
-    for tmp in sorted(folder.rglob(f".*{TMP_SUFFIX}")):
-        if tmp.is_file():
-            tmp.unlink()
+def _remove_tree(path: Path) -> None:
+    """Remove the temporary folder `path` of ours: links inside are removed, never followed;
+    `path` itself must be a real folder."""
+    st = _lstat(path)
+    if st is None:
+        return
+    if stat.S_ISDIR(st.st_mode):
+        shutil.rmtree(path, ignore_errors=True)

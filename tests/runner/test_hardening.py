@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import json
 import os
-import re
 import signal
 import subprocess
 import sys
@@ -23,8 +22,6 @@ from runner.scenario import ScenarioError, load
 
 ROOT = Path(__file__).resolve().parents[2]
 DATA = Path(__file__).parent / "data"
-# Temporary names runner.outputs writes through: `.NAME.PID.XXXXXXXX.tmp`.
-TEMP_NAME = re.compile(r"^\..+\.\d+\.[0-9a-f]{8}\.tmp$")
 # A refusal must cost little: well under a second and a few MB, whatever the file asks for.
 REFUSAL_SECONDS = 1.0
 REFUSAL_PEAK_BYTES = 8 * 2**20
@@ -134,9 +131,31 @@ def test_billion_laughs_is_refused_in_well_under_a_second_with_little_memory(cap
             "area is more than the world's",
         ),
         ("ticks: 1000000000000", [], "past the limit of 1000000000 ticks"),
-        ("ticks: 100000000\noutput: {frames: {every: 1}}", [], "past the limit of 1000000 frames"),
+        (
+            "ticks: 100000000\noutput: {frames: {every: 1}}",
+            [],
+            "past the limit of 1,000,000 frames",
+        ),
         ("ticks: 100000000\noutput: {frames: all, gif: false}", [], "frames"),
-        ("ticks: 1000000000", [], "output limit"),
+        # a billion ticks: the GIF's frames, and PNG frames of a scenario that names none
+        ("ticks: 1000000000", [], "1,000,000,001 GIF frames, past the limit of 1,000,000"),
+        ("ticks: 1000000000", ["--no-gif", "--png"], "1,000,000,001 PNG frames, past the limit"),
+        (
+            "world: {width: 1, height: 1}\nticks: 1000000000",
+            ["--max-frames", "2000000000"],
+            "on disk, past the output limit of 4,294,967,296 bytes",
+        ),
+        (
+            "world: {width: 1, height: 1}\nticks: 1000000000",
+            ["--no-gif", "--png", "--max-frames", "2000000000"],
+            "on disk, past the output limit",
+        ),
+        # a frame too large for memory: 16384 x 16384 x 3^2 x 3 bytes
+        (
+            "world: {width: 16384, height: 16384}\nticks: 10",
+            ["--scale", "3", "--no-gif", "--png"],
+            "takes 7,247,757,312 bytes in memory, past the limit of 1,073,741,824",
+        ),
         ("world: {width: 100000000000}", [], "past the limit of 16384 px"),
     ],
 )
@@ -227,18 +246,31 @@ def test_a_linked_output_folder_is_refused_and_its_target_untouched(tmp_path, ca
     assert tree(tmp_path) == before
 
 
-def test_a_linked_output_file_is_replaced_not_followed(tmp_path):
+def test_a_linked_output_file_is_refused_not_followed(tmp_path, capsys):
     outside = tmp_path / "outside.csv"
     outside.write_text("not yours\n")
     folder = tmp_path / "out" / "hard"
     folder.mkdir(parents=True)
     (folder / "final.csv").symlink_to(outside)
     (folder / "summary.json").symlink_to(tmp_path / "missing.json")
-    assert main(["run", str(scenario(tmp_path)), "--out", str(tmp_path / "out"), "--quiet"]) == 0
-    assert outside.read_text() == "not yours\n"
+    path = scenario(tmp_path)
+    before = tree(tmp_path)
+    assert main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 2
+    assert "final.csv is a symbolic link" in capsys.readouterr().err
+    assert tree(tmp_path) == before
     assert not (tmp_path / "missing.json").exists()
-    assert not (folder / "final.csv").is_symlink()
-    assert (folder / "final.csv").read_text().startswith("id,x,y,vx,vy\n")
+
+
+def test_files_a_run_does_not_write_are_never_replaced(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["run", str(scenario(tmp_path)), "--out", str(out), "--png", "--quiet"]) == 0
+    (out / "hard" / "notes.txt").write_text("mine")
+    (out / "hard" / "frames" / "sketch.png").write_bytes(b"mine too")
+    before = tree(tmp_path)
+    assert main(["run", str(scenario(tmp_path)), "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "holds files a run does not write (frames/sketch.png, notes.txt)" in err
+    assert tree(tmp_path) == before
 
 
 # ----------------------------------------------------------------------------- nothing written
@@ -289,7 +321,7 @@ def test_an_output_folder_that_is_a_file_is_a_clear_error(tmp_path, capsys):
     blocker = tmp_path / "out"
     blocker.write_text("a file")
     assert main(["run", str(scenario(tmp_path)), "--out", str(blocker), "--quiet"]) == 2
-    assert capsys.readouterr().err.startswith(f"collide2d: error: {blocker / 'hard'}: ")
+    assert capsys.readouterr().err.startswith(f"collide2d: error: {blocker}: ")
     assert blocker.read_text() == "a file"
 
 
@@ -316,18 +348,14 @@ def whole_outputs(folder: Path, n_objects: int) -> dict[str, int]:
     return seen
 
 
-def temporaries(folder: Path) -> list[str]:
-    return sorted(p.name for p in folder.rglob(".*") if p.is_file())
-
-
-def test_a_killed_run_leaves_old_or_new_whole_files_and_the_next_run_cleans_up(tmp_path):
+def test_a_killed_run_leaves_the_old_run_whole_and_the_next_run_cleans_up(tmp_path):
     out = tmp_path / "out"
     folder = out / "hard"
     short = scenario(tmp_path, ticks=30, file="short")
     assert main(["run", str(short), "--out", str(out), "--png", "--quiet"]) == 0
     old = whole_outputs(folder, 14)
     assert old == {"png": 31, "gif": 31, "events": old["events"], "ticks": 30}
-    old_bytes = tree(out)
+    old_bytes = tree(folder)
     old_files = comparable(folder)
 
     long = scenario(tmp_path, ticks=20000, file="long")
@@ -339,7 +367,7 @@ def test_a_killed_run_leaves_old_or_new_whole_files_and_the_next_run_cleans_up(t
     )
     try:
         deadline = time.monotonic() + 60
-        while not (folder / "frames" / "frame_000200.png").exists():
+        while not list(out.glob(".hard.*.run.tmp/frames/frame_000200.png")):
             assert proc.poll() is None, "the run ended before it could be killed"
             assert time.monotonic() < deadline
             time.sleep(0.005)
@@ -348,16 +376,12 @@ def test_a_killed_run_leaves_old_or_new_whole_files_and_the_next_run_cleans_up(t
         proc.wait()
     assert proc.returncode == -signal.SIGKILL
 
-    seen = whole_outputs(folder, 14)
-    assert seen["png"] > 200  # new frames, each whole (checked above)
-    for name in ("animation.gif", "events.jsonl", "final.csv", "summary.json"):
-        assert (folder / name).read_bytes() == old_bytes[f"hard/{name}"]  # the old file, whole
-    for name in temporaries(out):
-        assert TEMP_NAME.match(name), name  # clearly temporary, never taken for an output
-    assert any(".animation.gif." in name for name in temporaries(out))  # it was mid-GIF
+    assert tree(folder) == old_bytes  # the old run, whole, and nothing of the new one
+    (stage,) = out.glob(".hard.*.run.tmp")  # the killed run's files, apart
+    assert len(list((stage / "frames").glob("frame_*.png"))) > 200
 
     assert main(["run", str(short), "--out", str(out), "--png", "--quiet"]) == 0
-    assert temporaries(out) == []
+    assert sorted(p.name for p in out.iterdir()) == ["hard"]  # no staging folder, no lock
     assert comparable(folder) == old_files  # the same run again: the same files, and no others
 
 

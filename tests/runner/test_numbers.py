@@ -1,12 +1,13 @@
 """Every number in a scenario is in range or refused at its place (SPEC section 8), and every run
 ends in finite figures.
 
-Numbers of any length and YAML form are refused past `MAX_NUMBER_CHARS` characters at a cost linear
-in the text (time and memory measured here); the short forms (hex, octal, binary, sexagesimal,
-underscores) still read; masses lie in [MIN_MASS, MAX_MASS], so energy, momentum and 1/m stay
-finite, denormal masses are refused and `-0.0` is read as `0.0`. A hypothesis test puts values past
-range into every numeric field of the format: each document gives a located error at that value (or
-at what the value pushed out of place) or a scenario whose run has a finite summary.
+Numbers of any length and YAML form are refused past `MAX_NUMBER_CHARS` characters at a cost
+linear in the text (time and memory measured here, with libyaml's parser and with the pure Python
+one); the short forms (hex, octal, binary, sexagesimal, underscores) still read; masses lie in
+[MIN_MASS, MAX_MASS], so energy, momentum and 1/m stay finite, denormal masses are refused and
+`-0.0` is read as `0.0`. A hypothesis test puts values past range into every numeric field of the
+format: each document gives a located error at that value (or at what the value pushed out of
+place) or a scenario whose run has a finite summary.
 """
 
 from __future__ import annotations
@@ -21,11 +22,13 @@ import warnings
 
 import numpy as np
 import pytest
+import yaml
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
 from engine.world import Bodies, kinetic_energy, momentum
 from runner import run as run_module
+from runner import yamlsafe
 from runner.cli import main
 from runner.run import RunStopped, simulate
 from runner.scenario import (
@@ -38,7 +41,6 @@ from runner.scenario import (
     ScenarioError,
     loads,
 )
-from runner.yamlsafe import MAX_NUMBER_CHARS
 
 
 def at(text: str, needle: str) -> tuple[int, int]:
@@ -116,6 +118,17 @@ def test_a_long_number_is_refused_at_its_place_in_linear_time(form):
     assert peak < 4 * len(text) + 2**20
 
 
+@pytest.mark.parametrize("form", ["decimal", "sexagesimal", "tagged sexagesimal", "exponent form"])
+def test_the_pure_python_parser_refuses_long_numbers_too(monkeypatch, form):
+    """Without libyaml the text is scanned in Python, more slowly but still once."""
+    monkeypatch.setattr(yamlsafe, "_LOADER", yaml.SafeLoader)
+    text = with_mass(LONG[form])
+    err, seconds, peak = measured(lambda: loads(text, "n.yaml"))
+    assert isinstance(err, ScenarioError) and "characters long" in err.message
+    assert (err.line, err.col) == at(text, LONG[form])
+    assert seconds < 2.0 and peak < 4 * len(text) + 2**20
+
+
 @pytest.mark.parametrize("form", ["decimal", "sexagesimal", "hex"])
 def test_the_cost_of_refusing_grows_linearly(form):
     """2,000,000 characters: quadratic work (int(), YAML 1.1's sexagesimal sum) would take minutes,
@@ -155,8 +168,8 @@ def test_long_text_is_text_and_costs_little():
 
 
 def test_a_number_of_exactly_the_limit_reads():
-    value = "0." + "0" * (MAX_NUMBER_CHARS - 3) + "5"
-    assert len(value) == MAX_NUMBER_CHARS
+    value = "0." + "0" * (yamlsafe.MAX_NUMBER_CHARS - 3) + "5"
+    assert len(value) == yamlsafe.MAX_NUMBER_CHARS
     text = "version: 1\ngolden: {time_tolerance: %s}\n"
     assert loads(text % value).golden.time_tolerance == float(value) > 0
     err = refused(text % (value + "1"))
@@ -533,7 +546,7 @@ values_past_range = st.one_of(
     st.builds(int_text, INTEGERS, st.sampled_from(FORMS)),
     st.floats(allow_nan=True, allow_infinity=True).map(float_text),
     st.sampled_from(SPECIAL),
-    st.integers(MAX_NUMBER_CHARS - 2, 70_000).map(lambda k: "8" * k),
+    st.integers(yamlsafe.MAX_NUMBER_CHARS - 2, 70_000).map(lambda k: "8" * k),
 )
 LIMITS = Limits(max_objects=5_000, max_ticks=10**6, max_frames=10_000)
 

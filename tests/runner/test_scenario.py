@@ -16,6 +16,7 @@ import yaml
 
 from engine import motion
 from engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON
+from runner import yamlsafe as ys
 from runner.scenario import (
     TOP_KEYS,
     Limits,
@@ -101,7 +102,7 @@ def test_spec_example_loads_as_written():
     assert b.verts.tolist() == [[0, 9], [5, 0], [10, 9]]
     assert sc.lines[:4] == (8, 9, 10, 11) and set(sc.lines[4:]) == {13}
     assert sc.names == (None,) * 54
-    assert sc.output.frames == tuple(range(13)) and sc.output.frames_spec == "all"
+    assert tuple(sc.output.frames) == tuple(range(13)) and sc.output.frames_spec == "all"
     assert sc.output.gif and sc.output.events
     assert sc.golden.frames == (0, 6, 12)
     assert sc.golden.time_tolerance == 0.0 and sc.golden.max_diff_pixels == 0
@@ -116,7 +117,7 @@ def test_defaults():
     assert sc.background == (0, 0, 0)
     assert (sc.model, sc.substeps, sc.geometry) == ("paper", 1, "box")
     assert sc.ticks == 100  # 10 s at 10 fps
-    assert sc.output.frames == () and sc.output.frames_spec == "none"
+    assert tuple(sc.output.frames) == () and sc.output.frames_spec == "none"
     assert sc.output.gif is True and sc.output.events is True
     assert sc.golden.frames == (0, 50, 100)
     assert (sc.golden.time_tolerance, sc.golden.max_diff_pixels, sc.golden.color_threshold) == (
@@ -314,13 +315,51 @@ def test_safe_tags_are_fine():
     assert loads(BASE + "ticks: !!int '7'\n").ticks == 7
 
 
-def test_deep_nesting_refused_without_exhausting_the_stack():
-    depth = 100_000
+PARSERS = [yaml.SafeLoader] + ([yaml.CSafeLoader] if hasattr(yaml, "CSafeLoader") else [])
+
+
+@pytest.fixture(params=PARSERS, ids=lambda loader: loader.__name__)
+def parser(request, monkeypatch):
+    """Each YAML parser PyYAML offers here: pure Python always, libyaml's when it is built in."""
+    monkeypatch.setattr(ys, "_LOADER", request.param)
+    return request.param
+
+
+@pytest.mark.parametrize("depth", [65, 1_000, 100_000])
+def test_deep_flow_nesting_refused_at_our_bound_with_every_parser(parser, depth):
     text = "version: 1\ndescription: " + "[" * depth + "]" * depth + "\n"
     err = refused(text)
-    # the top mapping is level 1, so the 64th bracket opens level 65
+    # the top mapping is level 1, so the 64th bracket opens level 65, whatever limits of its own
+    # the parser has further on
     assert (err.line, err.col) == (2, len("description: ") + 64)
     assert "nested more than 64 levels" in err.message
+
+
+def test_deep_block_nesting_refused_at_our_bound_with_every_parser(parser):
+    text = "version: 1\ndescription:\n" + "".join(
+        " " * (2 * k) + f"k{k}:\n" for k in range(1, 200)
+    )
+    err = refused(text)
+    assert (err.line, err.col) == at(text, "k64:")
+    assert "nested more than 64 levels" in err.message
+
+
+def test_nesting_at_our_bound_is_read(parser):
+    # 63 brackets inside the top mapping: 64 levels, the most allowed
+    text = "version: 1\nworld: {width: 100, height: 80}\nname: deep\nx: " + "[" * 63
+    err = refused(text + "]" * 63 + "\n")
+    assert "unknown key 'x'" in err.message
+
+
+def test_invalid_yaml_is_reported_in_the_same_words_with_every_parser():
+    text = "version: 1\nworld: {width: 100, height: 80\nobjects: []\n"
+    seen = set()
+    for loader in PARSERS:
+        with pytest.MonkeyPatch.context() as mp:
+            mp.setattr(ys, "_LOADER", loader)
+            seen.add(str(refused(text)))
+    assert len(seen) == 1, seen
+    assert "invalid YAML" in seen.pop()
 
 
 def test_billion_laughs_refused_fast_at_the_alias():
@@ -793,7 +832,7 @@ def test_frame_count_limit():
 )
 def test_output_frames(frames, expected, spec):
     sc = loads(BASE + f"ticks: 12\noutput: {{frames: {frames}, gif: false, events: false}}\n")
-    assert sc.output.frames == expected and sc.output.frames_spec == spec
+    assert tuple(sc.output.frames) == expected and sc.output.frames_spec == spec
     assert sc.output.gif is False and sc.output.events is False
 
 
@@ -1209,10 +1248,10 @@ def test_model_override_replaces_the_model_entry():
 def test_ticks_override_resolves_frames():
     text = BASE + "ticks: 12\noutput: {frames: {every: 4}}\n"
     sc = loads(text, overrides={"ticks": 8})
-    assert sc.ticks == 8 and sc.output.frames == (0, 4, 8) and sc.golden.frames == (0, 4, 8)
+    assert sc.ticks == 8 and tuple(sc.output.frames) == (0, 4, 8) and sc.golden.frames == (0, 4, 8)
     # a run shortened from the command line drops listed frames past its end
     text = BASE + "ticks: 12\noutput: {frames: [0, 6, 10]}\n"
-    assert loads(text, overrides={"ticks": 8}).output.frames == (0, 6)
+    assert tuple(loads(text, overrides={"ticks": 8}).output.frames) == (0, 6)
     # the file's own list must fit the file's own ticks
     check_refused(
         text.replace("ticks: 12", "ticks: 9"), "10]", "frame 10 is past the last frame, 9"

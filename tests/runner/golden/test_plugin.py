@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pytest
 
+from runner.golden import cli
 from runner.golden.store import GoldenStore
 
 from . import synthetic
@@ -131,3 +132,20 @@ def test_xdist_blesses_each_golden_once_and_checks(project):
     for name in store.names():
         store.read(name)
     project.runpytest().assert_outcomes(passed=5)
+
+
+def test_links_in_goldens_fail_the_tests_clearly(project, tmp_path_factory):
+    argv = ["bless", "--root", str(project.path), "--quiet"]
+    assert cli.main(argv, load=synthetic.load, simulate=synthetic.simulate) == 0
+    outside = tmp_path_factory.mktemp("outside")
+    golden = project.path / "goldens" / "a"
+    golden.rename(outside / "a")
+    golden.symlink_to(outside / "a", target_is_directory=True)
+    before = sorted((p.as_posix(), p.read_bytes()) for p in outside.rglob("*") if p.is_file())
+    for argv in ([], ["--update-goldens"]):
+        result = project.runpytest(*argv)
+        result.assert_outcomes(passed=1, failed=1)
+        result.stdout.fnmatch_lines(["*goldens/a is a symbolic link*"])
+        result.stdout.no_fnmatch_line("*Traceback*")
+    after = sorted((p.as_posix(), p.read_bytes()) for p in outside.rglob("*") if p.is_file())
+    assert after == before and golden.is_symlink()

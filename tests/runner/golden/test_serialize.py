@@ -8,6 +8,7 @@ import struct
 import zlib
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
@@ -131,3 +132,45 @@ def test_manifest_has_a_format_version_hashes_and_no_timestamps(tmp_path):
     keys = json.dumps(m).lower()
     for word in ("time", "date", "created", "host", "user"):
         assert word not in keys
+
+
+@pytest.mark.parametrize(
+    "text, depth",
+    [
+        (b"1", 0),
+        (b'{"a": [1, {"b": []}]}', 4),
+        (b'{"a": "[[[[{{{{"}', 1),  # brackets inside a string do not nest
+        (b'{"a": "\\"[[[["}', 1),  # nor after an escaped quote
+        (b"[" * 100_000, 100_000),
+    ],
+)
+def test_json_depth_counts_nesting_outside_strings(text, depth):
+    assert ser.json_depth(text) == depth
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        (b"[" * 40 + b"]" * 40, "nested 40 levels deep, past 32"),
+        (b'{"t": 1e999}', "not finite"),
+        (b'{"t": -Infinity}', "-Infinity is not a number a golden holds"),
+        (b'{"id": 9223372036854775808}', "an integer past 64 bits"),
+        (b'{"id": ' + b"1" * 100_000 + b"}", "an integer past 64 bits"),
+        (b"\xff", "not UTF-8"),
+        (b"{", "not JSON"),
+    ],
+)
+def test_load_json_refuses_what_no_golden_holds(text, message):
+    with pytest.raises(ValueError, match=message):
+        ser.load_json(text)
+
+
+def test_load_json_keeps_the_extremes_a_golden_may_hold():
+    obj = ser.load_json(b'{"id": -9223372036854775807, "t": 1.7976931348623157e308}')
+    assert obj == {"id": -(2**63) + 1, "t": 1.7976931348623157e308}
+
+
+@pytest.mark.parametrize("rel", ["../x", "/abs", "a/../b", "a//b", "./a", "a\\b", "c:x", "", 3])
+def test_check_rel_refuses_paths_that_leave(rel):
+    with pytest.raises(ValueError, match="not a plain relative path"):
+        ser.check_rel(rel)

@@ -1,0 +1,197 @@
+"""One run per output folder, whole: the lock, the staging folder and the swap of `OUT/NAME`.
+
+A run of scenario NAME into OUT takes `OUT/.NAME.lock` (an exclusive `flock` on a file holding the
+writer's pid; the kernel drops it when the writer dies, so a dead writer's lock is simply taken
+over) and writes every file into a fresh sibling folder `OUT/.NAME.PID.XXXXXXXX.run.tmp`. Only when
+all of it is written does the staging folder take the place of `OUT/NAME`: in one atomic exchange
+of the two names where the system offers one (Linux `renameat2`), else by moving the old folder
+aside and the new one in, a step that the next run under the lock finishes if it was cut between
+the two renames. So `OUT/NAME` always holds one complete run, the old or the new. On any failure
+the staging folder is removed and the old run stays as it was.
+
+Nothing is followed through a symbolic link: a link at `OUT/NAME` or inside it is refused, and the
+old folder is removed only when it holds nothing but the files a run writes, so a file a user put
+there is never deleted (the run is refused and names it instead).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import ctypes
+import errno
+import os
+import re
+import secrets
+import shutil
+import stat
+from pathlib import Path
+
+try:
+    import fcntl
+except ImportError:  # pragma: no cover - not on POSIX
+    fcntl = None
+
+# The names a run writes in OUT/NAME (and `frames/frame_*.png` below it).
+RUN_FILES = ("animation.gif", "events.jsonl", "final.csv", "summary.json", "viewer.html")
+FRAME_FILE_RE = re.compile(r"^frame_\d{6,}\.png$")
+STAGE_SUFFIX = ".run.tmp"
+OLD_SUFFIX = ".old.tmp"
+_AT_FDCWD = -100
+_RENAME_EXCHANGE = 2
+
+
+class OutputBusy(Exception):
+    """Another live process holds the lock of OUT/NAME; str(err) says which."""
+
+
+class OutputRefused(Exception):
+    """OUT/NAME cannot be replaced safely (a link, or files no run writes); str(err) says why."""
+
+
+def _leftover_re(name: str) -> re.Pattern:
+    return re.compile(
+        rf"^\.{re.escape(name)}\.\d+\.[0-9a-f]{{8}}({re.escape(STAGE_SUFFIX)}|{re.escape(OLD_SUFFIX)})$"
+    )
+
+
+def _sibling(root: Path, name: str, suffix: str) -> Path:
+    return root / f".{name}.{os.getpid()}.{secrets.token_hex(4)}{suffix}"
+
+
+class RunLock:
+    """The lock of OUT/NAME, held for a `with` block; OutputBusy if a live writer holds it."""
+
+    def __init__(self, root: Path, name: str):
+        self.target = Path(root) / name
+        self.path = Path(root) / f".{name}.lock"
+        self.fd: int | None = None
+
+    def __enter__(self) -> RunLock:
+        if fcntl is None:  # pragma: no cover - no flock: one writer is the user's business
+            return self
+        while True:
+            fd = os.open(self.path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW, 0o666)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                holder = os.read(fd, 32).decode("ascii", "replace").strip() or "another process"
+                os.close(fd)
+                raise OutputBusy(
+                    f"{self.target} is being written by process "
+                    f"{holder} (lock {self.path}); wait for it to finish or use another --out"
+                ) from None
+            # the holder before us may have removed the file as we opened it: lock the live one
+            try:
+                same = os.path.samestat(os.fstat(fd), os.stat(self.path, follow_symlinks=False))
+            except FileNotFoundError:
+                same = False
+            if same:
+                break
+            os.close(fd)
+        os.ftruncate(fd, 0)
+        os.write(fd, f"{os.getpid()}\n".encode("ascii"))
+        self.fd = fd
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self.fd is None:
+            return
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(self.path)
+        os.close(self.fd)  # releases the flock
+        self.fd = None
+
+
+def check_replaceable(target: Path) -> None:
+    """Refuse a target that is a link, or holds anything but what a run writes."""
+    if target.is_symlink():
+        raise OutputRefused(
+            f"output folder {target} is a symbolic link; refusing to write through it"
+        )
+    if not target.exists():
+        return
+    if not target.is_dir():
+        raise OutputRefused(f"{target} is not a folder; refusing to replace it")
+    foreign = []
+    for entry in sorted(os.scandir(target), key=lambda e: e.name):
+        mode = entry.stat(follow_symlinks=False).st_mode
+        if entry.name == "frames" and stat.S_ISDIR(mode):
+            for e in sorted(os.scandir(entry.path), key=lambda e: e.name):
+                _refuse_link(e)
+                if not (FRAME_FILE_RE.match(e.name) and e.is_file(follow_symlinks=False)):
+                    foreign.append(f"frames/{e.name}")
+            continue
+        _refuse_link(entry)
+        if entry.name not in RUN_FILES or not stat.S_ISREG(mode):
+            foreign.append(entry.name)
+    if foreign:
+        shown = ", ".join(sorted(foreign)[:5]) + (", ..." if len(foreign) > 5 else "")
+        raise OutputRefused(
+            f"{target} holds files a run does not write ({shown}); a run replaces the whole "
+            "folder, so move them away or use another --out"
+        )
+
+
+def _refuse_link(entry: os.DirEntry) -> None:
+    if entry.is_symlink():
+        raise OutputRefused(
+            f"{entry.path} is a symbolic link; a run replaces its output folder whole and never "
+            "follows or removes a link: remove it or use another --out"
+        )
+
+
+def clean_leftovers(root: Path, name: str) -> None:
+    """Finish or undo what a killed run of NAME left in OUT; call with the lock held.
+
+    Staging folders are removed. An old folder moved aside is put back when OUT/NAME is missing
+    (the run was cut between its two renames), and removed otherwise.
+    """
+    pattern = _leftover_re(name)
+    target = root / name
+    for entry in sorted(os.scandir(root), key=lambda e: e.name):
+        if not pattern.match(entry.name) or not entry.is_dir(follow_symlinks=False):
+            continue
+        if entry.name.endswith(OLD_SUFFIX) and not os.path.lexists(target):
+            os.rename(entry.path, target)
+        else:
+            shutil.rmtree(entry.path)
+
+
+def new_stage(root: Path, name: str) -> Path:
+    """A new empty staging folder for NAME in OUT."""
+    while True:
+        stage = _sibling(root, name, STAGE_SUFFIX)
+        try:
+            stage.mkdir()
+            return stage
+        except FileExistsError:
+            continue
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap the names a and b in one atomic step; False when the system cannot."""
+    libc = ctypes.CDLL(None, use_errno=True)
+    renameat2 = getattr(libc, "renameat2", None)
+    if renameat2 is None:
+        return False
+    done = renameat2(_AT_FDCWD, os.fsencode(a), _AT_FDCWD, os.fsencode(b), _RENAME_EXCHANGE)
+    if done == 0:
+        return True
+    code = ctypes.get_errno()
+    if code in (errno.ENOSYS, errno.EINVAL, errno.ENOTSUP):
+        return False
+    raise OSError(code, os.strerror(code), str(b))
+
+
+def swap_in(stage: Path, target: Path) -> None:
+    """Put the complete staging folder at `target`, replacing the old run, and remove the old."""
+    if not os.path.lexists(target):
+        os.rename(stage, target)
+        return
+    if _exchange(stage, target):
+        shutil.rmtree(stage)  # now the old run
+        return
+    old = _sibling(target.parent, target.name, OLD_SUFFIX)
+    os.rename(target, old)
+    os.rename(stage, target)
+    shutil.rmtree(old)
