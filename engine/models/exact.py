@@ -33,6 +33,15 @@ of the two has another event), so a rounding error cannot make it collide twice.
 that needs more than `max_events_per_tick` events raises EventCapExceeded: a runaway is an error,
 never a hang.
 
+An object with no room to move on an axis would collide again and again at one instant: one
+that moves on an axis along which it touches (or overlaps) a wall or a static object on both
+sides, as a box as wide as the world moving on x does. The model refuses such a scene when it is
+built (`no_room` finds them; NoRoom names the object, the axis and what holds it). A jam it cannot
+see up front (a row of moving objects wedged together) ends at the cap, and when most of that
+tick's events came at one instant the error is NoRoom naming the objects of the last events.
+
+The kernel counts the wall and pair events as they happen, logged or not (`event_counts`).
+
 State is packed in few arrays, floats F (n, 8) and ints N (n, 7), columns named below; the heap
 is HT (time), HI (key, counters) and HN (contact normal). The small helpers are inlined into two
 kernels, `_predict` and `_run`, which allocate nothing: growing the heap or the event log is
@@ -41,12 +50,25 @@ done in Python between calls (the kernel stops before an event it has no room fo
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
-from engine.broadphase import grid_cell, grid_dims, static_cells
+from engine.broadphase import choose, find_pairs, grid_cell, grid_dims, static_cells
 from engine.contact import box_next_contact, box_reach, next_contact
-from engine.events import EV_PAIR, EV_WALL, SIDE_BOTTOM, SIDE_LEFT, SIDE_RIGHT, SIDE_TOP
+from engine.errors import EventCapExceeded, NoRoom
+from engine.events import (
+    AXIS_NAMES,
+    AXIS_X,
+    AXIS_Y,
+    EV_PAIR,
+    EV_WALL,
+    SIDE_BOTTOM,
+    SIDE_LEFT,
+    SIDE_RIGHT,
+    SIDE_TOP,
+)
 from engine.models.stepped import event_records, new_log
 from engine.response import exchange
 from engine.shapes import GEOMETRIES, build_cores
@@ -103,10 +125,19 @@ MAX_OBJECTS = 1 << _ID_BITS
 DIR_LEFT, DIR_RIGHT, DIR_UP, DIR_DOWN = range(4)
 
 # Scalar state st (int64): heap size, ticks done, events in the current tick, query stamp, event
-# rows written in this `advance`, objects given their first prediction. stf (float64): the current
-# time, s.
-_HEAP_N, _TICK, _TICK_EVENTS, _STAMP, _LOGGED, _FIRST = range(6)
-_T_NOW = 0
+# rows written in this `advance`, objects given their first prediction, wall events and pair
+# events so far (logged or not), events in a row at the latest event's instant. stf (float64): the
+# current time, s; the time of the first event of that instant, s.
+_HEAP_N, _TICK, _TICK_EVENTS, _STAMP, _LOGGED, _FIRST, _WALLS, _PAIRS, _INSTANT_RUN = range(9)
+_T_NOW, _T_INSTANT = range(2)
+# The last RECENT events (a, b (-1 for a wall), axis: AXIS_X or AXIS_Y for a wall, the pair's code
+# for a pair), a ring written at slot (wall + pair events) % RECENT: who a runaway involves.
+RECENT = 64
+# A tick stopped at the cap is a jam (NoRoom) when more than this share of its events came in a
+# row at one instant.
+JAM_SHARE = 0.5
+# Static objects are searched for a wedge among the boxes grown by this much (px) along the axis.
+WEDGE_REACH_PX = 0.5
 
 # Events closer in time than max(INSTANT_S, INSTANT_REL·t) are one instant: what parts them is
 # rounding (a few units in the last place of t, or of a pixel coordinate over a speed), not
@@ -126,10 +157,6 @@ INF = np.inf
 # counting references to those arrays at every inlined helper took ~85 % of the run time.
 _hot = njit(cache=True, inline="always")
 _kernel = njit(cache=True, _nrt=False)
-
-
-class EventCapExceeded(RuntimeError):
-    """A tick needed more events than allowed: a runaway (e.g. an object wedged between walls)."""
 
 
 # --- heap keys and entries ---------------------------------------------------------------------
@@ -621,6 +648,7 @@ def _run(
     world,
     rows,
     times,
+    recent,
 ):
     """Run ticks until tick_to: first (once) predict every object's first events; then take due
     events in order, apply each, predict again for the objects it touched. (Objects not touched
@@ -633,7 +661,9 @@ def _run(
     it is in turns out not to approach.
 
     Returns a status: STATUS_DONE; STATUS_HEAP_FULL / STATUS_LOG_FULL (grow, call again: nothing
-    was lost); STATUS_CAP (a runaway; stops mid-tick). st[_LOGGED] counts the rows written.
+    was lost); STATUS_CAP (a runaway; stops mid-tick). st[_LOGGED] counts the rows written,
+    st[_WALLS] and st[_PAIRS] every event, logged or not; `recent` keeps the last RECENT events and
+    st[_INSTANT_RUN] how many came in a row at the last one's instant.
     """
     extra_room = F.shape[0] * F.shape[0] if everyone else 0
     while st[_FIRST] < F.shape[0]:  # the first predictions, at time 0: each pair once
@@ -677,12 +707,21 @@ def _run(
                 if rank == RANK_WALL:
                     n_jobs = _on_wall(a, b, t, F, N, world, jobs)
                     kind, b = EV_WALL, -1
+                    axis = AXIS_X if code == SIDE_LEFT or code == SIDE_RIGHT else AXIS_Y
                 else:
                     n_jobs = _on_pair(a, b, code, nx, ny, t, F, N, jobs)
-                    kind = EV_PAIR
-                if log and n_jobs > 0:  # a pair that was not approaching is no event
-                    _log_row(rows, times, st[_LOGGED], tick, t, kind, a, b, code)
-                    st[_LOGGED] += 1
+                    kind, axis = EV_PAIR, code
+                if n_jobs > 0:  # a pair that was not approaching is no event
+                    slot = (st[_WALLS] + st[_PAIRS]) % RECENT
+                    recent[slot, 0], recent[slot, 1], recent[slot, 2] = a, b, axis
+                    st[_WALLS if kind == EV_WALL else _PAIRS] += 1
+                    if t > stf[_T_INSTANT] + _instant(stf[_T_INSTANT]):
+                        stf[_T_INSTANT] = t
+                        st[_INSTANT_RUN] = 0
+                    st[_INSTANT_RUN] += 1
+                    if log:
+                        _log_row(rows, times, st[_LOGGED], tick, t, kind, a, b, code)
+                        st[_LOGGED] += 1
             for k in range(n_jobs):
                 _predict(jobs, k, t, F, N, C, cells, s_start, s_items, HT, HI, HN, st, world)
             if everyone and n_jobs > 0:
@@ -715,6 +754,116 @@ def _run(
     return STATUS_DONE
 
 
+class Wedge(NamedTuple):
+    """An object with no room to move on an axis: `obj` moves on `axis` (AXIS_X or AXIS_Y) and
+    touches (or overlaps) `low` on its low side and `high` on its high side; each is a static
+    object's id, or WALL for the world's wall on that side."""
+
+    obj: int
+    axis: int
+    low: int
+    high: int
+
+
+WALL = -1
+_NONE = -2
+
+
+def no_room(world: WorldSpec, bodies: Bodies, geometry: str | None = "exact") -> list[Wedge]:
+    """Every moving object with no room on an axis it moves on, in (id, axis) order: its velocity
+    on the axis is not 0, and along that axis it touches or overlaps a wall or a static object
+    on both sides (a static one only when its box overlaps the mover's box on the other axis with
+    positive length). Under `geometry: exact` a static object holds a mover only when both are
+    boxes (other shapes touch by their real outline); the walls hold every shape by its box.
+    Such an object would collide again and again with no time passing. Linear work in n but for
+    one broad-phase pass when there are static objects."""
+    geometry = "exact" if geometry is None else geometry
+    static = np.asarray(bodies.static, bool)
+    pos = np.asarray(bodies.pos, np.float64).reshape(-1, 2)
+    size = np.asarray(bodies.size, np.float64).reshape(-1, 2)
+    vel = np.asarray(bodies.vel, np.float64).reshape(-1, 2)
+    boxy = np.ones(len(static), bool) if geometry == "box" else bodies.kind == KIND_BOX
+    found = []
+    for axis, side in ((AXIS_X, float(world.width)), (AXIS_Y, float(world.height))):
+        k = 0 if axis == AXIS_X else 1
+        moving = ~static & (vel[:, k] != 0.0)
+        if not moving.any():
+            continue
+        low = np.where(moving & (pos[:, k] <= 0.0), WALL, _NONE)
+        high = np.where(moving & (pos[:, k] + size[:, k] >= side), WALL, _NONE)
+        holders = static & boxy
+        if holders.any() and (moving & boxy & ((low == _NONE) | (high == _NONE))).any():
+            _static_holders(pos, size, moving & boxy, holders, k, world, low, high)
+        for i in np.flatnonzero((low != _NONE) & (high != _NONE)):
+            found.append(Wedge(int(i), axis, int(low[i]), int(high[i])))
+    return sorted(found)
+
+
+def _static_holders(pos, size, movers, holders, k, world, low, high):
+    """Fill low/high (where _NONE) with the lowest id of a static box touching or overlapping
+    each mover from below / above along axis k (their boxes overlapping on the other axis)."""
+    sel = np.flatnonzero(movers | holders)
+    lo = pos[sel].copy()
+    hi = lo + size[sel]
+    lo[:, k] -= WEDGE_REACH_PX
+    hi[:, k] += WEDGE_REACH_PX
+    method, cell = choose(world.width, world.height, hi - lo)
+    pairs = sel[find_pairs(method, lo, hi, movers[sel], cell)]
+    for a, b in pairs.tolist():
+        if movers[a] == movers[b]:
+            continue
+        m, s = (a, b) if movers[a] else (b, a)
+        m_lo, m_hi = pos[m, k], pos[m, k] + size[m, k]
+        s_lo, s_hi = pos[s, k], pos[s, k] + size[s, k]
+        if s_lo < m_lo <= s_hi and (low[m] == _NONE or s < low[m] != WALL):
+            low[m] = s
+        if s_lo <= m_hi < s_hi and (high[m] == _NONE or s < high[m] != WALL):
+            high[m] = s
+
+
+def no_room_message(found: list[Wedge], bodies: Bodies, names=None) -> str:
+    """What `no_room` found, in words: the first object (`names[i]` when given, shown beside its
+    id) and what holds it, then how many more."""
+    w = found[0]
+    k = 0 if w.axis == AXIS_X else 1
+    axis = AXIS_NAMES[w.axis]
+    name = names[w.obj] if names is not None and names[w.obj] else None
+    who = f"object {w.obj}" + (f" ({name})" if name else "")
+    sides = ("left", "right") if w.axis == AXIS_X else ("top", "bottom")
+    wide = "wide" if w.axis == AXIS_X else "tall"
+
+    def holder(j, side):
+        return f"the {side} wall" if j == WALL else f"static object {j}"
+
+    if w.low == WALL and w.high == WALL:
+        span = f"it is as {wide} as the world"
+    else:
+        span = (
+            f"it is as {wide} as the space between {holder(w.low, sides[0])} and "
+            f"{holder(w.high, sides[1])} (or wider)"
+        )
+    v = float(np.asarray(bodies.vel, np.float64).reshape(-1, 2)[w.obj, k])
+    also = [f for f in found[1:] if f.obj == w.obj]
+    both = f" (and on {AXIS_NAMES[also[0].axis]})" if also else ""
+    more = len({f.obj for f in found}) - 1
+    rest = f"; {more} more such object{'s' if more > 1 else ''}" if more else ""
+    return (
+        f"{who} has no room to move on {axis}{both}: {span}, and it moves on {axis} "
+        f"(v{axis} = {v:g} px/s), so under the exact model it would collide again and again "
+        f"with no time passing; give it room or no velocity on {axis}{rest}"
+    )
+
+
+def _listing(word: str, ids: list[int], most: int = 8) -> str:
+    """ "object 3", "objects 1 and 2", "objects 1, 2, 3, ... (12 in all)"."""
+    if len(ids) == 1:
+        return f"{word} {ids[0]}"
+    shown = [str(i) for i in ids[:most]]
+    if len(ids) > most:
+        return f"{word}s {', '.join(shown)}, ... ({len(ids)} in all)"
+    return f"{word}s {', '.join(shown[:-1])} and {shown[-1]}"
+
+
 class Model:
     """Event-driven elastic model; see the module docstring. Surface as in engine.models."""
 
@@ -741,6 +890,13 @@ class Model:
             raise ValueError(f"cell_size must be > 0 px, got {cell_size!r}")
         if repredict not in REPREDICT:
             raise ValueError(f"repredict must be one of {REPREDICT}, got {repredict!r}")
+        stuck = no_room(world, bodies, geometry)
+        if stuck:
+            raise NoRoom(
+                no_room_message(stuck, bodies),
+                tuple(w.obj for w in stuck),
+                AXIS_NAMES[stuck[0].axis],
+            )
         self.repredict = repredict
         self.world = world
         self.geometry = geometry
@@ -775,8 +931,9 @@ class Model:
         self._G = _build_grid(self._F, self._N, self.cell_size, gnx, gny)
         cap = max(64, HEAP_PER_OBJECT * n)
         self._heap = [np.empty(cap), np.empty((cap, 3), np.int64), np.empty((cap, 2))]
-        self._st = np.zeros(6, np.int64)
-        self._stf = np.zeros(1)
+        self._st = np.zeros(9, np.int64)
+        self._stf = np.array([0.0, -1.0])  # now; the last instant (none yet)
+        self._recent = np.full((RECENT, 3), -1, np.int64)  # scratch: the last events
         self._jobs = np.zeros((JOB_ROWS, 3), np.int64)  # scratch: the prediction jobs of one event
         self._stack = np.zeros(INSTANT_STACK, np.int64)  # scratch: walking one instant's entries
 
@@ -814,22 +971,49 @@ class Model:
                 world,
                 rows,
                 times,
+                self._recent,
             )
             if status == STATUS_HEAP_FULL:
                 self._heap = [_grown(a) for a in self._heap]
             elif status == STATUS_LOG_FULL:
                 rows, times = _grown(rows), _grown(times)
             elif status == STATUS_CAP:
-                self._broken = (
-                    f"tick {int(st[_TICK]) + 1} needed more than {self.max_events_per_tick} "
-                    f"events (max_events_per_tick); stopped as a runaway at t = "
-                    f"{float(self._stf[_T_NOW])!r} s"
-                )
-                raise EventCapExceeded(self._broken)
+                self._broken = self._runaway()
+                raise self._broken
             else:
                 break
         self.tick = int(self._st[_TICK])
         return event_records(rows, times, int(self._st[_LOGGED]))
+
+    def event_counts(self) -> tuple[int, int]:
+        """(wall events, pair events) so far, logged or not."""
+        return int(self._st[_WALLS]), int(self._st[_PAIRS])
+
+    def _runaway(self) -> EventCapExceeded | NoRoom:
+        """The error of a tick stopped at the cap: NoRoom when most of its events came in a row at
+        one instant (a jam: objects with no room, colliding without time passing), naming the
+        objects and axes of the last events; else EventCapExceeded."""
+        st, t = self._st, float(self._stf[_T_NOW])
+        cap = self.max_events_per_tick
+        said = (
+            f"tick {int(st[_TICK]) + 1} needed more than {cap} events (max_events_per_tick); "
+            f"stopped as a runaway at t = {t!r} s"
+        )
+        if st[_INSTANT_RUN] <= JAM_SHARE * cap:
+            return EventCapExceeded(said)
+        done = int(st[_WALLS] + st[_PAIRS])
+        last = self._recent[: min(done, RECENT)]
+        objects = sorted({int(i) for i in last[:, :2].ravel() if i >= 0})
+        axes = sorted({int(a) for a in last[:, 2]})
+        walls = " and the walls" if (last[:, 1] < 0).any() else ""
+        return NoRoom(
+            f"{_listing('object', objects)} {'has' if len(objects) == 1 else 'have'} no room to "
+            f"move on {' and '.join(AXIS_NAMES[a] for a in axes)}: {int(st[_INSTANT_RUN])} "
+            f"collisions with each other{walls} in a row at t = "
+            f"{float(self._stf[_T_INSTANT])!r} s, with no time passing ({said})",
+            tuple(objects),
+            AXIS_NAMES[axes[0]],
+        )
 
     def positions(self) -> np.ndarray:
         """(n, 2) float64 top-left corners at the last tick's end, px (each object carried from
