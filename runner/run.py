@@ -5,8 +5,10 @@ at every frame someone needs (and often enough to show progress and stream event
 those frames, and calls back with events and frames as they come. Two front ends sit on it:
 `simulate` keeps everything in memory (goldens, tests), `run_to_dir` streams the files of SPEC
 section 5 into `OUT/NAME/`, each through a temporary name and a rename (temporaries a killed run
-left there are removed first). A model that stops a run as a runaway (the exact model's event cap,
-the stepped model's fold limit) raises `RunStopped` with a message for the user.
+left there are removed first). A model that stops a run as a runaway (an `engine.errors.Runaway`:
+the exact model's event cap or an object with no room to move, the stepped model's fold limit)
+raises `RunStopped` with a message for the user. The summary counts the wall and pair events
+whether or not they are logged (the models count them as they happen).
 """
 
 from __future__ import annotations
@@ -21,8 +23,8 @@ from pathlib import Path
 import numpy as np
 
 from engine import models
-from engine.events import EV_PAIR, EV_WALL, empty_events
-from engine.models.exact import EventCapExceeded
+from engine.errors import Runaway
+from engine.events import empty_events
 from engine.raster import Renderer
 from engine.world import kinetic_energy, momentum
 from runner import outputs
@@ -44,8 +46,9 @@ OUTPUT_FILES = ("animation.gif", "events.jsonl", "final.csv", "summary.json")
 
 
 class RunStopped(Exception):
-    """A model stopped the run with a clear error (a runaway: the exact model's event cap, or an
-    object crossing the world too many times in one stepped step). str(err) is the message."""
+    """A model stopped the run with a clear error (a runaway: the exact model's event cap or an
+    object with no room to move, or an object crossing the world too many times in one stepped
+    step). str(err) is the message."""
 
 
 @dataclass
@@ -76,16 +79,18 @@ def drive(
     log_events: record events and pass each chunk's array to `on_events`.
     """
     bodies = scenario.bodies
-    model = models.make(
-        scenario.model,
-        scenario.world,
-        bodies,
-        substeps=scenario.substeps,
-        geometry=scenario.geometry,
-    )
+    options = {"substeps": scenario.substeps, "geometry": scenario.geometry}
+    if scenario.model == "exact":
+        options["max_events_per_tick"] = scenario.max_events_per_tick
+    try:
+        model = models.make(scenario.model, scenario.world, bodies, **options)
+    except Runaway as exc:
+        raise RunStopped(
+            f"{scenario.path or scenario.name}: error: the {scenario.model} model refused the "
+            f"scene: {exc}"
+        ) from None
     wanted = sorted({int(k) for k in frames if 0 <= k <= scenario.ticks})
     renderer = Renderer(scenario.world, bodies) if wanted else None
-    counts = {"wall": 0, "pair": 0}
     start = _energy_momentum(bodies, model.velocities())
     began = time.perf_counter()
 
@@ -99,17 +104,14 @@ def drive(
             stop = min(stop, wanted[next_frame])
         try:
             events = model.advance(stop - model.tick, log_events)
-        except (EventCapExceeded, ValueError) as exc:
+        except Runaway as exc:
             when = f"tick {stop}" if stop == model.tick + 1 else f"ticks {model.tick + 1}-{stop}"
             raise RunStopped(
                 f"{scenario.path or scenario.name}: error: the {scenario.model} model stopped "
                 f"the run in {when}: {exc}"
             ) from None
-        if log_events and len(events):
-            counts["wall"] += int(np.count_nonzero(events["type"] == EV_WALL))
-            counts["pair"] += int(np.count_nonzero(events["type"] == EV_PAIR))
-            if on_events is not None:
-                on_events(events)
+        if log_events and len(events) and on_events is not None:
+            on_events(events)
         if next_frame < len(wanted) and model.tick == wanted[next_frame]:
             on_frame(model.tick, renderer.draw(model.positions()))
             next_frame += 1
@@ -120,13 +122,14 @@ def drive(
         progress.close()
 
     end = _energy_momentum(bodies, model.velocities())
+    walls, pairs = model.event_counts()
     summary = {
         "name": scenario.name,
         "model": scenario.model,
         "fps": scenario.world.fps,
         "ticks": scenario.ticks,
         "objects": bodies.n,
-        "events": counts if log_events else None,
+        "events": {"wall": walls, "pair": pairs},
         "kinetic_energy": {"start": start[0], "end": end[0]},
         "momentum": {"start": list(start[1]), "end": list(end[1])},
         "run_time_s": round(run_time, 6),

@@ -46,6 +46,7 @@ import yaml
 
 from engine import motion
 from engine.models import MODEL_NAMES
+from engine.models.exact import MAX_EVENTS_PER_TICK, no_room, no_room_message
 from engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies, WorldSpec
 from runner import colors
 from runner import generate as gen
@@ -63,6 +64,10 @@ DEFAULT_COLOR = (255, 255, 255)
 DEFAULT_MASS = 1.0  # mass units
 MAX_SPEED = 1e9  # px/s, largest velocity component (a larger one crosses any world in a tick)
 MAX_SUBSTEPS = 10_000  # substeps per tick of the stepped model
+# The exact model's `max_events_per_tick`: the default, and the largest a scenario or
+# --max-events-per-tick may ask for (counted exactly in the kernel's int64 and in float64).
+DEFAULT_MAX_EVENTS_PER_TICK = MAX_EVENTS_PER_TICK
+MAX_EVENT_CAP = 2**53
 MAX_POINT_OFFSET = 2**24  # px, largest |coordinate| of a polygon point relative to its position
 MAX_NAME_LENGTH = 100  # characters in a scenario name (it names a folder)
 PALETTE_SIZE = 256  # palette rows: the background and up to 255 object colours
@@ -91,7 +96,7 @@ TOP_KEYS = (
     "golden",
 )
 WORLD_KEYS = ("width", "height", "fps", "background")
-MODEL_KEYS = ("kind", "substeps", "geometry")
+MODEL_KEYS = ("kind", "substeps", "geometry", "max_events_per_tick")
 OBJECT_KEYS = (
     "shape",
     "size",
@@ -123,7 +128,7 @@ RANGE_KEYS = ("min", "max")
 EVERY_KEYS = ("every",)
 OUTPUT_KEYS = ("frames", "gif", "events")
 GOLDEN_KEYS = ("frames", "time_tolerance", "max_diff_pixels", "color_threshold")
-OVERRIDE_KEYS = ("model", "fps", "ticks")
+OVERRIDE_KEYS = ("model", "fps", "ticks", "max_events_per_tick")
 
 
 @dataclass(frozen=True)
@@ -176,6 +181,8 @@ class Scenario:
     output: Output
     golden: Golden
     text_sha256: str  # of the file's bytes
+    # the exact model's cap: --max-events-per-tick, else the model option, else the default
+    max_events_per_tick: int = DEFAULT_MAX_EVENTS_PER_TICK
 
 
 def load(path, *, overrides: dict | None = None, limits: Limits | None = None) -> Scenario:
@@ -440,7 +447,7 @@ class _Reader:
         if "description" in top:
             description = self.string(top["description"][1], "description")
         world, background = self.world(top)
-        model, substeps, geometry = self.model(top)
+        model, substeps, geometry, cap = self.model(top)
         ticks = self.ticks(top, world.fps)
         paper = model == "paper"
         listed = self.objects(top, world, paper, geometry)
@@ -448,6 +455,8 @@ class _Reader:
         output = self.output(top, ticks)
         golden = self.golden(top, ticks)
         bodies, names, lines, palette = self.bodies(listed, blocks, world, background)
+        if model == "exact":
+            self.room(world, bodies, geometry, names, listed, lines)
         return Scenario(
             path=self.file_path,
             name=name,
@@ -465,6 +474,7 @@ class _Reader:
             output=output,
             golden=golden,
             text_sha256=digest,
+            max_events_per_tick=cap,
         )
 
     def version(self, top: dict, root) -> None:
@@ -539,8 +549,9 @@ class _Reader:
             background = self.color(m["background"][1], "world.background")
         return WorldSpec(side["width"], side["height"], fps), background
 
-    def model(self, top: dict) -> tuple[str, int, str]:
-        kind, substeps, geometry = "paper", 1, None
+    def model(self, top: dict) -> tuple[str, int, str, int]:
+        """(kind, substeps, geometry, max_events_per_tick) from `model` and the overrides."""
+        kind, substeps, geometry, cap = "paper", 1, None, DEFAULT_MAX_EVENTS_PER_TICK
         sub_node = geo_node = None
         if "model" in top:
             node = top["model"][1]
@@ -555,6 +566,16 @@ class _Reader:
                     if kind != "stepped":
                         raise self.error(
                             sub_node, f"substeps applies to the stepped model only, not to {kind}"
+                        )
+                if "max_events_per_tick" in m:
+                    cap_node = m["max_events_per_tick"][1]
+                    cap = self.integer(
+                        cap_node, "model.max_events_per_tick", lo=1, hi=MAX_EVENT_CAP
+                    )
+                    if kind != "exact":
+                        raise self.error(
+                            cap_node,
+                            f"max_events_per_tick applies to the exact model only, not to {kind}",
                         )
                 if "geometry" in m:
                     geo_node = m["geometry"][1]
@@ -579,9 +600,30 @@ class _Reader:
             if v != kind:
                 self.model_from = origin
                 kind, substeps, geometry = v, 1, None
+                cap = DEFAULT_MAX_EVENTS_PER_TICK
+        if "max_events_per_tick" in self.overrides:  # any model: only the exact one uses it
+            v = self.overrides["max_events_per_tick"]
+            if isinstance(v, bool) or not isinstance(v, int) or not 1 <= v <= MAX_EVENT_CAP:
+                raise self.error(
+                    None,
+                    f"--max-events-per-tick {v}: must be a whole number from 1 to {MAX_EVENT_CAP}",
+                )
+            cap = v
         if geometry is None:
             geometry = "exact" if kind == "exact" else "box"
-        return kind, substeps, geometry
+        return kind, substeps, geometry, cap
+
+    def room(self, world, bodies, geometry, names, listed, lines) -> None:
+        """Refuse, at the object, a moving object with no room on an axis it moves on (the exact
+        model would collide it again and again with no time passing; engine.models.exact)."""
+        found = no_room(world, bodies, geometry)
+        if not found:
+            return
+        i = found[0].obj
+        message = self.prefix(self.model_from) + no_room_message(found, bodies, names)
+        if i < len(listed):
+            raise self.error(listed[i].node, message)
+        raise ys.ScenarioError(self.path, lines[i], 1, message)
 
     def ticks(self, top: dict, fps: int) -> int:
         """Ticks from `ticks`, `duration` (at the fps in force) or the default, then --ticks."""

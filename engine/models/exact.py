@@ -991,8 +991,8 @@ class Model:
 
     def _runaway(self) -> EventCapExceeded | NoRoom:
         """The error of a tick stopped at the cap: NoRoom when most of its events came in a row at
-        one instant (a jam: objects with no room, colliding without time passing), naming the
-        objects and axes of the last events; else EventCapExceeded."""
+        one instant and the objects of the last events are jammed (`_jammed`: colliding without
+        time passing, with no room to move), naming them and the axis; else EventCapExceeded."""
         st, t = self._st, float(self._stf[_T_NOW])
         cap = self.max_events_per_tick
         said = (
@@ -1003,17 +1003,49 @@ class Model:
             return EventCapExceeded(said)
         done = int(st[_WALLS] + st[_PAIRS])
         last = self._recent[: min(done, RECENT)]
-        objects = sorted({int(i) for i in last[:, :2].ravel() if i >= 0})
-        axes = sorted({int(a) for a in last[:, 2]})
-        walls = " and the walls" if (last[:, 1] < 0).any() else ""
-        return NoRoom(
-            f"{_listing('object', objects)} {'has' if len(objects) == 1 else 'have'} no room to "
-            f"move on {' and '.join(AXIS_NAMES[a] for a in axes)}: {int(st[_INSTANT_RUN])} "
-            f"collisions with each other{walls} in a row at t = "
-            f"{float(self._stf[_T_INSTANT])!r} s, with no time passing ({said})",
-            tuple(objects),
-            AXIS_NAMES[axes[0]],
+        involved = sorted({int(i) for i in last[:, :2].ravel() if i >= 0})
+        for axis in sorted({int(a) for a in last[:, 2]} & {AXIS_X, AXIS_Y}):
+            objects = self._jammed(involved, axis, t)
+            if not objects:
+                continue
+            walls = " and the walls" if (last[:, 1] < 0).any() else ""
+            return NoRoom(
+                f"{_listing('object', objects)} {'has' if len(objects) == 1 else 'have'} no room "
+                f"to move on {AXIS_NAMES[axis]}: {int(st[_INSTANT_RUN])} collisions with each "
+                f"other{walls} in a row at t = {float(self._stf[_T_INSTANT])!r} s, with no time "
+                f"passing ({said})",
+                tuple(objects),
+                AXIS_NAMES[axis],
+            )
+        return EventCapExceeded(said)
+
+    def _jammed(self, ids: list[int], axis: int, t: float) -> list[int]:
+        """The moving objects of `ids` held on `axis` at time t from both sides by a chain of
+        boxes of `ids` that touch (or overlap) along the axis and overlap on the other, from a
+        wall or a static object to a wall or a static object: they cannot move on that axis."""
+        F, k = self._F, 0 if axis == AXIS_X else 1
+        ids = np.array(ids, np.int64)
+        lo = F[ids, X : Y + 1] + F[ids, VX : VY + 1] * (t - F[ids, TLOC : TLOC + 1])
+        hi = lo + F[ids, SW : SH + 1]
+        side = self._world[k]
+        tol = 1e-9 * max(self._world[0], self._world[1])
+        fixed = self._N[ids, STATIC] != 0
+        o = 1 - k
+        beside = (lo[:, None, o] < hi[None, :, o]) & (lo[None, :, o] < hi[:, None, o])
+        # below[j, i]: j touches i from below along the axis
+        below = (
+            beside & (lo[:, None, k] < lo[None, :, k]) & (hi[:, None, k] >= lo[None, :, k] - tol)
         )
+        held = []
+        for start, links in ((lo[:, k] <= tol, below), (hi[:, k] >= side - tol, below.T)):
+            reached = fixed | start
+            while True:
+                more = reached | (links & reached[:, None]).any(axis=0)
+                if (more == reached).all():
+                    break
+                reached = more
+            held.append(reached)
+        return [int(i) for i in ids[held[0] & held[1] & ~fixed]]
 
     def positions(self) -> np.ndarray:
         """(n, 2) float64 top-left corners at the last tick's end, px (each object carried from
