@@ -126,16 +126,12 @@ DIR_LEFT, DIR_RIGHT, DIR_UP, DIR_DOWN = range(4)
 
 # Scalar state st (int64): heap size, ticks done, events in the current tick, query stamp, event
 # rows written in this `advance`, objects given their first prediction, wall events and pair
-# events so far (logged or not), events in a row at the latest event's instant. stf (float64): the
-# current time, s; the time of the first event of that instant, s.
-_HEAP_N, _TICK, _TICK_EVENTS, _STAMP, _LOGGED, _FIRST, _WALLS, _PAIRS, _INSTANT_RUN = range(9)
-_T_NOW, _T_INSTANT = range(2)
-# The last RECENT events (a, b (-1 for a wall), axis: AXIS_X or AXIS_Y for a wall, the pair's code
-# for a pair), a ring written at slot (wall + pair events) % RECENT: who a runaway involves.
+# events so far (logged or not). stf (float64): the current time, s.
+_HEAP_N, _TICK, _TICK_EVENTS, _STAMP, _LOGGED, _FIRST, _WALLS, _PAIRS = range(8)
+_T_NOW = 0
+# Who a runaway involves: once a tick stops at the cap, the model (stopped for good) runs up to
+# RECENT more events with the log on and looks at them, so the hot loop keeps no record of its own.
 RECENT = 64
-# A tick stopped at the cap is a jam (NoRoom) when more than this share of its events came in a
-# row at one instant.
-JAM_SHARE = 0.5
 # Static objects are searched for a wedge among the boxes grown by this much (px) along the axis.
 WEDGE_REACH_PX = 0.5
 
@@ -648,7 +644,6 @@ def _run(
     world,
     rows,
     times,
-    recent,
 ):
     """Run ticks until tick_to: first (once) predict every object's first events; then take due
     events in order, apply each, predict again for the objects it touched. (Objects not touched
@@ -661,9 +656,9 @@ def _run(
     it is in turns out not to approach.
 
     Returns a status: STATUS_DONE; STATUS_HEAP_FULL / STATUS_LOG_FULL (grow, call again: nothing
-    was lost); STATUS_CAP (a runaway; stops mid-tick). st[_LOGGED] counts the rows written,
-    st[_WALLS] and st[_PAIRS] every event, logged or not; `recent` keeps the last RECENT events and
-    st[_INSTANT_RUN] how many came in a row at the last one's instant.
+    was lost); STATUS_CAP (a runaway; stops mid-tick, before the event past the cap, so that a call
+    with a higher cap would resume). st[_LOGGED] counts the rows written, st[_WALLS] and st[_PAIRS]
+    every event, logged or not.
     """
     extra_room = F.shape[0] * F.shape[0] if everyone else 0
     while st[_FIRST] < F.shape[0]:  # the first predictions, at time 0: each pair once
@@ -702,23 +697,18 @@ def _run(
                 n_jobs = _on_cross(a, b, N, cells, world, jobs)
             else:
                 st[_TICK_EVENTS] += 1
-                if st[_TICK_EVENTS] > cap:
+                if st[_TICK_EVENTS] > cap:  # put it back: a call with a higher cap resumes
+                    st[_TICK_EVENTS] -= 1
+                    _push(HT, HI, HN, st, t, key, ca, cb, nx, ny)
                     return STATUS_CAP
                 if rank == RANK_WALL:
                     n_jobs = _on_wall(a, b, t, F, N, world, jobs)
                     kind, b = EV_WALL, -1
-                    axis = AXIS_X if code == SIDE_LEFT or code == SIDE_RIGHT else AXIS_Y
                 else:
                     n_jobs = _on_pair(a, b, code, nx, ny, t, F, N, jobs)
-                    kind, axis = EV_PAIR, code
+                    kind = EV_PAIR
                 if n_jobs > 0:  # a pair that was not approaching is no event
-                    slot = (st[_WALLS] + st[_PAIRS]) % RECENT
-                    recent[slot, 0], recent[slot, 1], recent[slot, 2] = a, b, axis
                     st[_WALLS if kind == EV_WALL else _PAIRS] += 1
-                    if t > stf[_T_INSTANT] + _instant(stf[_T_INSTANT]):
-                        stf[_T_INSTANT] = t
-                        st[_INSTANT_RUN] = 0
-                    st[_INSTANT_RUN] += 1
                     if log:
                         _log_row(rows, times, st[_LOGGED], tick, t, kind, a, b, code)
                         st[_LOGGED] += 1
@@ -931,9 +921,8 @@ class Model:
         self._G = _build_grid(self._F, self._N, self.cell_size, gnx, gny)
         cap = max(64, HEAP_PER_OBJECT * n)
         self._heap = [np.empty(cap), np.empty((cap, 3), np.int64), np.empty((cap, 2))]
-        self._st = np.zeros(9, np.int64)
-        self._stf = np.array([0.0, -1.0])  # now; the last instant (none yet)
-        self._recent = np.full((RECENT, 3), -1, np.int64)  # scratch: the last events
+        self._st = np.zeros(8, np.int64)
+        self._stf = np.zeros(1)
         self._jobs = np.zeros((JOB_ROWS, 3), np.int64)  # scratch: the prediction jobs of one event
         self._stack = np.zeros(INSTANT_STACK, np.int64)  # scratch: walking one instant's entries
 
@@ -944,35 +933,12 @@ class Model:
     def advance(self, ticks: int, log: bool = True) -> np.ndarray:
         """Run `ticks` ticks; the events in the order they happened (empty when log is False)."""
         if self._broken:
-            raise EventCapExceeded(self._broken)
+            raise self._broken
         rows, times = new_log(log)
         self._st[_LOGGED] = 0
         target = self.tick + int(ticks)
         while True:
-            F, N, C, cells, s_start, s_items, HT, HI, HN, st, world = self._state()
-            status = _run(
-                self._jobs,
-                self._stack,
-                target,
-                bool(log),
-                self.max_events_per_tick,
-                self.repredict == "all",
-                F,
-                N,
-                C,
-                cells,
-                s_start,
-                s_items,
-                HT,
-                HI,
-                HN,
-                st,
-                self._stf,
-                world,
-                rows,
-                times,
-                self._recent,
-            )
+            status = self._call(target, bool(log), self.max_events_per_tick, rows, times)
             if status == STATUS_HEAP_FULL:
                 self._heap = [_grown(a) for a in self._heap]
             elif status == STATUS_LOG_FULL:
@@ -985,38 +951,78 @@ class Model:
         self.tick = int(self._st[_TICK])
         return event_records(rows, times, int(self._st[_LOGGED]))
 
+    def _call(self, target, log, cap, rows, times) -> int:
+        """One call of the kernel `_run` on the model's state; its status."""
+        F, N, C, cells, s_start, s_items, HT, HI, HN, st, world = self._state()
+        return _run(
+            self._jobs,
+            self._stack,
+            target,
+            log,
+            cap,
+            self.repredict == "all",
+            F,
+            N,
+            C,
+            cells,
+            s_start,
+            s_items,
+            HT,
+            HI,
+            HN,
+            st,
+            self._stf,
+            world,
+            rows,
+            times,
+        )
+
     def event_counts(self) -> tuple[int, int]:
         """(wall events, pair events) so far, logged or not."""
         return int(self._st[_WALLS]), int(self._st[_PAIRS])
 
     def _runaway(self) -> EventCapExceeded | NoRoom:
-        """The error of a tick stopped at the cap: NoRoom when most of its events came in a row at
-        one instant and the objects of the last events are jammed (`_jammed`: colliding without
-        time passing, with no room to move), naming them and the axis; else EventCapExceeded."""
+        """The error of a tick stopped at the cap: NoRoom when the objects of the events that
+        would come next, at the instant it stopped, are jammed on an axis (`_jammed`: they collide
+        again and again with no time passing, having no room to move), naming them; else
+        EventCapExceeded. The model is stopped for good, so it runs up to RECENT more events of
+        that tick, logged, to see them."""
         st, t = self._st, float(self._stf[_T_NOW])
-        cap = self.max_events_per_tick
         said = (
-            f"tick {int(st[_TICK]) + 1} needed more than {cap} events (max_events_per_tick); "
-            f"stopped as a runaway at t = {t!r} s"
+            f"tick {int(st[_TICK]) + 1} needed more than {self.max_events_per_tick} events "
+            f"(max_events_per_tick); stopped as a runaway at t = {t!r} s"
         )
-        if st[_INSTANT_RUN] <= JAM_SHARE * cap:
-            return EventCapExceeded(said)
-        done = int(st[_WALLS] + st[_PAIRS])
-        last = self._recent[: min(done, RECENT)]
+        counts = st[_WALLS : _PAIRS + 1].copy()
+        st[_LOGGED] = 0
+        rows, times = np.empty((RECENT, 5), np.int64), np.empty(RECENT)
+        cap = int(st[_TICK_EVENTS]) + RECENT
+        while self._call(int(st[_TICK]) + 1, True, cap, rows, times) == STATUS_HEAP_FULL:
+            self._heap = [_grown(a) for a in self._heap]
+        st[_WALLS : _PAIRS + 1] = counts  # the counts stay those of the events before the stop
+        t = float(self._stf[_T_NOW])
+        n = int(st[_LOGGED])
+        same = np.abs(times[:n] - t) <= max(INSTANT_S, abs(t) * INSTANT_REL)
+        last = rows[:n][same][:, 2:5]  # a, b, code
         involved = sorted({int(i) for i in last[:, :2].ravel() if i >= 0})
-        for axis in sorted({int(a) for a in last[:, 2]} & {AXIS_X, AXIS_Y}):
-            objects = self._jammed(involved, axis, t)
-            if not objects:
-                continue
-            walls = " and the walls" if (last[:, 1] < 0).any() else ""
-            return NoRoom(
-                f"{_listing('object', objects)} {'has' if len(objects) == 1 else 'have'} no room "
-                f"to move on {AXIS_NAMES[axis]}: {int(st[_INSTANT_RUN])} collisions with each "
-                f"other{walls} in a row at t = {float(self._stf[_T_INSTANT])!r} s, with no time "
-                f"passing ({said})",
-                tuple(objects),
-                AXIS_NAMES[axis],
-            )
+        walls = last[:, 1] < 0
+        x_side = (last[:, 2] == SIDE_LEFT) | (last[:, 2] == SIDE_RIGHT)
+        on = {
+            AXIS_X: (walls & x_side) | (~walls & (last[:, 2] != AXIS_Y)),
+            AXIS_Y: (walls & ~x_side) | (~walls & (last[:, 2] != AXIS_X)),
+        }
+        for axis in (AXIS_X, AXIS_Y):
+            objects = self._jammed(involved, axis, t) if on[axis].any() else []
+            if objects:
+                one = len(objects) == 1
+                against = " and the walls" if walls.any() else ""
+                return NoRoom(
+                    f"{_listing('object', objects)} {'has' if one else 'have'} no room to move on "
+                    f"{AXIS_NAMES[axis]}: {'it collides' if one else 'they collide'} with "
+                    f"{'its neighbours' if one else 'each other'}{against} again and again at "
+                    f"t = {t!r} s with no time passing ({said})",
+                    tuple(objects),
+                    AXIS_NAMES[axis],
+                )
         return EventCapExceeded(said)
 
     def _jammed(self, ids: list[int], axis: int, t: float) -> list[int]:
