@@ -790,8 +790,11 @@ def no_room(world: WorldSpec, bodies: Bodies, geometry: str | None = "exact") ->
 
 
 def _static_holders(pos, size, movers, holders, k, world, low, high):
-    """Fill low/high (where _NONE) with the lowest id of a static box touching or overlapping
-    each mover from below / above along axis k (their boxes overlapping on the other axis)."""
+    """Fill low/high (where _NONE) with the lowest id of a static box that holds each mover from
+    below / above along axis k: it overlaps the mover's box on the other axis, and on axis k it
+    reaches to the mover's low edge (touching or overlapping) without reaching past its high edge
+    (from below), or the other way round (from above). A static box holding it from both sides
+    (the mover inside it on that axis) is neither: once they collide they separate."""
     sel = np.flatnonzero(movers | holders)
     lo = pos[sel].copy()
     hi = lo + size[sel]
@@ -799,16 +802,22 @@ def _static_holders(pos, size, movers, holders, k, world, low, high):
     hi[:, k] += WEDGE_REACH_PX
     method, cell = choose(world.width, world.height, hi - lo)
     pairs = sel[find_pairs(method, lo, hi, movers[sel], cell)]
-    for a, b in pairs.tolist():
-        if movers[a] == movers[b]:
-            continue
-        m, s = (a, b) if movers[a] else (b, a)
-        m_lo, m_hi = pos[m, k], pos[m, k] + size[m, k]
-        s_lo, s_hi = pos[s, k], pos[s, k] + size[s, k]
-        if s_lo < m_lo <= s_hi and (low[m] == _NONE or s < low[m] != WALL):
-            low[m] = s
-        if s_lo <= m_hi < s_hi and (high[m] == _NONE or s < high[m] != WALL):
-            high[m] = s
+    a, b = pairs[:, 0], pairs[:, 1]
+    mixed = movers[a] != movers[b]
+    a, b = a[mixed], b[mixed]
+    m = np.where(movers[a], a, b)
+    s = np.where(movers[a], b, a)
+    m_lo, s_lo = pos[m, k], pos[s, k]
+    m_hi, s_hi = m_lo + size[m, k], s_lo + size[s, k]
+    none = np.iinfo(np.int64).max
+    for side, held in (
+        (low, (s_lo < m_lo) & (m_lo <= s_hi) & (s_hi < m_hi)),
+        (high, (m_lo < s_lo) & (s_lo <= m_hi) & (m_hi < s_hi)),
+    ):
+        first = np.full(len(side), none, np.int64)
+        np.minimum.at(first, m[held], s[held])
+        take = (side == _NONE) & (first != none)
+        side[take] = first[take]
 
 
 def no_room_message(found: list[Wedge], bodies: Bodies, names=None) -> str:
