@@ -1,11 +1,12 @@
 """Scenario files: YAML text in, a validated `Scenario` out (SPEC sections 2 and 8), and its schema.
 
 `load(path)` and `loads(text)` read a scenario, apply the command line's overrides (`model`, `fps`,
-`ticks`), check everything, and return a frozen `Scenario`: the world, the model settings, every
-object as `engine.world.Bodies` arrays (listed objects first, then each `generate` block, in id
-order), the palette, the output and golden settings. Any problem raises `ScenarioError`, whose text
-is `FILE:LINE:COL: error: MESSAGE` (1-based) and points at the offending YAML node. Nothing large is
-allocated before every count has been checked against `Limits`.
+`ticks`, `max_events_per_tick`), check everything, and return a frozen `Scenario`: the world, the
+model settings, every object as `engine.world.Bodies` arrays (listed objects first, then each
+`generate` block, in id order), the palette, the output and golden settings. Any problem raises
+`ScenarioError`, whose text is `FILE:LINE:COL: error: MESSAGE` (1-based) and points at the
+offending YAML node. Nothing large is allocated before every count has been checked against
+`Limits`.
 
 Reading goes in two steps: `runner.yamlsafe` turns the text into a node tree within the bounds of
 `Limits` (safe tags only, depth, aliases, size, value count); then the tree is walked by hand, so
@@ -25,9 +26,10 @@ rounded to the nearest whole tick with halves up and computed exactly from the d
 Every value in the file must be valid on its own. The overrides then replace values (`model`
 replaces the file's whole `model` entry unless it names the same kind, whose settings are kept;
 `fps` replaces `world.fps`, so a `duration` is counted again in ticks; `ticks` replaces `ticks` and
-`duration`), and everything that depends on them (paper velocities and positions, the tick limit,
-frame numbers) is checked with the values in force; such an error starts with the override, e.g.
-`--fps 3: ...`.
+`duration`; `max_events_per_tick`, the exact model's cap, replaces the model option of that name
+under any model, though only the exact model uses it), and everything that depends on them (paper
+velocities and positions, the tick limit, frame numbers, room to move under the exact model) is
+checked with the values in force; such an error starts with the override, e.g. `--fps 3: ...`.
 """
 
 from __future__ import annotations
