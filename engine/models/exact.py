@@ -37,8 +37,10 @@ An object with no room to move on an axis would collide again and again at one i
 that moves on an axis along which it touches (or overlaps) a wall or a static object on both
 sides, as a box as wide as the world moving on x does. The model refuses such a scene when it is
 built (`no_room` finds them; NoRoom names the object, the axis and what holds it). A jam it cannot
-see up front (a row of moving objects wedged together) ends at the cap, and when most of that
-tick's events came at one instant the error is NoRoom naming the objects of the last events.
+see up front (a row of moving objects wedged together) ends at the cap; the stopped model then
+runs a few more events with the log on, and when the objects of those at the last instant are held
+from both sides by a touching chain from wall or static object to wall or static object, the
+error is NoRoom naming them (the hot loop keeps no record for this).
 
 The kernel counts the wall and pair events as they happen, logged or not (`event_counts`).
 
