@@ -21,6 +21,7 @@ from __future__ import annotations
 
 from numba import njit
 
+from engine.errors import FoldLimitExceeded
 from engine.events import AXIS_XY
 
 # More folds than this at one wall axis in one step is refused (a runaway, not a bounce).
@@ -107,12 +108,15 @@ def fold(x, v, span):
     x px (top-left corner), v px/s, span = world side - box side. Returns (x', v', folds_low,
     folds_high, first_low): x -> -x at the low wall, x -> 2 span - x at the high wall, v reversed
     at each fold; first_low tells which wall came first. span <= 0 pins x at 0 without a fold.
-    Raises ValueError past MAX_FOLDS_PER_STEP folds (a step far too long for the speed).
+    Raises FoldLimitExceeded (a Runaway, and a ValueError) past MAX_FOLDS_PER_STEP folds (a step
+    far too long for the speed).
     """
     if span <= 0.0:
         return 0.0, v, 0, 0, False
     if x < -MAX_FOLDS_PER_STEP * span or x > (MAX_FOLDS_PER_STEP + 1) * span:
-        raise ValueError("an object crosses the world too many times in one step; use substeps")
+        raise FoldLimitExceeded(
+            "an object crosses the world too many times in one step; use substeps"
+        )
     low = 0
     high = 0
     first_low = x < 0.0

@@ -18,6 +18,7 @@ from engine.models import ModelUnavailable
 from runner import bench, stress, validate
 from runner.golden import cli as golden_cli
 from runner.options import (
+    add_cap_argument,
     add_limit_arguments,
     add_override_arguments,
     limits_from_args,
@@ -77,6 +78,7 @@ def register_run(subparsers) -> None:
     )
     p.add_argument("--quiet", action="store_true", help="no progress bar, no notes")
     add_limit_arguments(p, output=True)
+    add_cap_argument(p)
     p.set_defaults(func=cmd_run)
 
 
@@ -95,9 +97,9 @@ def cmd_run(args: argparse.Namespace) -> int:
     target, summary = run_to_dir(scenario, args.out, options, limits)
     if not args.quiet:
         counts = summary["events"]
-        said = f", {counts['wall']} wall and {counts['pair']} pair events" if counts else ""
         print(
-            f"{scenario.name}: {scenario.ticks} ticks under {scenario.model}{said} "
+            f"{scenario.name}: {scenario.ticks} ticks under {scenario.model}, "
+            f"{counts['wall']:,} wall and {counts['pair']:,} pair events "
             f"in {summary['run_time_s']:.3f}s -> {target}"
         )
     return EXIT_OK

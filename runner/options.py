@@ -4,7 +4,9 @@
 `--max-ticks`, `--max-side`, `--max-frames`, `--max-file-bytes`, `--max-yaml-nodes`, and
 `--max-output-bytes` and `--max-frame-bytes` where frames are written);
 `add_override_arguments` / `overrides_from_args` carry `--model`, `--fps`, `--ticks`, which override
-the scenario file (the loader checks the result again).
+the scenario file (the loader checks the result again); `add_cap_argument` adds
+`--max-events-per-tick` (run, check, bless), the exact model's bound, which overrides the scenario's
+`model.max_events_per_tick` and goes to the loader with the overrides.
 """
 
 from __future__ import annotations
@@ -12,7 +14,7 @@ from __future__ import annotations
 import argparse
 
 from engine.models import MODEL_NAMES
-from runner.scenario import Limits
+from runner.scenario import DEFAULT_MAX_EVENTS_PER_TICK, Limits
 
 _LIMIT_OPTIONS = (
     ("--max-objects", "max_objects", "objects in a scenario"),
@@ -72,6 +74,22 @@ def add_override_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--ticks", type=whole, metavar="N", help="ticks to run instead")
 
 
+def add_cap_argument(parser: argparse.ArgumentParser) -> None:
+    """Add --max-events-per-tick (the exact model's cap; over the scenario's model option)."""
+    parser.add_argument(
+        "--max-events-per-tick",
+        dest="max_events_per_tick",
+        type=positive_int,
+        metavar="N",
+        help="largest number of wall and pair events in one tick of the exact model, a runaway "
+        "past it (default: the scenario's model.max_events_per_tick, else "
+        f"{DEFAULT_MAX_EVENTS_PER_TICK:,})",
+    )
+
+
 def overrides_from_args(args: argparse.Namespace) -> dict:
-    """{"model", "fps", "ticks"} from the command line; None where not given."""
-    return {key: getattr(args, key, None) for key in ("model", "fps", "ticks")}
+    """{"model", "fps", "ticks", "max_events_per_tick"} from the command line; None where not
+    given."""
+    return {
+        key: getattr(args, key, None) for key in ("model", "fps", "ticks", "max_events_per_tick")
+    }

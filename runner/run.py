@@ -7,8 +7,9 @@ those frames, and calls back with events and frames as they come. Two front ends
 section 5 into a staging folder that replaces `OUT/NAME/` whole when the run is done, under a lock
 (`runner.rundir`), after `runner.budget` has checked what its frames will cost. Frames are a
 `FrameRule`, so nothing sized by the number of ticks is built. A model that stops a run as a
-runaway (the exact model's event cap, the stepped model's fold limit) raises `RunStopped` with a
-message for the user.
+runaway (an `engine.errors.Runaway`: the exact model's event cap or an object with no room to move,
+the stepped model's fold limit) raises `RunStopped` with a message for the user. The summary counts
+the wall and pair events whether or not they are logged (the models count them as they happen).
 """
 
 from __future__ import annotations
@@ -24,8 +25,8 @@ from pathlib import Path
 import numpy as np
 
 from engine import models
-from engine.events import EV_PAIR, EV_WALL, empty_events
-from engine.models.exact import EventCapExceeded
+from engine.errors import Runaway
+from engine.events import empty_events
 from engine.raster import Renderer
 from engine.world import kinetic_energy, momentum
 from runner import budget, outputs, rundir
@@ -39,8 +40,9 @@ CHUNK_TICKS = 65_536
 
 
 class RunStopped(Exception):
-    """A model stopped the run with a clear error (a runaway: the exact model's event cap, or an
-    object crossing the world too many times in one stepped step). str(err) is the message."""
+    """A model stopped the run with a clear error (a runaway: the exact model's event cap or an
+    object with no room to move, or an object crossing the world too many times in one stepped
+    step). str(err) is the message."""
 
 
 @dataclass
@@ -72,17 +74,19 @@ def drive(
     log_events: record events and pass each chunk's array to `on_events`.
     """
     bodies = scenario.bodies
-    model = models.make(
-        scenario.model,
-        scenario.world,
-        bodies,
-        substeps=scenario.substeps,
-        geometry=scenario.geometry,
-    )
+    options = {"substeps": scenario.substeps, "geometry": scenario.geometry}
+    if scenario.model == "exact":
+        options["max_events_per_tick"] = scenario.max_events_per_tick
+    try:
+        model = models.make(scenario.model, scenario.world, bodies, **options)
+    except Runaway as exc:
+        raise RunStopped(
+            f"{scenario.path or scenario.name}: error: the {scenario.model} model refused the "
+            f"scene: {exc}"
+        ) from None
     if not isinstance(frames, FrameRule):
         frames = FrameRule.of(frames, scenario.ticks)
     renderer = Renderer(scenario.world, bodies) if frames else None
-    counts = {"wall": 0, "pair": 0}
     start = _energy_momentum(bodies, model.velocities())
     began = time.perf_counter()
 
@@ -96,17 +100,14 @@ def drive(
             stop = min(stop, next_frame)
         try:
             events = model.advance(stop - model.tick, log_events)
-        except (EventCapExceeded, ValueError) as exc:
+        except Runaway as exc:
             when = f"tick {stop}" if stop == model.tick + 1 else f"ticks {model.tick + 1}-{stop}"
             raise RunStopped(
                 f"{scenario.path or scenario.name}: error: the {scenario.model} model stopped "
                 f"the run in {when}: {exc}"
             ) from None
-        if log_events and len(events):
-            counts["wall"] += int(np.count_nonzero(events["type"] == EV_WALL))
-            counts["pair"] += int(np.count_nonzero(events["type"] == EV_PAIR))
-            if on_events is not None:
-                on_events(events)
+        if log_events and len(events) and on_events is not None:
+            on_events(events)
         if model.tick == next_frame:
             on_frame(model.tick, renderer.draw(model.positions()))
             next_frame = frames.next_from(model.tick + 1)
@@ -118,13 +119,14 @@ def drive(
 
     end = _energy_momentum(bodies, model.velocities())
     _check_finite(scenario, model, start, end)
+    walls, pairs = model.event_counts()
     summary = {
         "name": scenario.name,
         "model": scenario.model,
         "fps": scenario.world.fps,
         "ticks": scenario.ticks,
         "objects": bodies.n,
-        "events": counts if log_events else None,
+        "events": {"wall": walls, "pair": pairs},
         "kinetic_energy": {"start": start[0], "end": end[0]},
         "momentum": {"start": list(start[1]), "end": list(end[1])},
         "run_time_s": round(run_time, 6),

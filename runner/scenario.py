@@ -1,11 +1,12 @@
 """Scenario files: YAML text in, a validated `Scenario` out (SPEC sections 2 and 8), and its schema.
 
 `load(path)` and `loads(text)` read a scenario, apply the command line's overrides (`model`, `fps`,
-`ticks`), check everything, and return a frozen `Scenario`: the world, the model settings, every
-object as `engine.world.Bodies` arrays (listed objects first, then each `generate` block, in id
-order), the palette, the output and golden settings. Any problem raises `ScenarioError`, whose text
-is `FILE:LINE:COL: error: MESSAGE` (1-based) and points at the offending YAML node. Nothing large is
-allocated before every count has been checked against `Limits`.
+`ticks`, `max_events_per_tick`), check everything, and return a frozen `Scenario`: the world, the
+model settings, every object as `engine.world.Bodies` arrays (listed objects first, then each
+`generate` block, in id order), the palette, the output and golden settings. Any problem raises
+`ScenarioError`, whose text is `FILE:LINE:COL: error: MESSAGE` (1-based) and points at the
+offending YAML node. Nothing large is allocated before every count has been checked against
+`Limits`.
 
 Reading goes in two steps: `runner.yamlsafe` turns the text into a node tree within the bounds of
 `Limits` (safe tags only, depth, aliases, size, value count); then the tree is walked by hand, so
@@ -38,9 +39,10 @@ to an immovable object.
 Every value in the file must be valid on its own. The overrides then replace values (`model`
 replaces the file's whole `model` entry unless it names the same kind, whose settings are kept;
 `fps` replaces `world.fps`, so a `duration` is counted again in ticks; `ticks` replaces `ticks` and
-`duration`), and everything that depends on them (paper velocities and positions, the tick limit,
-frame numbers) is checked with the values in force; such an error starts with the override, e.g.
-`--fps 3: ...`.
+`duration`; `max_events_per_tick`, the exact model's cap, replaces the model option of that name
+under any model, though only the exact model uses it), and everything that depends on them (paper
+velocities and positions, the tick limit, frame numbers, room to move under the exact model) is
+checked with the values in force; such an error starts with the override, e.g. `--fps 3: ...`.
 """
 
 from __future__ import annotations
@@ -59,6 +61,7 @@ import yaml
 
 from engine import motion
 from engine.models import MODEL_NAMES
+from engine.models.exact import MAX_EVENTS_PER_TICK, no_room, no_room_message
 from engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies, WorldSpec
 from runner import colors
 from runner import generate as gen
@@ -81,6 +84,10 @@ MAX_INTEGER = 2**63 - 1  # the largest whole number a field takes unless it has 
 MAX_SEED = 2**64 - 1  # the largest generate seed
 MAX_SPEED = 1e9  # px/s, largest velocity component (a larger one crosses any world in a tick)
 MAX_SUBSTEPS = 10_000  # substeps per tick of the stepped model
+# The exact model's `max_events_per_tick`: the default, and the largest a scenario or
+# --max-events-per-tick may ask for (counted exactly in the kernel's int64 and in float64).
+DEFAULT_MAX_EVENTS_PER_TICK = MAX_EVENTS_PER_TICK
+MAX_EVENT_CAP = 2**53
 MAX_POINT_OFFSET = 2**24  # px, largest |coordinate| of a polygon point relative to its position
 MAX_NAME_LENGTH = 100  # characters in a scenario name (it names a folder)
 PALETTE_SIZE = 256  # palette rows: the background and up to 255 object colours
@@ -109,7 +116,7 @@ TOP_KEYS = (
     "golden",
 )
 WORLD_KEYS = ("width", "height", "fps", "background")
-MODEL_KEYS = ("kind", "substeps", "geometry")
+MODEL_KEYS = ("kind", "substeps", "geometry", "max_events_per_tick")
 OBJECT_KEYS = (
     "shape",
     "size",
@@ -141,7 +148,7 @@ RANGE_KEYS = ("min", "max")
 EVERY_KEYS = ("every",)
 OUTPUT_KEYS = ("frames", "gif", "events")
 GOLDEN_KEYS = ("frames", "time_tolerance", "max_diff_pixels", "color_threshold")
-OVERRIDE_KEYS = ("model", "fps", "ticks")
+OVERRIDE_KEYS = ("model", "fps", "ticks", "max_events_per_tick")
 
 
 @dataclass(frozen=True)
@@ -195,6 +202,8 @@ class Scenario:
     output: Output
     golden: Golden
     text_sha256: str  # of the file's bytes
+    # the exact model's cap: --max-events-per-tick, else the model option, else the default
+    max_events_per_tick: int = DEFAULT_MAX_EVENTS_PER_TICK
 
 
 def load(path, *, overrides: dict | None = None, limits: Limits | None = None) -> Scenario:
@@ -467,7 +476,7 @@ class _Reader:
         if "description" in top:
             description = self.string(top["description"][1], "description")
         world, background = self.world(top)
-        model, substeps, geometry = self.model(top)
+        model, substeps, geometry, cap = self.model(top)
         ticks = self.ticks(top, world.fps)
         paper = model == "paper"
         listed = self.objects(top, world, paper, geometry)
@@ -475,6 +484,8 @@ class _Reader:
         output = self.output(top, ticks)
         golden = self.golden(top, ticks)
         bodies, names, lines, palette = self.bodies(listed, blocks, world, background)
+        if model == "exact":
+            self.room(world, bodies, geometry, names, listed, lines)
         return Scenario(
             path=self.file_path,
             name=name,
@@ -492,6 +503,7 @@ class _Reader:
             output=output,
             golden=golden,
             text_sha256=digest,
+            max_events_per_tick=cap,
         )
 
     def version(self, top: dict, root) -> None:
@@ -566,8 +578,9 @@ class _Reader:
             background = self.color(m["background"][1], "world.background")
         return WorldSpec(side["width"], side["height"], fps), background
 
-    def model(self, top: dict) -> tuple[str, int, str]:
-        kind, substeps, geometry = "paper", 1, None
+    def model(self, top: dict) -> tuple[str, int, str, int]:
+        """(kind, substeps, geometry, max_events_per_tick) from `model` and the overrides."""
+        kind, substeps, geometry, cap = "paper", 1, None, DEFAULT_MAX_EVENTS_PER_TICK
         sub_node = geo_node = None
         if "model" in top:
             node = top["model"][1]
@@ -582,6 +595,16 @@ class _Reader:
                     if kind != "stepped":
                         raise self.error(
                             sub_node, f"substeps applies to the stepped model only, not to {kind}"
+                        )
+                if "max_events_per_tick" in m:
+                    cap_node = m["max_events_per_tick"][1]
+                    cap = self.integer(
+                        cap_node, "model.max_events_per_tick", lo=1, hi=MAX_EVENT_CAP
+                    )
+                    if kind != "exact":
+                        raise self.error(
+                            cap_node,
+                            f"max_events_per_tick applies to the exact model only, not to {kind}",
                         )
                 if "geometry" in m:
                     geo_node = m["geometry"][1]
@@ -606,9 +629,30 @@ class _Reader:
             if v != kind:
                 self.model_from = origin
                 kind, substeps, geometry = v, 1, None
+                cap = DEFAULT_MAX_EVENTS_PER_TICK
+        if "max_events_per_tick" in self.overrides:  # any model: only the exact one uses it
+            v = self.overrides["max_events_per_tick"]
+            if isinstance(v, bool) or not isinstance(v, int) or not 1 <= v <= MAX_EVENT_CAP:
+                raise self.error(
+                    None,
+                    f"--max-events-per-tick {v}: must be a whole number from 1 to {MAX_EVENT_CAP}",
+                )
+            cap = v
         if geometry is None:
             geometry = "exact" if kind == "exact" else "box"
-        return kind, substeps, geometry
+        return kind, substeps, geometry, cap
+
+    def room(self, world, bodies, geometry, names, listed, lines) -> None:
+        """Refuse, at the object, a moving object with no room on an axis it moves on (the exact
+        model would collide it again and again with no time passing; engine.models.exact)."""
+        found = no_room(world, bodies, geometry)
+        if not found:
+            return
+        i = found[0].obj
+        message = self.prefix(self.model_from) + no_room_message(found, bodies, names)
+        if i < len(listed):
+            raise self.error(listed[i].node, message)
+        raise ys.ScenarioError(self.path, lines[i], 1, message)
 
     def ticks(self, top: dict, fps: int) -> int:
         """Ticks from `ticks`, `duration` (at the fps in force) or the default, then --ticks."""

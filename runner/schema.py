@@ -15,10 +15,12 @@ from runner.scenario import (
     DEFAULT_DURATION,
     DEFAULT_FPS,
     DEFAULT_HEIGHT,
+    DEFAULT_MAX_EVENTS_PER_TICK,
     DEFAULT_WIDTH,
     FORMAT_VERSION,
     FRAME_WORDS,
     GEOMETRIES,
+    MAX_EVENT_CAP,
     MAX_FPS,
     MAX_MASS,
     MAX_NAME_LENGTH,
@@ -169,19 +171,35 @@ def json_schema() -> dict:
                             "kind": {"enum": list(MODEL_NAMES)},
                             "substeps": {"type": "integer", "minimum": 1, "maximum": MAX_SUBSTEPS},
                             "geometry": {"enum": list(GEOMETRIES)},
+                            "max_events_per_tick": {
+                                "type": "integer",
+                                "minimum": 1,
+                                "maximum": MAX_EVENT_CAP,
+                                "description": "exact model only: the most wall and pair events "
+                                f"one tick may take, default {DEFAULT_MAX_EVENTS_PER_TICK:,}",
+                            },
                         },
                         "required": ["kind"],
                         "additionalProperties": False,
                         "not": {
-                            "properties": {
-                                "kind": {"const": "paper"},
-                                "geometry": {"const": "exact"},
-                            },
-                            "required": ["kind", "geometry"],
+                            "anyOf": [
+                                {
+                                    "properties": {
+                                        "kind": {"const": "paper"},
+                                        "geometry": {"const": "exact"},
+                                    },
+                                    "required": ["kind", "geometry"],
+                                },
+                                {
+                                    "properties": {"kind": {"enum": ["paper", "stepped"]}},
+                                    "required": ["kind", "max_events_per_tick"],
+                                },
+                            ]
                         },
                     },
                 ],
-                "description": "paper (default) | stepped | exact, or {kind, substeps, geometry}",
+                "description": "paper (default) | stepped | exact, or {kind, substeps, geometry, "
+                "max_events_per_tick}",
             },
             "ticks": {"type": "integer", "minimum": 0},
             "duration": {

@@ -7,8 +7,10 @@ Every model is a class built as `Model(world, bodies, **options)` with the same 
                           empty when `log` is False)
     positions()           (n, 2) float64 current top-left corners
     velocities()          (n, 2) float64 current velocities, px/s
+    event_counts()        (wall events, pair events) so far, counted whether logged or not
 
-`make` picks one by name. Each model's tick runs move -> walls -> pairs -> record.
+`make` picks one by name. Each model's tick runs move -> walls -> pairs -> record. A model that
+cannot carry a scene on (when built, or in `advance`) raises an `engine.errors.Runaway`.
 """
 
 from __future__ import annotations

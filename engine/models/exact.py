@@ -33,6 +33,17 @@ of the two has another event), so a rounding error cannot make it collide twice.
 that needs more than `max_events_per_tick` events raises EventCapExceeded: a runaway is an error,
 never a hang.
 
+An object with no room to move on an axis would collide again and again at one instant: one
+that moves on an axis along which it touches (or overlaps) a wall or a static object on both
+sides, as a box as wide as the world moving on x does. The model refuses such a scene when it is
+built (`no_room` finds them; NoRoom names the object, the axis and what holds it). A jam it cannot
+see up front (a row of moving objects wedged together) ends at the cap; the stopped model then
+runs a few more events with the log on, and when the objects of those at the last instant are held
+from both sides by a touching chain from wall or static object to wall or static object, the
+error is NoRoom naming them (the hot loop keeps no record for this).
+
+The kernel counts the wall and pair events as they happen, logged or not (`event_counts`).
+
 State is packed in few arrays, floats F (n, 8) and ints N (n, 7), columns named below; the heap
 is HT (time), HI (key, counters) and HN (contact normal). The small helpers are inlined into two
 kernels, `_predict` and `_run`, which allocate nothing: growing the heap or the event log is
@@ -41,12 +52,25 @@ done in Python between calls (the kernel stops before an event it has no room fo
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
-from engine.broadphase import grid_cell, grid_dims, static_cells
+from engine.broadphase import choose, find_pairs, grid_cell, grid_dims, static_cells
 from engine.contact import box_next_contact, box_reach, next_contact
-from engine.events import EV_PAIR, EV_WALL, SIDE_BOTTOM, SIDE_LEFT, SIDE_RIGHT, SIDE_TOP
+from engine.errors import EventCapExceeded, NoRoom
+from engine.events import (
+    AXIS_NAMES,
+    AXIS_X,
+    AXIS_Y,
+    EV_PAIR,
+    EV_WALL,
+    SIDE_BOTTOM,
+    SIDE_LEFT,
+    SIDE_RIGHT,
+    SIDE_TOP,
+)
 from engine.models.stepped import event_records, new_log
 from engine.response import exchange
 from engine.shapes import GEOMETRIES, build_cores
@@ -103,10 +127,15 @@ MAX_OBJECTS = 1 << _ID_BITS
 DIR_LEFT, DIR_RIGHT, DIR_UP, DIR_DOWN = range(4)
 
 # Scalar state st (int64): heap size, ticks done, events in the current tick, query stamp, event
-# rows written in this `advance`, objects given their first prediction. stf (float64): the current
-# time, s.
-_HEAP_N, _TICK, _TICK_EVENTS, _STAMP, _LOGGED, _FIRST = range(6)
+# rows written in this `advance`, objects given their first prediction, wall events and pair
+# events so far (logged or not). stf (float64): the current time, s.
+_HEAP_N, _TICK, _TICK_EVENTS, _STAMP, _LOGGED, _FIRST, _WALLS, _PAIRS = range(8)
 _T_NOW = 0
+# Who a runaway involves: once a tick stops at the cap, the model (stopped for good) runs up to
+# RECENT more events with the log on and looks at them, so the hot loop keeps no record of its own.
+RECENT = 64
+# Static objects are searched for a wedge among the boxes grown by this much (px) along the axis.
+WEDGE_REACH_PX = 0.5
 
 # Events closer in time than max(INSTANT_S, INSTANT_REL·t) are one instant: what parts them is
 # rounding (a few units in the last place of t, or of a pixel coordinate over a speed), not
@@ -126,10 +155,6 @@ INF = np.inf
 # counting references to those arrays at every inlined helper took ~85 % of the run time.
 _hot = njit(cache=True, inline="always")
 _kernel = njit(cache=True, _nrt=False)
-
-
-class EventCapExceeded(RuntimeError):
-    """A tick needed more events than allowed: a runaway (e.g. an object wedged between walls)."""
 
 
 # --- heap keys and entries ---------------------------------------------------------------------
@@ -633,7 +658,9 @@ def _run(
     it is in turns out not to approach.
 
     Returns a status: STATUS_DONE; STATUS_HEAP_FULL / STATUS_LOG_FULL (grow, call again: nothing
-    was lost); STATUS_CAP (a runaway; stops mid-tick). st[_LOGGED] counts the rows written.
+    was lost); STATUS_CAP (a runaway; stops mid-tick, before the event past the cap, so that a call
+    with a higher cap would resume). st[_LOGGED] counts the rows written, st[_WALLS] and st[_PAIRS]
+    every event, logged or not.
     """
     extra_room = F.shape[0] * F.shape[0] if everyone else 0
     while st[_FIRST] < F.shape[0]:  # the first predictions, at time 0: each pair once
@@ -672,7 +699,9 @@ def _run(
                 n_jobs = _on_cross(a, b, N, cells, world, jobs)
             else:
                 st[_TICK_EVENTS] += 1
-                if st[_TICK_EVENTS] > cap:
+                if st[_TICK_EVENTS] > cap:  # put it back: a call with a higher cap resumes
+                    st[_TICK_EVENTS] -= 1
+                    _push(HT, HI, HN, st, t, key, ca, cb, nx, ny)
                     return STATUS_CAP
                 if rank == RANK_WALL:
                     n_jobs = _on_wall(a, b, t, F, N, world, jobs)
@@ -680,9 +709,11 @@ def _run(
                 else:
                     n_jobs = _on_pair(a, b, code, nx, ny, t, F, N, jobs)
                     kind = EV_PAIR
-                if log and n_jobs > 0:  # a pair that was not approaching is no event
-                    _log_row(rows, times, st[_LOGGED], tick, t, kind, a, b, code)
-                    st[_LOGGED] += 1
+                if n_jobs > 0:  # a pair that was not approaching is no event
+                    st[_WALLS if kind == EV_WALL else _PAIRS] += 1
+                    if log:
+                        _log_row(rows, times, st[_LOGGED], tick, t, kind, a, b, code)
+                        st[_LOGGED] += 1
             for k in range(n_jobs):
                 _predict(jobs, k, t, F, N, C, cells, s_start, s_items, HT, HI, HN, st, world)
             if everyone and n_jobs > 0:
@@ -715,6 +746,125 @@ def _run(
     return STATUS_DONE
 
 
+class Wedge(NamedTuple):
+    """An object with no room to move on an axis: `obj` moves on `axis` (AXIS_X or AXIS_Y) and
+    touches (or overlaps) `low` on its low side and `high` on its high side; each is a static
+    object's id, or WALL for the world's wall on that side."""
+
+    obj: int
+    axis: int
+    low: int
+    high: int
+
+
+WALL = -1
+_NONE = -2
+
+
+def no_room(world: WorldSpec, bodies: Bodies, geometry: str | None = "exact") -> list[Wedge]:
+    """Every moving object with no room on an axis it moves on, in (id, axis) order: its velocity
+    on the axis is not 0, and along that axis it touches or overlaps a wall or a static object
+    on both sides (a static one only when its box overlaps the mover's box on the other axis with
+    positive length). Under `geometry: exact` a static object holds a mover only when both are
+    boxes (other shapes touch by their real outline); the walls hold every shape by its box.
+    Such an object would collide again and again with no time passing. Linear work in n but for
+    one broad-phase pass when there are static objects."""
+    geometry = "exact" if geometry is None else geometry
+    static = np.asarray(bodies.static, bool)
+    pos = np.asarray(bodies.pos, np.float64).reshape(-1, 2)
+    size = np.asarray(bodies.size, np.float64).reshape(-1, 2)
+    vel = np.asarray(bodies.vel, np.float64).reshape(-1, 2)
+    boxy = np.ones(len(static), bool) if geometry == "box" else bodies.kind == KIND_BOX
+    found = []
+    for axis, side in ((AXIS_X, float(world.width)), (AXIS_Y, float(world.height))):
+        k = 0 if axis == AXIS_X else 1
+        moving = ~static & (vel[:, k] != 0.0)
+        if not moving.any():
+            continue
+        low = np.where(moving & (pos[:, k] <= 0.0), WALL, _NONE)
+        high = np.where(moving & (pos[:, k] + size[:, k] >= side), WALL, _NONE)
+        holders = static & boxy
+        if holders.any() and (moving & boxy & ((low == _NONE) | (high == _NONE))).any():
+            _static_holders(pos, size, moving & boxy, holders, k, world, low, high)
+        for i in np.flatnonzero((low != _NONE) & (high != _NONE)):
+            found.append(Wedge(int(i), axis, int(low[i]), int(high[i])))
+    return sorted(found)
+
+
+def _static_holders(pos, size, movers, holders, k, world, low, high):
+    """Fill low/high (where _NONE) with the lowest id of a static box that holds each mover from
+    below / above along axis k: it overlaps the mover's box on the other axis, and on axis k it
+    reaches to the mover's low edge (touching or overlapping) without reaching past its high edge
+    (from below), or the other way round (from above). A static box holding it from both sides
+    (the mover inside it on that axis) is neither: once they collide they separate."""
+    sel = np.flatnonzero(movers | holders)
+    lo = pos[sel].copy()
+    hi = lo + size[sel]
+    lo[:, k] -= WEDGE_REACH_PX
+    hi[:, k] += WEDGE_REACH_PX
+    method, cell = choose(world.width, world.height, hi - lo)
+    pairs = sel[find_pairs(method, lo, hi, movers[sel], cell)]
+    a, b = pairs[:, 0], pairs[:, 1]
+    mixed = movers[a] != movers[b]
+    a, b = a[mixed], b[mixed]
+    m = np.where(movers[a], a, b)
+    s = np.where(movers[a], b, a)
+    m_lo, s_lo = pos[m, k], pos[s, k]
+    m_hi, s_hi = m_lo + size[m, k], s_lo + size[s, k]
+    none = np.iinfo(np.int64).max
+    for side, held in (
+        (low, (s_lo < m_lo) & (m_lo <= s_hi) & (s_hi < m_hi)),
+        (high, (m_lo < s_lo) & (s_lo <= m_hi) & (m_hi < s_hi)),
+    ):
+        first = np.full(len(side), none, np.int64)
+        np.minimum.at(first, m[held], s[held])
+        take = (side == _NONE) & (first != none)
+        side[take] = first[take]
+
+
+def no_room_message(found: list[Wedge], bodies: Bodies, names=None) -> str:
+    """What `no_room` found, in words: the first object (`names[i]` when given, shown beside its
+    id) and what holds it, then how many more."""
+    w = found[0]
+    k = 0 if w.axis == AXIS_X else 1
+    axis = AXIS_NAMES[w.axis]
+    name = names[w.obj] if names is not None and names[w.obj] else None
+    who = f"object {w.obj}" + (f" ({name})" if name else "")
+    sides = ("left", "right") if w.axis == AXIS_X else ("top", "bottom")
+    wide = "wide" if w.axis == AXIS_X else "tall"
+
+    def holder(j, side):
+        return f"the {side} wall" if j == WALL else f"static object {j}"
+
+    if w.low == WALL and w.high == WALL:
+        span = f"it is as {wide} as the world"
+    else:
+        span = (
+            f"it is as {wide} as the space between {holder(w.low, sides[0])} and "
+            f"{holder(w.high, sides[1])} (or wider)"
+        )
+    v = float(np.asarray(bodies.vel, np.float64).reshape(-1, 2)[w.obj, k])
+    also = [f for f in found[1:] if f.obj == w.obj]
+    both = f" (and on {AXIS_NAMES[also[0].axis]})" if also else ""
+    more = len({f.obj for f in found}) - 1
+    rest = f"; {more} more such object{'s' if more > 1 else ''}" if more else ""
+    return (
+        f"{who} has no room to move on {axis}{both}: {span}, and it moves on {axis} "
+        f"(v{axis} = {v:g} px/s), so under the exact model it would collide again and again "
+        f"with no time passing; give it room or no velocity on {axis}{rest}"
+    )
+
+
+def _listing(word: str, ids: list[int], most: int = 8) -> str:
+    """ "object 3", "objects 1 and 2", "objects 1, 2, 3, ... (12 in all)"."""
+    if len(ids) == 1:
+        return f"{word} {ids[0]}"
+    shown = [str(i) for i in ids[:most]]
+    if len(ids) > most:
+        return f"{word}s {', '.join(shown)}, ... ({len(ids)} in all)"
+    return f"{word}s {', '.join(shown[:-1])} and {shown[-1]}"
+
+
 class Model:
     """Event-driven elastic model; see the module docstring. Surface as in engine.models."""
 
@@ -741,6 +891,13 @@ class Model:
             raise ValueError(f"cell_size must be > 0 px, got {cell_size!r}")
         if repredict not in REPREDICT:
             raise ValueError(f"repredict must be one of {REPREDICT}, got {repredict!r}")
+        stuck = no_room(world, bodies, geometry)
+        if stuck:
+            raise NoRoom(
+                no_room_message(stuck, bodies),
+                tuple(w.obj for w in stuck),
+                AXIS_NAMES[stuck[0].axis],
+            )
         self.repredict = repredict
         self.world = world
         self.geometry = geometry
@@ -775,7 +932,7 @@ class Model:
         self._G = _build_grid(self._F, self._N, self.cell_size, gnx, gny)
         cap = max(64, HEAP_PER_OBJECT * n)
         self._heap = [np.empty(cap), np.empty((cap, 3), np.int64), np.empty((cap, 2))]
-        self._st = np.zeros(6, np.int64)
+        self._st = np.zeros(8, np.int64)
         self._stf = np.zeros(1)
         self._jobs = np.zeros((JOB_ROWS, 3), np.int64)  # scratch: the prediction jobs of one event
         self._stack = np.zeros(INSTANT_STACK, np.int64)  # scratch: walking one instant's entries
@@ -787,49 +944,125 @@ class Model:
     def advance(self, ticks: int, log: bool = True) -> np.ndarray:
         """Run `ticks` ticks; the events in the order they happened (empty when log is False)."""
         if self._broken:
-            raise EventCapExceeded(self._broken)
+            raise self._broken
         rows, times = new_log(log)
         self._st[_LOGGED] = 0
         target = self.tick + int(ticks)
         while True:
-            F, N, C, cells, s_start, s_items, HT, HI, HN, st, world = self._state()
-            status = _run(
-                self._jobs,
-                self._stack,
-                target,
-                bool(log),
-                self.max_events_per_tick,
-                self.repredict == "all",
-                F,
-                N,
-                C,
-                cells,
-                s_start,
-                s_items,
-                HT,
-                HI,
-                HN,
-                st,
-                self._stf,
-                world,
-                rows,
-                times,
-            )
+            status = self._call(target, bool(log), self.max_events_per_tick, rows, times)
             if status == STATUS_HEAP_FULL:
                 self._heap = [_grown(a) for a in self._heap]
             elif status == STATUS_LOG_FULL:
                 rows, times = _grown(rows), _grown(times)
             elif status == STATUS_CAP:
-                self._broken = (
-                    f"tick {int(st[_TICK]) + 1} needed more than {self.max_events_per_tick} "
-                    f"events (max_events_per_tick); stopped as a runaway at t = "
-                    f"{float(self._stf[_T_NOW])!r} s"
-                )
-                raise EventCapExceeded(self._broken)
+                self._broken = self._runaway()
+                raise self._broken
             else:
                 break
         self.tick = int(self._st[_TICK])
         return event_records(rows, times, int(self._st[_LOGGED]))
+
+    def _call(self, target, log, cap, rows, times) -> int:
+        """One call of the kernel `_run` on the model's state; its status."""
+        F, N, C, cells, s_start, s_items, HT, HI, HN, st, world = self._state()
+        return _run(
+            self._jobs,
+            self._stack,
+            target,
+            log,
+            cap,
+            self.repredict == "all",
+            F,
+            N,
+            C,
+            cells,
+            s_start,
+            s_items,
+            HT,
+            HI,
+            HN,
+            st,
+            self._stf,
+            world,
+            rows,
+            times,
+        )
+
+    def event_counts(self) -> tuple[int, int]:
+        """(wall events, pair events) so far, logged or not."""
+        return int(self._st[_WALLS]), int(self._st[_PAIRS])
+
+    def _runaway(self) -> EventCapExceeded | NoRoom:
+        """The error of a tick stopped at the cap: NoRoom when the objects of the events that
+        would come next, at the instant it stopped, are jammed on an axis (`_jammed`: they collide
+        again and again with no time passing, having no room to move), naming them; else
+        EventCapExceeded. The model is stopped for good, so it runs up to RECENT more events of
+        that tick, logged, to see them."""
+        st, t = self._st, float(self._stf[_T_NOW])
+        said = (
+            f"tick {int(st[_TICK]) + 1} needed more than {self.max_events_per_tick} events "
+            f"(max_events_per_tick); stopped as a runaway at t = {t!r} s"
+        )
+        counts = st[_WALLS : _PAIRS + 1].copy()
+        st[_LOGGED] = 0
+        rows, times = np.empty((RECENT, 5), np.int64), np.empty(RECENT)
+        cap = int(st[_TICK_EVENTS]) + RECENT
+        while self._call(int(st[_TICK]) + 1, True, cap, rows, times) == STATUS_HEAP_FULL:
+            self._heap = [_grown(a) for a in self._heap]
+        st[_WALLS : _PAIRS + 1] = counts  # the counts stay those of the events before the stop
+        t = float(self._stf[_T_NOW])
+        n = int(st[_LOGGED])
+        same = np.abs(times[:n] - t) <= max(INSTANT_S, abs(t) * INSTANT_REL)
+        last = rows[:n][same][:, 2:5]  # a, b, code
+        involved = sorted({int(i) for i in last[:, :2].ravel() if i >= 0})
+        walls = last[:, 1] < 0
+        x_side = (last[:, 2] == SIDE_LEFT) | (last[:, 2] == SIDE_RIGHT)
+        on = {
+            AXIS_X: (walls & x_side) | (~walls & (last[:, 2] != AXIS_Y)),
+            AXIS_Y: (walls & ~x_side) | (~walls & (last[:, 2] != AXIS_X)),
+        }
+        for axis in (AXIS_X, AXIS_Y):
+            objects = self._jammed(involved, axis, t) if on[axis].any() else []
+            if objects:
+                one = len(objects) == 1
+                against = " and the walls" if walls.any() else ""
+                return NoRoom(
+                    f"{_listing('object', objects)} {'has' if one else 'have'} no room to move on "
+                    f"{AXIS_NAMES[axis]}: {'it collides' if one else 'they collide'} with "
+                    f"{'its neighbours' if one else 'each other'}{against} again and again at "
+                    f"t = {t!r} s with no time passing ({said})",
+                    tuple(objects),
+                    AXIS_NAMES[axis],
+                )
+        return EventCapExceeded(said)
+
+    def _jammed(self, ids: list[int], axis: int, t: float) -> list[int]:
+        """The moving objects of `ids` held on `axis` at time t from both sides by a chain of
+        boxes of `ids` that touch (or overlap) along the axis and overlap on the other, from a
+        wall or a static object to a wall or a static object: they cannot move on that axis."""
+        F, k = self._F, 0 if axis == AXIS_X else 1
+        ids = np.array(ids, np.int64)
+        lo = F[ids, X : Y + 1] + F[ids, VX : VY + 1] * (t - F[ids, TLOC : TLOC + 1])
+        hi = lo + F[ids, SW : SH + 1]
+        side = self._world[k]
+        tol = 1e-9 * max(self._world[0], self._world[1])
+        fixed = self._N[ids, STATIC] != 0
+        o = 1 - k
+        beside = (lo[:, None, o] < hi[None, :, o]) & (lo[None, :, o] < hi[:, None, o])
+        # below[j, i]: j touches i from below along the axis
+        below = (
+            beside & (lo[:, None, k] < lo[None, :, k]) & (hi[:, None, k] >= lo[None, :, k] - tol)
+        )
+        held = []
+        for start, links in ((lo[:, k] <= tol, below), (hi[:, k] >= side - tol, below.T)):
+            reached = fixed | start
+            while True:
+                more = reached | (links & reached[:, None]).any(axis=0)
+                if (more == reached).all():
+                    break
+                reached = more
+            held.append(reached)
+        return [int(i) for i in ids[held[0] & held[1] & ~fixed]]
 
     def positions(self) -> np.ndarray:
         """(n, 2) float64 top-left corners at the last tick's end, px (each object carried from

@@ -69,8 +69,11 @@ _MARGIN_MAX_PX = 32
 # The kernel's scalar state (int64): ticks done, the stage of the next tick to run, candidates
 # listed (-1: none yet), this tick's drift (px) and whether a box left the world, whether the list
 # is to be made anew this tick, event rows written in this `advance`, the candidates a too small
-# buffer needed, whether pairs can happen at all.
+# buffer needed, whether pairs can happen at all, wall events and pair events so far (logged or
+# not).
 _S_TICK, _S_STAGE, _S_KEYS, _S_DRIFT, _S_LEFT, _S_RELIST, _S_EVENTS, _S_NEEDED, _S_PAIRS = range(9)
+_S_WALLS, _S_PAIR_EVENTS = 9, 10
+_S_SIZE = 11
 _STAGE_MOVE, _STAGE_WALLS, _STAGE_PAIRS = range(3)
 # What a call of the kernel ends with: done, or stopped for more room (grow, call again).
 _DONE, _LOG_FULL, _KEYS_FULL = range(3)
@@ -115,7 +118,7 @@ def _move(pos, step, period, count, disp, anchor, room):
 
 
 @njit(cache=True, inline="always")
-def _walls(pos, room, step, disp, tick, log, ev, n_ev):
+def _walls(pos, room, step, disp, tick, log, ev, n_ev, st):
     """Reverse and take back each component that left the world moving outward (SPEC 3.1)."""
     for i in range(pos.shape[0]):
         for ax in range(2):
@@ -129,6 +132,7 @@ def _walls(pos, room, step, disp, tick, log, ev, n_ev):
             step[i, ax] = -step[i, ax]
             pos[i, ax] -= d
             disp[i, ax] = 0
+            st[_S_WALLS] += 1
             if log:
                 n_ev = _record(ev, n_ev, tick, EV_WALL, i, -1, side, -1, -1)
     return n_ev
@@ -169,7 +173,7 @@ def _near(pos, size, disp, keys, n_keys, near):
 
 
 @njit(cache=True, inline="always")
-def _pairs(pos, size, step, disp, near, n_near, tick, log, ev, n_ev):
+def _pairs(pos, size, step, disp, near, n_near, tick, log, ev, n_ev, st):
     """The flip rule on every overlapping pair of `near`, in (a, b) order (SPEC 3.1)."""
     for c in range(n_near):
         a = near[c] >> KEY_SHIFT
@@ -192,6 +196,7 @@ def _pairs(pos, size, step, disp, near, n_near, tick, log, ev, n_ev):
             for ax in range(2):
                 pos[i, ax] -= disp[i, ax]
                 disp[i, ax] = 0
+        st[_S_PAIR_EVENTS] += 1
         if log:
             n_ev = _record(ev, n_ev, tick, EV_PAIR, a, b, axis, xdiff, ydiff)
     return n_ev
@@ -223,7 +228,7 @@ def _run(pos, size, room, step, period, count, movable, tick_to, log, st, bp, ev
                 if log and n_ev + 2 * n > ev.shape[0]:
                     st[_S_EVENTS] = n_ev
                     return _LOG_FULL
-                n_ev = _walls(pos, room, step, disp, tick, log, ev, n_ev)
+                n_ev = _walls(pos, room, step, disp, tick, log, ev, n_ev, st)
             # the list is made anew once anything drifted a margin from where it was made
             # (drift is measured before the walls take steps back, which only errs early)
             st[_S_RELIST] = st[_S_KEYS] < 0 or st[_S_DRIFT] >= margin
@@ -245,7 +250,7 @@ def _run(pos, size, room, step, period, count, movable, tick_to, log, st, bp, ev
                 st[_S_EVENTS] = n_ev
                 return _LOG_FULL
             n_near = _near(pos, size, disp, keys, st[_S_KEYS], near)
-            n_ev = _pairs(pos, size, step, disp, near, n_near, tick, log, ev, n_ev)
+            n_ev = _pairs(pos, size, step, disp, near, n_near, tick, log, ev, n_ev, st)
         st[_S_STAGE] = _STAGE_MOVE
         st[_S_TICK] = tick
     st[_S_EVENTS] = n_ev
@@ -280,7 +285,7 @@ class Model:
         limit = np.array([world.width, world.height], np.int64)
         self._room = np.ascontiguousarray(limit - self.size)
         self._ev = np.empty((_INITIAL_ROWS, _EVENT_COLS), np.int64)
-        self._st = np.zeros(9, np.int64)
+        self._st = np.zeros(_S_SIZE, np.int64)
         self._st[_S_KEYS] = -1
         self._st[_S_PAIRS] = n >= 2 and (bool(self.movable.any()) or not skip)
         margin = _margin(self.step)
@@ -337,6 +342,10 @@ class Model:
         self.tick = int(self._st[_S_TICK])
         return _event_records(self._ev[: self._st[_S_EVENTS]], self.fps)
 
+    def event_counts(self) -> tuple[int, int]:
+        """(wall events, pair events) so far, logged or not."""
+        return int(self._st[_S_WALLS]), int(self._st[_S_PAIR_EVENTS])
+
     def profile(self, ticks: int) -> dict[str, float]:
         """Run `ticks` ticks with the event log off, one stage at a time, and return the seconds
         spent in each: "move" (counters and walls), "broad" (making the candidate list),
@@ -356,7 +365,7 @@ class Model:
                 self.pos, self.step, self.period, self.count, disp, anchor, self._room
             )
             if left:
-                _walls(self.pos, self._room, self.step, disp, tick, False, self._ev, 0)
+                _walls(self.pos, self._room, self.step, disp, tick, False, self._ev, 0, self._st)
             t1 = clock()
             spent["move"] += t1 - t0
             if st[_S_PAIRS]:
@@ -371,7 +380,19 @@ class Model:
                 t2 = clock()
                 n_near = _near(self.pos, self.size, disp, keys, st[_S_KEYS], near)
                 t3 = clock()
-                _pairs(self.pos, self.size, self.step, disp, near, n_near, tick, False, self._ev, 0)
+                _pairs(
+                    self.pos,
+                    self.size,
+                    self.step,
+                    disp,
+                    near,
+                    n_near,
+                    tick,
+                    False,
+                    self._ev,
+                    0,
+                    self._st,
+                )
                 t4 = clock()
                 spent["broad"] += t2 - t1
                 spent["narrow"] += t3 - t2

@@ -72,6 +72,8 @@ MARGIN_MAX_SIDES = 1.5
 # world's side) of the margin: room for the rounding of the drift and of the grown boxes.
 DRIFT_SLACK_PX = 1e-6
 DRIFT_SLACK_REL = 1e-12
+# The wall and pair event counters in the broad phase's `state` array (see `_run`).
+ST_WALLS, ST_PAIRS = 3, 4
 # Candidate slots to start with per object (the buffers double when full).
 CANDIDATES_PER_OBJECT = 4
 # The objects inside are put back in the broad phase's order once they have strayed from it by
@@ -325,9 +327,9 @@ def _contact(a, b, ea, eb, pos, size, exact, shape, radius, start, verts, normal
 
 
 @njit(cache=True)
-def _pairs(S, width, height, exact, cores, near, n_near, tick, t, log, rows, times, n_ev):
+def _pairs(S, width, height, exact, cores, near, n_near, tick, t, log, rows, times, n_ev, state):
     """Respond to every overlapping, approaching pair of `near` (ascending keys of ids) in order;
-    log each."""
+    count each in state[ST_PAIRS], log it when `log`."""
     pos, vel, size, inv_mass, static, movable, span, ext, rank, anchor = S
     shape, radius, start, verts, normals = cores
     for m in range(n_near):
@@ -349,6 +351,7 @@ def _pairs(S, width, height, exact, cores, near, n_near, tick, t, log, rows, tim
         separate(
             pos, size, a, b, inv_mass[a], inv_mass[b], code, nx, ny, depth, depth_y, width, height
         )
+        state[ST_PAIRS] += 1
         if log:
             rows, times = log_event(rows, times, n_ev, tick, t, EV_PAIR, ea, eb, code)
             n_ev += 1
@@ -362,8 +365,9 @@ def _run(world, substeps, tick0, ticks, log, S, exact, cores, rows, times, bp):
 
     S: the state arrays (see `Model`). bp = (keys, near, order, lo, hi, folds, state, params, ws):
     the candidate list kept between calls (see the module docstring) and scratch; state = [keys
-    listed (-1: no list yet), method, whether pairs can happen at all]; params = [margin px,
-    grid cell px, drift slack px].
+    listed (-1: no list yet), method, whether pairs can happen at all, wall events and pair events
+    so far, logged or not (ST_WALLS, ST_PAIRS)]; params = [margin px, grid cell px, drift slack
+    px].
     """
     keys, near, order, lo, hi, folds, state, params, ws = bp
     pos, size, ext = S[0], S[2], S[7]
@@ -379,8 +383,11 @@ def _run(world, substeps, tick0, ticks, log, S, exact, cores, rows, times, bp):
             # move, walls: every object; the walls' events in id order; how far anything
             # drifted from where the candidate list was made
             n_folds, drift = _move_walls(S, dt, folds)
-            if log and n_folds:
-                rows, times, n_ev = _log_walls(folds, n_folds, tick, t, rows, times, n_ev)
+            if n_folds:
+                for r in range(n_folds):  # one wall event per fold
+                    state[ST_WALLS] += folds[r, 1] + folds[r, 2]
+                if log:
+                    rows, times, n_ev = _log_walls(folds, n_folds, tick, t, rows, times, n_ev)
             if not pairs_possible:
                 continue
             # pairs: the list made anew once an object drifted its margin, then the listed
@@ -394,7 +401,7 @@ def _run(world, substeps, tick0, ticks, log, S, exact, cores, rows, times, bp):
                 bp = (keys, near, order, lo, hi, folds, state, params, ws)
                 n_near = _overlapping(pos, size, ext, keys, state[0], near)
             rows, times, n_ev = _pairs(
-                S, width, height, exact, cores, near, n_near, tick, t, log, rows, times, n_ev
+                S, width, height, exact, cores, near, n_near, tick, t, log, rows, times, n_ev, state
             )
     return rows, times, n_ev, keys, near
 
@@ -471,6 +478,11 @@ class Model:
         self.tick += int(ticks)
         return event_records(rows, times, n)
 
+    def event_counts(self) -> tuple[int, int]:
+        """(wall events, pair events) so far, logged or not."""
+        state = self._bp[6]
+        return int(state[ST_WALLS]), int(state[ST_PAIRS])
+
     def profile(self, ticks: int) -> dict[str, float]:
         """Run `ticks` ticks with the event log off, one stage at a time, and return the seconds
         spent in each: "move" (motion and walls), "broad" (making the candidate list), "narrow"
@@ -490,6 +502,7 @@ class Model:
             for _ in range(self.substeps):
                 t0 = clock()
                 n_folds, drift = _move_walls(self._S, dt, folds)
+                state[ST_WALLS] += folds[:n_folds, 1:3].sum()
                 t1 = clock()
                 spent["move"] += t1 - t0
                 if not state[2]:
@@ -517,6 +530,7 @@ class Model:
                     rows,
                     times,
                     0,
+                    state,
                 )
                 t4 = clock()
                 spent["broad"] += t2 - t1
@@ -561,7 +575,7 @@ def _broad_phase(world, pos, vel, size, movable, substeps, skip, broadphase):
         np.empty_like(pos),  # lo
         np.empty_like(pos),  # hi
         np.empty((2 * n, 4), np.int64),  # folds
-        np.array([-1, method, int(possible)], np.int64),
+        np.array([-1, method, int(possible), 0, 0], np.int64),  # state (see _run)
         np.array([margin, cell, slack]),
         workspace(n),
     )

@@ -2,7 +2,8 @@
 
 Inputs: command-line arguments — scenario files or names (none: every file in `scenarios/`), the
 project root (`--root`, default the nearest folder upward with `scenarios/`), `--report DIR`,
-`--prune`, `--quiet`. Outputs: console text (stdout: one block per scenario and a closing count;
+`--prune`, `--quiet`, `--max-events-per-tick N` (the exact model's cap, over each scenario's).
+Outputs: console text (stdout: one block per scenario and a closing count;
 stderr: errors and, on a terminal, progress), report folders, golden folders, and the exit status:
 0 fine, 1 a check found a difference (or a golden is missing, damaged or hostile), 2 bad input or
 usage (a scenario refused, a symbolic link in the way), 3 an unexpected error. Each scenario is
@@ -54,11 +55,11 @@ class _Usage(Exception):
         return EXIT_USAGE
 
 
-def default_load(path):
+def default_load(path, **kwargs):
     """runner.scenario.load (imported when first needed)."""
     from runner.scenario import load
 
-    return load(path)
+    return load(path, **kwargs)
 
 
 def default_simulate(scenario, **kwargs):
@@ -100,8 +101,11 @@ def register(subparsers, *, load=None, simulate=None) -> None:
 
 
 def _common(p) -> None:
+    from runner.options import add_cap_argument
+
     p.add_argument("--root", metavar="DIR", help="project folder holding scenarios/ and goldens/")
     p.add_argument("--quiet", action="store_true", help="no progress output")
+    add_cap_argument(p)
 
 
 def _debug_option(parser) -> None:
@@ -251,6 +255,9 @@ def _prepare(args, load):
     paths = [_resolve(a, root) for a in args.scenarios] or scenario_files(root)
     if not paths:
         raise _Usage(f"no scenario files in {shown_path(root / SCENARIOS_DIR)}")
+    cap = getattr(args, "max_events_per_tick", None)
+    if cap is not None:
+        load = partial(load, overrides={"max_events_per_tick": cap})
     scenarios = _load_all(paths, load)
     seen = {}
     for path, scn in scenarios:

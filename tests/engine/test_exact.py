@@ -5,6 +5,7 @@ import hashlib
 import math
 import subprocess
 import sys
+import time
 from fractions import Fraction
 
 import numpy as np
@@ -13,6 +14,7 @@ from engine_refs import pixel_corners, random_boxes, ref_hull
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
+from engine.errors import NoRoom, Runaway
 from engine.events import (
     AXIS_NAMES,
     AXIS_X,
@@ -627,16 +629,108 @@ def test_log_off_gives_no_events_and_the_same_state():
     assert a.positions().tobytes() == b.positions().tobytes()
 
 
+def galperin(ratio):
+    """Galperin's billiard: a light block between the left wall and a block `ratio` heavier."""
+    world = WorldSpec(4000, 100, 1)
+    return world, Bodies.boxes([[50, 45], [100, 45]], 10, [[0, 0], [-10, 0]], mass=[1.0, ratio])
+
+
 def test_the_event_cap_turns_a_runaway_into_an_error():
-    # A box as wide as the world bounces between both walls in no time at all.
-    world = WorldSpec(20, 20, 10)
-    bodies = Bodies.boxes([[0, 0]], [[20, 5]], [[3, 1]])
-    model = make("exact", world, bodies, max_events_per_tick=1000)
-    with pytest.raises(EventCapExceeded, match=r"tick 1 needed more than 1000 events"):
-        model.advance(5)
+    # 3141 collisions, over a thousand of them in tick 9
+    model = make("exact", *galperin(1e6), max_events_per_tick=1000)
+    with pytest.raises(EventCapExceeded, match=r"tick 9 needed more than 1000 events") as err:
+        model.advance(20)
+    assert isinstance(err.value, Runaway)
     with pytest.raises(EventCapExceeded):  # and it stays stopped
         model.advance(1)
     assert MAX_EVENTS_PER_TICK == 1_000_000
+
+
+def test_the_digits_of_pi_to_seven_places_with_the_cap_raised():
+    """Mass ratio 10^12: 3,141,592 collisions, about 1.57 million in each of two ticks; counted
+    without an event log."""
+    with pytest.raises(EventCapExceeded):
+        make("exact", *galperin(1e12)).advance(30, log=False)
+    model = make("exact", *galperin(1e12), max_events_per_tick=2_000_000)
+    assert len(model.advance(30, log=False)) == 0
+    walls, pairs = model.event_counts()
+    assert walls + pairs == 3_141_592
+    v = model.velocities()
+    assert 0 <= v[0, 0] <= v[1, 0]  # no more contact
+
+
+def test_event_counts_match_the_log_with_or_without_it():
+    world = WorldSpec(160, 120, 10)
+    bodies = random_boxes(20, seed=4, world=world)
+    a, b = make("exact", world, bodies), make("exact", world, bodies)
+    quiet, logged = [], a.advance(50)
+    for _ in range(5):
+        quiet.append(b.advance(10, log=False))
+    kinds = np.bincount(logged["type"], minlength=2)
+    assert a.event_counts() == b.event_counts() == (kinds[EV_WALL], kinds[EV_PAIR])
+    assert kinds.min() > 0 and sum(map(len, quiet)) == 0
+
+
+def wedge_scene(static_ids, pos, size, vel, world=(100, 100)):
+    static = [i in static_ids for i in range(len(pos))]
+    kind = [KIND_BOX] * len(pos)
+    return WorldSpec(*world, 10), shapes(kind, pos, size, vel, static=static)
+
+
+@pytest.mark.parametrize(
+    "scene, obj, axis, words",
+    [
+        # a box as wide as the world, moving on x
+        (wedge_scene([], [[0, 0]], [[20, 5]], [[3, 1]], world=(20, 20)), 0, "x", "as the world"),
+        # a 1x1 box in a 1x1 world
+        (wedge_scene([], [[0, 0]], [[1, 1]], [[0, 2]], world=(1, 1)), 0, "y", "as the world"),
+        # between two static boxes with no gap
+        (
+            wedge_scene(
+                [0, 2], [[0, 0], [10, 0], [20, 0]], [[10, 10]] * 3, [[0, 0], [5, 1], [0, 0]]
+            ),
+            1,
+            "x",
+            "between static object 0 and static object 2",
+        ),
+        # between a static box and the bottom wall, moving on y
+        (
+            wedge_scene([1], [[40, 90], [35, 70]], [[10, 10], [30, 20]], [[2, -4], [0, 0]]),
+            0,
+            "y",
+            "between static object 1 and the bottom wall",
+        ),
+    ],
+)
+def test_an_object_with_no_room_is_refused_when_the_model_is_built(scene, obj, axis, words):
+    started = time.perf_counter()
+    with pytest.raises(NoRoom, match=f"object {obj} has no room to move on {axis}") as err:
+        make("exact", *scene)
+    assert time.perf_counter() - started < 1.0
+    assert words in str(err.value) and isinstance(err.value, Runaway)
+    assert err.value.objects == (obj,) and err.value.axis == axis
+
+
+def test_room_enough_is_not_refused():
+    # touching on one side only, or wedged on an axis it does not move on, or a corner touch
+    world, bodies = wedge_scene(
+        [0, 3],
+        [[0, 0], [10, 0], [50, 0], [60, 10]],
+        [[10, 10], [10, 10], [10, 10], [10, 10]],
+        [[0, 0], [0, 50], [-5, 0], [0, 0]],
+    )
+    assert exact_model.no_room(world, bodies) == []
+    assert len(make("exact", world, bodies).advance(20)) > 0
+
+
+def test_a_jam_of_moving_objects_ends_at_the_cap_naming_them():
+    # two boxes side by side fill the world's width: no room for either, found by the kernel
+    world = WorldSpec(20, 20, 10)
+    bodies = Bodies.boxes([[0, 0], [10, 0]], 10, [[3, 0], [0, 1]])
+    model = make("exact", world, bodies, max_events_per_tick=500)
+    with pytest.raises(NoRoom, match=r"objects 0 and 1 have no room to move on x") as err:
+        model.advance(3)
+    assert "t = 0.0 s" in str(err.value) and "tick 1 needed more than 500" in str(err.value)
 
 
 def test_a_busy_tick_under_the_cap_is_fine():

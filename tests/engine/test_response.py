@@ -7,6 +7,7 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
+from engine.errors import Runaway
 from engine.events import AXIS_NORMAL, AXIS_X, AXIS_XY
 from engine.response import MAX_FOLDS_PER_STEP, exchange, exchange_along, fold, separate
 
@@ -133,7 +134,7 @@ def test_fold_is_the_reflecting_walls_triangle_wave(x, span):
 
 
 def test_fold_refuses_a_runaway():
-    with pytest.raises(ValueError, match="substeps"):
+    with pytest.raises(Runaway, match="substeps"):
         fold(10.0 * (MAX_FOLDS_PER_STEP + 2), 1.0, 10.0)
 
 

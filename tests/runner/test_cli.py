@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import imageio.v3 as iio
@@ -225,3 +226,114 @@ def test_every_scenario_runs_end_to_end(tmp_path, path):
     assert final.shape[0] == summary["objects"]
     assert np.isfinite(final).all()
     assert (folder / "animation.gif").is_file() and list((folder / "frames").glob("*.png"))
+
+
+# ----------------------------------------------------------------------------- runaways
+
+GALPERIN = ROOT / "tests" / "runner" / "data" / "galperin_pi.yaml"
+
+
+def test_galperin_billiard_counts_pi_to_seven_digits_from_the_command_line(tmp_path):
+    """Mass ratio 10^12: 3,141,592 collisions, about 1.57 million in each of two ticks, past the
+    default cap: the scenario raises it in its model options; counted with no event log."""
+    out = subprocess.run(
+        [sys.executable, "-m", "runner", "run", str(GALPERIN), "--out", str(tmp_path)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert out.returncode == 0, out.stderr
+    folder = tmp_path / "galperin-pi"
+    summary = json.loads((folder / "summary.json").read_text())
+    assert summary["events"]["wall"] + summary["events"]["pair"] == 3_141_592
+    assert "1,570,796 wall and 1,570,796 pair events" in out.stdout
+    assert not (folder / "events.jsonl").exists()
+
+
+def galperin_small(tmp_path, model_line):
+    text = GALPERIN.read_text().replace("mass: 1e12", "mass: 1e6")
+    text = text.replace("model: {kind: exact, max_events_per_tick: 4000000}", model_line)
+    path = tmp_path / "g.yaml"
+    path.write_text(text)
+    return path
+
+
+def test_the_cap_comes_from_the_command_line_over_the_scenario(tmp_path, capsys):
+    """3141 collisions, 1,571 of them in tick 9: a cap of 1,000 stops the run, from the
+    scenario's model options or from --max-events-per-tick, which wins."""
+    capped = galperin_small(tmp_path, "model: {kind: exact, max_events_per_tick: 1000}")
+    assert run([capped, "--out", tmp_path / "a", "--quiet"]) == 2
+    assert "tick 9 needed more than 1000 events" in capsys.readouterr().err
+    assert run([capped, "--out", tmp_path / "b", "--quiet", "--max-events-per-tick", "2000"]) == 0
+    summary = json.loads((tmp_path / "b" / "galperin-pi" / "summary.json").read_text())
+    assert summary["events"]["wall"] + summary["events"]["pair"] == 3141
+    free = galperin_small(tmp_path, "model: exact")
+    assert run([free, "--out", tmp_path / "c", "--quiet", "--max-events-per-tick", "1500"]) == 2
+    assert "tick 9 needed more than 1500 events" in capsys.readouterr().err
+
+
+def test_the_cap_is_refused_under_another_model_at_its_place(tmp_path, capsys):
+    path = galperin_small(tmp_path, "model: {kind: stepped, max_events_per_tick: 1000}")
+    assert run([path, "--out", tmp_path, "--quiet"]) == 2
+    err = capsys.readouterr().err
+    line = path.read_text().splitlines().index("model: {kind: stepped, max_events_per_tick: 1000}")
+    assert err.startswith(f"{path}:{line + 1}:")
+    assert "max_events_per_tick applies to the exact model only, not to stepped" in err
+    assert not (tmp_path / "galperin-pi").exists()
+
+
+def test_check_and_bless_take_the_cap(tmp_path, capsys):
+    (tmp_path / "scenarios").mkdir()
+    galperin_small(tmp_path / "scenarios", "model: exact")
+    args = ["--root", str(tmp_path), "--quiet", "--max-events-per-tick", "1000"]
+    assert main(["bless", *args]) == 2
+    assert "tick 9 needed more than 1000 events" in capsys.readouterr().err
+    assert not (tmp_path / "goldens" / "galperin-pi").exists()
+    assert main(["bless", *args[:-1], "2000"]) == 0
+    assert main(["check", *args[:-1], "2000"]) == 0
+    assert main(["check", *args]) == 2
+
+
+@pytest.mark.parametrize(
+    "world, obj, message",
+    [
+        (
+            "{width: 20, height: 20}",
+            "{shape: box, size: [20, 5], position: [0, 0], velocity: [3, 1]}",
+            "object 0 has no room to move on x: it is as wide as the world",
+        ),
+        (
+            "{width: 1, height: 1}",
+            "{shape: box, size: 1, position: [0, 0], velocity: [1, 1]}",
+            "object 0 has no room to move on x (and on y)",
+        ),
+    ],
+)
+def test_a_wedged_object_is_refused_at_its_place_before_running(
+    tmp_path, capsys, world, obj, message
+):
+    path = tmp_path / "w.yaml"
+    path.write_text(f"version: 1\nworld: {world}\nmodel: exact\nobjects:\n  - {obj}\n")
+    started = time.perf_counter()
+    assert run([path, "--out", tmp_path / "out"]) == 2
+    assert time.perf_counter() - started < 2.0
+    err = capsys.readouterr().err
+    assert err.startswith(f"{path}:5:5: error: ") and message in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_wedged_object_between_statics_is_named(tmp_path, capsys):
+    path = tmp_path / "w.yaml"
+    path.write_text(
+        "version: 1\nmodel: exact\nobjects:\n"
+        "  - {shape: box, size: 10, position: [0, 0], static: true}\n"
+        "  - {name: stuck, shape: box, size: 10, position: [10, 0], velocity: [5, 0]}\n"
+        "  - {shape: box, size: 10, position: [20, 0], static: true}\n"
+    )
+    assert run([path, "--out", tmp_path / "out", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"{path}:5:5: error: object 1 (stuck) has no room to move on x: it is ")
+    assert "between static object 0 and static object 2" in err
+    # the other models run the same scene to its end (no hang, no crash)
+    for model in ("paper", "stepped"):
+        assert run([path, "--out", tmp_path / model, "--quiet", "--model", model]) == 0

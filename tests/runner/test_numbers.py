@@ -316,7 +316,7 @@ def test_a_run_whose_model_breaks_the_bounds_stops_instead_of_writing_inf(monkey
     sc = loads(with_mass("2"))
     real = run_module.models.make
 
-    class Runaway:
+    class Diverging:
         """The real model, whose velocities turn infinite at the end of the run."""
 
         def __init__(self, *args, **kw):
@@ -331,7 +331,7 @@ def test_a_run_whose_model_breaks_the_bounds_stops_instead_of_writing_inf(monkey
                 v[:] = np.inf
             return v
 
-    monkeypatch.setattr(run_module.models, "make", Runaway)
+    monkeypatch.setattr(run_module.models, "make", Diverging)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         with pytest.raises(RunStopped, match="not a finite number"):

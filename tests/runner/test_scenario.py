@@ -512,6 +512,16 @@ def test_keys_must_be_names():
             "substeps applies to the stepped model",
         ),
         (
+            BASE + "model: {kind: stepped, max_events_per_tick: 10}\n",
+            "10}",
+            "max_events_per_tick applies to the exact model only, not to stepped",
+        ),
+        (
+            BASE + "model: {kind: exact, max_events_per_tick: 0}\n",
+            "0}",
+            "model.max_events_per_tick must be at least 1",
+        ),
+        (
             BASE + "model: {kind: paper, geometry: exact}\n",
             "exact}",
             "geometry 'exact' is not available with the paper model",
@@ -1381,6 +1391,7 @@ GOOD_DOCS = [
     "version: 1\n",
     (DATA / "spec_example.yaml").read_text(),
     BASE + "model: {kind: stepped, substeps: 4}\nduration: 2.5\noutput: {frames: {every: 3}}\n",
+    BASE + "model: {kind: exact, max_events_per_tick: 5000000}\n",
     objects(
         "{shape: polygon, points: [[0, 0], [4, 0], [0, 4]], position: [1, 1], color: '#aabbcc',"
         " fill: true, name: tri}"
@@ -1408,6 +1419,8 @@ def test_schema_accepts_good_documents(text):
         objects("{shape: box, size: 0, position: [0, 0]}"),
         objects("{shape: box, size: 3}"),
         BASE + "model: {kind: paper, geometry: exact}\n",
+        BASE + "model: {kind: stepped, max_events_per_tick: 10}\n",
+        BASE + "model: {kind: exact, max_events_per_tick: 0}\n",
         BASE + "golden: {color_threshold: 300}\n",
         BASE + "name: ../x\n",
         BASE + "generate:\n  - {count: 3, shape: box, size: 3, speed: 1, velocity: {min: [0, 0], "
