@@ -373,9 +373,7 @@ world:
     - @world.background.r=0@
     - @world.background.g=0@
     - @world.background.b=0@
-model:
-  kind: stepped
-  substeps: @model.substeps=2@
+@model
 @ticks
 objects:
   - shape: box
@@ -441,14 +439,17 @@ golden:
 """
 TICKS = "ticks: @ticks=4@"
 DURATION = "duration: @duration=0.4@"
+STEPPED = "model:\n  kind: stepped\n  substeps: @model.substeps=2@"
+EXACT = "model:\n  kind: exact\n  max_events_per_tick: @model.max_events_per_tick=10000@"
 FIELD = re.compile(r"@([a-z._]+)=([^@]*)@")
-FIELDS = sorted(set(FIELD.findall(TEMPLATE + TICKS + DURATION)))
+FIELDS = sorted(set(FIELD.findall(TEMPLATE + TICKS + DURATION + STEPPED + EXACT)))
 NAMES = [name for name, _ in FIELDS]
 
 # Errors that a value may cause away from its own line: objects pushed out of the world or into
 # each other, boxes that no longer fit, frames past a shorter run or too many for a longer one,
-# range ends out of order.
+# range ends out of order, a polygon point that leaves the polygon without area (under `exact`).
 ELSEWHERE = (
+    "a polygon must be convex with some area",
     "lies outside the world",
     "overlaps",
     "cannot place",
@@ -458,9 +459,13 @@ ELSEWHERE = (
 )
 
 
-def render(values: dict[str, str], duration: bool) -> tuple[str, dict[str, tuple[int, int]]]:
-    """The document with `values` written in, and the 1-based (line, column) of every field."""
+def render(
+    values: dict[str, str], duration: bool, exact: bool
+) -> tuple[str, dict[str, tuple[int, int]]]:
+    """The document with `values` written in, and the 1-based (line, column) of every field:
+    with `duration` or `ticks`, under the exact model or the stepped one."""
     text = TEMPLATE.replace("@ticks", DURATION if duration else TICKS)
+    text = text.replace("@model", EXACT if exact else STEPPED)
     places = {}
     out = []
     for number, line in enumerate(text.splitlines(), 1):
@@ -557,18 +562,28 @@ def documents(draw):
     names = {draw(st.sampled_from(NAMES)), draw(st.sampled_from(NAMES))}
     duration = draw(st.booleans())
     names.discard("ticks" if duration else "duration")
+    exact = "model.max_events_per_tick" in names or (
+        "model.substeps" not in names and draw(st.booleans())
+    )
+    names.discard("model.substeps" if exact else "model.max_events_per_tick")
     values = {name: draw(values_past_range) for name in sorted(names)}
-    text, places = render(values, duration)
+    text, places = render(values, duration, exact)
     return text, {places[name] for name in values}
 
 
 def test_the_template_is_valid_and_names_every_numeric_field():
     for duration in (False, True):
-        text, places = render({}, duration)
-        assert "@" not in text and len(places) == len(NAMES) - 1
-        sc = loads(text, "n.yaml", limits=LIMITS)
-        assert sc.bodies.n == 10 and sc.ticks == 4
-    assert len(NAMES) == 36 and "model.substeps" in NAMES and "golden.color_threshold" in NAMES
+        for exact in (False, True):
+            text, places = render({}, duration, exact)
+            assert "@" not in text and len(places) == len(NAMES) - 2
+            sc = loads(text, "n.yaml", limits=LIMITS)
+            assert sc.bodies.n == 10 and sc.ticks == 4
+            assert sc.model == ("exact" if exact else "stepped")
+    assert (
+        len(NAMES) == 37
+        and "model.max_events_per_tick" in NAMES
+        and "golden.color_threshold" in NAMES
+    )
 
 
 @settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])

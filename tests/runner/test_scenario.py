@@ -336,9 +336,7 @@ def test_deep_flow_nesting_refused_at_our_bound_with_every_parser(parser, depth)
 
 
 def test_deep_block_nesting_refused_at_our_bound_with_every_parser(parser):
-    text = "version: 1\ndescription:\n" + "".join(
-        " " * (2 * k) + f"k{k}:\n" for k in range(1, 200)
-    )
+    text = "version: 1\ndescription:\n" + "".join(" " * (2 * k) + f"k{k}:\n" for k in range(1, 200))
     err = refused(text)
     assert (err.line, err.col) == at(text, "k64:")
     assert "nested more than 64 levels" in err.message
