@@ -41,6 +41,9 @@ GIF_MAX_DELAY_CS = 65535
 # A GIF colour table has at most this many colours.
 GIF_MAX_COLORS = 256
 
+# Events formatted and written at once by EventsWriter: bounds the text held in memory (~5 MB).
+EVENTS_PER_WRITE = 65_536
+
 TEMP_SUFFIX = ".tmp"
 _TEMP_RE = re.compile(r"^\..+\.\d+\.[0-9a-f]{8}\.tmp$")
 
@@ -454,11 +457,12 @@ class EventsWriter(_StreamWriter):
         self.count = 0
 
     def write(self, events: np.ndarray) -> None:
-        if len(events) == 0:
-            return
-        text = "".join(format_event(rec) + "\n" for rec in events)
-        self._file.write(text.encode("utf-8"))
-        self.count += len(events)
+        # in slices, so that the text of a tick with millions of events is never held whole
+        for start in range(0, len(events), EVENTS_PER_WRITE):
+            part = events[start : start + EVENTS_PER_WRITE]
+            text = "".join(format_event(rec) + "\n" for rec in part)
+            self._file.write(text.encode("utf-8"))
+            self.count += len(part)
 
 
 def final_csv_text(pos: np.ndarray, vel: np.ndarray) -> str:
