@@ -19,8 +19,8 @@ import time
 
 import numpy as np
 
-from engine import models
-from engine.world import Bodies, WorldSpec
+from collide2d.engine import models
+from collide2d.engine.world import Bodies, WorldSpec
 
 REPEATS = 5
 CHAIN_TICKS = 1000  # 100 s at 10 fps: about 160,000 events

@@ -15,9 +15,9 @@ import sys
 import time
 from pathlib import Path
 
-from engine import models
-from runner.run import drive
-from runner.scenario import load
+from collide2d.engine import models
+from collide2d.runner.run import drive
+from collide2d.runner.scenario import load
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENARIO = ROOT / "scenarios" / "paper_fifty_boxes.yaml"

@@ -20,9 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
-from engine.raster import Renderer, to_rgb
-from engine.world import Bodies, WorldSpec
-from runner import outputs
+from collide2d.engine.raster import Renderer, to_rgb
+from collide2d.engine.world import Bodies, WorldSpec
+from collide2d.runner import outputs
 
 WIDTH, HEIGHT = 320, 240  # px, the paper's VGA frame
 N_BOXES = 50

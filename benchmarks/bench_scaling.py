@@ -18,9 +18,9 @@ import argparse
 import statistics
 import time
 
-from engine import models
-from runner.bench import SCALING_N, standard_scene
-from runner.scenario import loads
+from collide2d.engine import models
+from collide2d.runner.bench import SCALING_N, standard_scene
+from collide2d.runner.scenario import loads
 
 REPEATS = 3
 TARGET_S = 1.0

@@ -23,8 +23,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from engine.events import AXIS_NORMAL, AXIS_X, AXIS_XY, AXIS_Y
-from engine.world import KIND_BOX, KIND_CIRCLE
+from collide2d.engine.events import AXIS_NORMAL, AXIS_X, AXIS_XY, AXIS_Y
+from collide2d.engine.world import KIND_BOX, KIND_CIRCLE
 
 INF = np.inf
 # Two unit normals whose dot product is at least this are the same face direction (rad^2 scale).

@@ -27,7 +27,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies, WorldSpec
+from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies, WorldSpec
 
 # Rounded positions are clamped to +-POSITION_LIMIT_PX (px) so that pixel arithmetic on an object
 # far off screen (or at a non-finite position) stays inside int64; such an object draws nothing.

@@ -21,8 +21,8 @@ from __future__ import annotations
 
 from numba import njit
 
-from engine.errors import FoldLimitExceeded
-from engine.events import AXIS_XY
+from collide2d.engine.errors import FoldLimitExceeded
+from collide2d.engine.events import AXIS_XY
 
 # More folds than this at one wall axis in one step is refused (a runaway, not a bounce).
 MAX_FOLDS_PER_STEP = 1000

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies
+from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies
 
 GEOMETRIES = ("box", "exact")
 

@@ -1,7 +1,7 @@
-"""`python -m runner` is the `collide2d` command."""
+"""`python -m collide2d.runner` is the `collide2d` command too."""
 
 import sys
 
-from runner.cli import main
+from collide2d.runner.cli import main
 
 sys.exit(main())

@@ -48,9 +48,9 @@ from pathlib import Path
 
 import numpy as np
 
-from engine import models
-from engine.events import EV_PAIR
-from engine.world import WorldSpec, kinetic_energy
+from collide2d.engine import models
+from collide2d.engine.events import EV_PAIR
+from collide2d.engine.world import WorldSpec, kinetic_energy
 
 # subprocess, tempfile, csv and io are imported where used: `collide2d` loads this module for its
 # parser, and a run should not pay for them.
@@ -209,10 +209,10 @@ def _median(values) -> float:
 
 def _cli_seconds(path: Path, ticks: int, out: Path) -> float:
     """Wall time of `collide2d run PATH --ticks T` with nothing written but final.csv and summary,
-    in a subprocess (`python -m runner`, what the console script runs)."""
+    in a subprocess (`python -m collide2d`, what the console script runs)."""
     import subprocess
 
-    cmd = [sys.executable, "-m", "runner", "run", str(path), "--no-gif", "--no-png"]
+    cmd = [sys.executable, "-m", "collide2d", "run", str(path), "--no-gif", "--no-png"]
     cmd += ["--no-events", "--quiet", "--ticks", str(ticks), "--out", str(out)]
     began = time.perf_counter()
     subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
@@ -222,8 +222,8 @@ def _cli_seconds(path: Path, ticks: int, out: Path) -> float:
 def _drive_seconds(text: str, ticks: int) -> float:
     """Seconds `runner.run.drive` takes over `ticks` ticks of the scenario text (loading not
     counted; model set-up counted, as in a run)."""
-    from runner.run import drive
-    from runner.scenario import loads
+    from collide2d.runner.run import drive
+    from collide2d.runner.scenario import loads
 
     scenario = loads(text, overrides={"ticks": ticks})
     began = time.perf_counter()
@@ -276,8 +276,8 @@ def scaling(models_: list[str], ns: list[int], quick: bool, in_process: bool, ec
 
 
 def _scaling_row(model, n, target, probe_s, repeats, in_process, tmp: Path, echo) -> dict:
-    from engine.raster import Renderer
-    from runner.scenario import loads
+    from collide2d.engine.raster import Renderer
+    from collide2d.runner.scenario import loads
 
     text = standard_scene(n, model)
     scenario = loads(text)
@@ -390,7 +390,7 @@ def _pymunk_space(scenario, hashed: bool):
 def pymunk_steps_per_second(n: int, target: float, repeats: int) -> tuple[float, str]:
     """pymunk's steps/s on the standard scene with n boxes, the median of `repeats` timed runs of
     about `target` s after a warm-up; the better of its default tree and its spatial hash."""
-    from runner.scenario import loads
+    from collide2d.runner.scenario import loads
 
     scenario = loads(standard_scene(n, "stepped"))
     dt = 1.0 / STANDARD_FPS
@@ -459,7 +459,7 @@ def _pair_counts(events) -> Counter:
 def max_penetration(pos: np.ndarray, size: np.ndarray) -> float:
     """The deepest overlap of two boxes, min(overlap width, overlap height), px (0 if none).
     pos, size (n, 2) px."""
-    from engine.broadphase import METHOD_SWEEP, find_pairs
+    from collide2d.engine.broadphase import METHOD_SWEEP, find_pairs
 
     pairs = find_pairs(METHOD_SWEEP, pos, pos + size, np.ones(len(pos), bool))
     if not len(pairs):
@@ -486,7 +486,7 @@ def _reference(scenario, duration: float) -> dict:
 def error_ladder(names, models_, quick: bool, echo) -> list[dict]:
     """Each benchmark scenario under each model and (fps, substeps) of the ladder, against the
     exact model: one row each (see the module docstring)."""
-    from runner.scenario import load
+    from collide2d.runner.scenario import load
 
     ladder = QUICK_LADDER if quick else LADDER
     repeats = 1 if quick else REPEATS
@@ -590,10 +590,10 @@ def _best_of(fn, repeats: int) -> float:
 
 def skips(quick: bool, echo) -> list[dict]:
     """Each skip's work with and without it (see the module docstring)."""
-    from engine.raster import Renderer
-    from engine.world import Bodies
-    from runner.run import drive
-    from runner.scenario import load
+    from collide2d.engine.raster import Renderer
+    from collide2d.engine.world import Bodies
+    from collide2d.runner.run import drive
+    from collide2d.runner.scenario import load
 
     repeats = 1 if quick else REPEATS
     ticks = 60 if quick else SKIP_TICKS
@@ -695,7 +695,7 @@ def _exact_has_full_repredict() -> bool:
     each event: the work its local re-prediction saves)."""
     import inspect
 
-    from engine.models import exact
+    from collide2d.engine.models import exact
 
     return "repredict" in inspect.signature(exact.Model).parameters
 
@@ -708,7 +708,7 @@ def targets(quick: bool, echo) -> list[dict]:
     import subprocess
     import tempfile
 
-    from runner.scenario import load
+    from collide2d.runner.scenario import load
 
     repeats = 1 if quick else 5
     ticks = QUICK_DEMO_TICKS if quick else DEMO_TICKS
@@ -735,7 +735,7 @@ def targets(quick: bool, echo) -> list[dict]:
     if not quick:
         path = scenarios_dir() / f"{SMALL_SCENARIO}.yaml"
         with tempfile.TemporaryDirectory(prefix="collide2d-bench-") as tmp:
-            cmd = [sys.executable, "-m", "runner", "run", str(path), "--quiet", "--out", tmp]
+            cmd = [sys.executable, "-m", "collide2d", "run", str(path), "--quiet", "--out", tmp]
             subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)  # kernels cached
             wall = _median(
                 _timed(lambda: subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL))
@@ -917,7 +917,7 @@ def plots(rows: list[dict], folder: Path) -> list[str]:
         from matplotlib import ticker
     except ImportError:
         return []
-    from runner.outputs import atomic_path
+    from collide2d.runner.outputs import atomic_path
 
     written = []
     scale = [r for r in rows if r["part"] in ("scaling", "peers")]
@@ -976,7 +976,7 @@ def plots(rows: list[dict], folder: Path) -> list[str]:
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
-    from runner import outputs
+    from collide2d.runner import outputs
 
     parts = tuple(dict.fromkeys(args.part)) if args.part else DEFAULT_PARTS
     if args.peers and "peers" not in parts:
@@ -1084,6 +1084,6 @@ def register(subparsers) -> None:
 
 
 def _positive(text: str) -> int:
-    from runner.options import positive_int
+    from collide2d.runner.options import positive_int
 
     return positive_int(text)

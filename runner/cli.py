@@ -1,4 +1,4 @@
-"""The `collide2d` command line (also `python -m runner`): parse, dispatch, map errors to exits.
+"""The `collide2d` command line (also `python -m collide2d`): parse, dispatch, map errors to exits.
 
 Each subcommand lives with what it drives (`run` here; `validate`/`schema` in runner.validate;
 `check`/`bless` in runner.golden.cli) and registers itself on the parser. Exit status: 0 fine,
@@ -14,10 +14,10 @@ import sys
 import traceback
 from importlib import resources
 
-from engine.models import ModelUnavailable
-from runner import bench, stress, validate
-from runner.golden import cli as golden_cli
-from runner.options import (
+from collide2d.engine.models import ModelUnavailable
+from collide2d.runner import bench, stress, validate
+from collide2d.runner.golden import cli as golden_cli
+from collide2d.runner.options import (
     add_cap_argument,
     add_limit_arguments,
     add_override_arguments,
@@ -25,8 +25,8 @@ from runner.options import (
     overrides_from_args,
     positive_int,
 )
-from runner.run import RunOptions, RunStopped, run_to_dir
-from runner.scenario import ScenarioError, load
+from collide2d.runner.run import RunOptions, RunStopped, run_to_dir
+from collide2d.runner.scenario import ScenarioError, load
 
 EXIT_OK = 0
 EXIT_DIFFERENCE = 1
@@ -36,7 +36,7 @@ EXIT_UNEXPECTED = 3
 
 def demo_path() -> str:
     """The bundled scenario of the paper's section IV: 50 boxes, 10x10, 10 px/s, 10 fps."""
-    return str(resources.files("runner") / "data" / "paper_fifty_boxes.yaml")
+    return str(resources.files("collide2d.runner") / "data" / "paper_fifty_boxes.yaml")
 
 
 def register_run(subparsers) -> None:

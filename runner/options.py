@@ -13,8 +13,8 @@ from __future__ import annotations
 
 import argparse
 
-from engine.models import MODEL_NAMES
-from runner.scenario import DEFAULT_MAX_EVENTS_PER_TICK, Limits
+from collide2d.engine.models import MODEL_NAMES
+from collide2d.runner.scenario import DEFAULT_MAX_EVENTS_PER_TICK, Limits
 
 _LIMIT_OPTIONS = (
     ("--max-objects", "max_objects", "objects in a scenario"),

@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 from PIL import GifImagePlugin, Image
 
-from engine.events import format_event, format_number
+from collide2d.engine.events import format_event, format_number
 
 # zlib level of every PNG (0-9): fixed so that the same pixels give the same bytes.
 PNG_COMPRESS_LEVEL = 6

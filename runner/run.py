@@ -24,15 +24,15 @@ from pathlib import Path
 
 import numpy as np
 
-from engine import models
-from engine.errors import Runaway
-from engine.events import empty_events
-from engine.raster import Renderer
-from engine.world import kinetic_energy, momentum
-from runner import budget, outputs, rundir
-from runner.frames import FrameRule
-from runner.progress import Progress
-from runner.scenario import Limits, Scenario, ScenarioError
+from collide2d.engine import models
+from collide2d.engine.errors import Runaway
+from collide2d.engine.events import empty_events
+from collide2d.engine.raster import Renderer
+from collide2d.engine.world import kinetic_energy, momentum
+from collide2d.runner import budget, outputs, rundir
+from collide2d.runner.frames import FrameRule
+from collide2d.runner.progress import Progress
+from collide2d.runner.scenario import Limits, Scenario, ScenarioError
 
 # Ticks per model call when nothing else ends a chunk: large enough that the kernel dominates,
 # small enough that events stream out and progress moves.

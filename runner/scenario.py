@@ -59,15 +59,15 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from engine import motion
-from engine.models import MODEL_NAMES
-from engine.models.exact import MAX_EVENTS_PER_TICK, no_room, no_room_message
-from engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies, WorldSpec
-from runner import colors
-from runner import generate as gen
-from runner import yamlsafe as ys
-from runner.frames import FrameRule
-from runner.yamlsafe import ScenarioError
+from collide2d.engine import motion
+from collide2d.engine.models import MODEL_NAMES
+from collide2d.engine.models.exact import MAX_EVENTS_PER_TICK, no_room, no_room_message
+from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies, WorldSpec
+from collide2d.runner import colors
+from collide2d.runner import generate as gen
+from collide2d.runner import yamlsafe as ys
+from collide2d.runner.frames import FrameRule
+from collide2d.runner.yamlsafe import ScenarioError
 
 FORMAT_VERSION = 1
 DEFAULT_WIDTH = 320  # px

@@ -8,9 +8,9 @@ polygons) only the loader checks.
 
 from __future__ import annotations
 
-from engine.models import MODEL_NAMES
-from runner import colors
-from runner.scenario import (
+from collide2d.engine.models import MODEL_NAMES
+from collide2d.runner import colors
+from collide2d.runner.scenario import (
     BLOCK_SHAPES,
     DEFAULT_DURATION,
     DEFAULT_FPS,

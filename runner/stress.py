@@ -41,12 +41,12 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
-from engine.events import EV_WALL
-from engine.models import MODEL_NAMES, ModelUnavailable
-from engine.models import make as make_model
-from engine.raster import round_positions
-from engine.world import Bodies, WorldSpec
-from runner import outputs
+from collide2d.engine.events import EV_WALL
+from collide2d.engine.models import MODEL_NAMES, ModelUnavailable
+from collide2d.engine.models import make as make_model
+from collide2d.engine.raster import round_positions
+from collide2d.engine.world import Bodies, WorldSpec
+from collide2d.runner import outputs
 
 EXIT_OK = 0
 EXIT_BROKEN = 1

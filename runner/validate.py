@@ -14,14 +14,14 @@ import argparse
 import json
 import sys
 
-from runner.options import (
+from collide2d.runner.options import (
     add_limit_arguments,
     add_override_arguments,
     limits_from_args,
     overrides_from_args,
 )
-from runner.scenario import ScenarioError, load
-from runner.schema import json_schema
+from collide2d.runner.scenario import ScenarioError, load
+from collide2d.runner.schema import json_schema
 
 EXIT_OK = 0
 EXIT_BAD_INPUT = 2

@@ -29,7 +29,7 @@ def test_goldens_stay_small(golden_root):
 
 
 def _golden(root, name):
-    from runner.golden.store import GoldenError, GoldenStore
+    from collide2d.runner.golden.store import GoldenError, GoldenStore
 
     try:
         return GoldenStore(root).read(name)

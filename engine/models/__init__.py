@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import importlib
 
-from engine.world import Bodies, WorldSpec
+from collide2d.engine.world import Bodies, WorldSpec
 
 MODEL_NAMES = ("paper", "stepped", "exact")
 
@@ -31,9 +31,9 @@ def make(name: str, world: WorldSpec, bodies: Bodies, **options):
     if name not in MODEL_NAMES:
         raise ValueError(f"unknown model {name!r}; expected one of {', '.join(MODEL_NAMES)}")
     try:
-        module = importlib.import_module(f"engine.models.{name}")
+        module = importlib.import_module(f"collide2d.engine.models.{name}")
     except ModuleNotFoundError as exc:
-        if exc.name == f"engine.models.{name}":
+        if exc.name == f"collide2d.engine.models.{name}":
             raise ModelUnavailable(f"model {name!r} is not available yet") from exc
         raise
     return module.Model(world, bodies, **options)

@@ -57,10 +57,10 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from engine.broadphase import choose, find_pairs, grid_cell, grid_dims, static_cells
-from engine.contact import box_next_contact, box_reach, next_contact
-from engine.errors import EventCapExceeded, NoRoom
-from engine.events import (
+from collide2d.engine.broadphase import choose, find_pairs, grid_cell, grid_dims, static_cells
+from collide2d.engine.contact import box_next_contact, box_reach, next_contact
+from collide2d.engine.errors import EventCapExceeded, NoRoom
+from collide2d.engine.events import (
     AXIS_NAMES,
     AXIS_X,
     AXIS_Y,
@@ -71,10 +71,10 @@ from engine.events import (
     SIDE_RIGHT,
     SIDE_TOP,
 )
-from engine.models.stepped import event_records, new_log
-from engine.response import exchange
-from engine.shapes import GEOMETRIES, build_cores
-from engine.world import KIND_BOX, Bodies, WorldSpec
+from collide2d.engine.models.stepped import event_records, new_log
+from collide2d.engine.response import exchange
+from collide2d.engine.shapes import GEOMETRIES, build_cores
+from collide2d.engine.world import KIND_BOX, Bodies, WorldSpec
 
 # Most wall and pair events one tick may take before the run is stopped as a runaway.
 MAX_EVENTS_PER_TICK = 1_000_000

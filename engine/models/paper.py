@@ -39,8 +39,8 @@ import time
 import numpy as np
 from numba import njit
 
-from engine.broadphase import KEY_MASK, KEY_SHIFT, candidates, choose, sort_keys, workspace
-from engine.events import (
+from collide2d.engine.broadphase import KEY_MASK, KEY_SHIFT, candidates, choose, sort_keys, workspace
+from collide2d.engine.events import (
     AXIS_X,
     AXIS_XY,
     AXIS_Y,
@@ -52,8 +52,8 @@ from engine.events import (
     SIDE_RIGHT,
     SIDE_TOP,
 )
-from engine.motion import paper_rate
-from engine.world import Bodies, WorldSpec
+from collide2d.engine.motion import paper_rate
+from collide2d.engine.world import Bodies, WorldSpec
 
 # Columns of the kernel's event rows (int64); `t` is added in Python as tick / fps.
 _TICK, _TYPE, _A, _B, _CODE, _XDIFF, _YDIFF = range(7)

@@ -35,7 +35,7 @@ import time
 import numpy as np
 from numba import njit
 
-from engine.broadphase import (
+from collide2d.engine.broadphase import (
     KEY_MASK,
     KEY_SHIFT,
     METHOD_GRID,
@@ -46,8 +46,8 @@ from engine.broadphase import (
     sort_keys,
     workspace,
 )
-from engine.contact import box_overlap_axis, penetration
-from engine.events import (
+from collide2d.engine.contact import box_overlap_axis, penetration
+from collide2d.engine.events import (
     EV_PAIR,
     EV_WALL,
     EVENT_DTYPE,
@@ -56,9 +56,9 @@ from engine.events import (
     SIDE_RIGHT,
     SIDE_TOP,
 )
-from engine.response import exchange, fold, separate
-from engine.shapes import GEOMETRIES, build_cores
-from engine.world import Bodies, WorldSpec
+from collide2d.engine.response import exchange, fold, separate
+from collide2d.engine.shapes import GEOMETRIES, build_cores
+from collide2d.engine.world import Bodies, WorldSpec
 
 # Rows of a fresh event buffer; it doubles when full.
 LOG_ROWS = 1024

@@ -17,9 +17,9 @@ import json
 import shlex
 from dataclasses import dataclass
 
-from runner.golden import compare, report
-from runner.golden import serialize as ser
-from runner.golden.store import (
+from collide2d.runner.golden import compare, report
+from collide2d.runner.golden import serialize as ser
+from collide2d.runner.golden.store import (
     DEFAULT_MAX_FRAME_PIXELS,
     GoldenMissing,
     GoldenStore,

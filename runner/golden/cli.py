@@ -24,8 +24,8 @@ import traceback
 from functools import partial
 from pathlib import Path
 
-from runner.golden import bless_run, check_run, golden_frames, report, shown_path
-from runner.golden.store import (
+from collide2d.runner.golden import bless_run, check_run, golden_frames, report, shown_path
+from collide2d.runner.golden.store import (
     GOLDENS_DIR,
     SCENARIO_SUFFIXES,
     SCENARIOS_DIR,
@@ -57,14 +57,14 @@ class _Usage(Exception):
 
 def default_load(path, **kwargs):
     """runner.scenario.load (imported when first needed)."""
-    from runner.scenario import load
+    from collide2d.runner.scenario import load
 
     return load(path, **kwargs)
 
 
 def default_simulate(scenario, **kwargs):
     """runner.run.simulate (imported when first needed)."""
-    from runner.run import simulate
+    from collide2d.runner.run import simulate
 
     return simulate(scenario, **kwargs)
 
@@ -101,7 +101,7 @@ def register(subparsers, *, load=None, simulate=None) -> None:
 
 
 def _common(p) -> None:
-    from runner.options import add_cap_argument
+    from collide2d.runner.options import add_cap_argument
 
     p.add_argument("--root", metavar="DIR", help="project folder holding scenarios/ and goldens/")
     p.add_argument("--quiet", action="store_true", help="no progress output")
@@ -193,8 +193,8 @@ def _scenario_failed(args, doing: str, path, scn, exc: Exception) -> int:
 
 def _refusals() -> tuple:
     """The exception types that refuse one scenario as bad input rather than a bug."""
-    from engine.models import ModelUnavailable
-    from runner.run import RunStopped
+    from collide2d.engine.models import ModelUnavailable
+    from collide2d.runner.run import RunStopped
 
     return (GoldenError, ModelUnavailable, RunStopped, *scenario_errors())
 
@@ -283,7 +283,7 @@ def _load_all(paths, load):
 
 def scenario_errors() -> tuple:
     """The exception types that mean "this scenario file is refused"."""
-    from runner.scenario import ScenarioError
+    from collide2d.runner.scenario import ScenarioError
 
     return (ScenarioError,)
 

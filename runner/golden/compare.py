@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from runner.golden.serialize import pixel_sha256
+from collide2d.runner.golden.serialize import pixel_sha256
 
 FINAL_COLUMNS = ("x", "y", "vx", "vy")
 # The event fields whose values are times (compared within τ) or follow from the time.

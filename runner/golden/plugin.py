@@ -1,6 +1,7 @@
 """The pytest plugin of the goldens: every scenario a test, `test_golden[fig2_case1]` (SPEC §7).
 
-Registered by the project's root `conftest.py` (`pytest_plugins = ["runner.golden.plugin"]`).
+Registered through the `pytest11` entry point of the distribution, so it loads in the pytest run
+of any project that installs collide2d.
 Inputs: the scenario files of the project (`ROOT/scenarios/`, ROOT found upward from the current
 directory or given by `--golden-root`) and the options below. Outputs: test outcomes whose failure
 text is the same as `collide2d check` prints, a report per failing scenario, and with
@@ -57,7 +58,7 @@ def pytest_addoption(parser) -> None:
 def pytest_configure(config) -> None:
     if not config.getoption("update_goldens"):
         return
-    from runner.golden.store import ci_active
+    from collide2d.runner.golden.store import ci_active
 
     if ci_active():
         pytest.exit(
@@ -68,7 +69,7 @@ def pytest_configure(config) -> None:
 
 
 def _root(config) -> Path:
-    from runner.golden.store import find_root
+    from collide2d.runner.golden.store import find_root
 
     given = config.getoption("golden_root")
     if given:
@@ -79,7 +80,7 @@ def _root(config) -> Path:
 def pytest_generate_tests(metafunc) -> None:
     if "golden_scenario" not in metafunc.fixturenames:
         return
-    from runner.golden.store import GoldenError, scenario_files
+    from collide2d.runner.golden.store import GoldenError, scenario_files
 
     try:
         root = _root(metafunc.config)
@@ -100,7 +101,7 @@ def golden_root(pytestconfig) -> Path:
 @pytest.fixture(scope="session")
 def golden_load():
     """The scenario loader: path -> Scenario."""
-    from runner.golden.cli import default_load
+    from collide2d.runner.golden.cli import default_load
 
     return default_load
 
@@ -108,7 +109,7 @@ def golden_load():
 @pytest.fixture(scope="session")
 def golden_simulate():
     """The simulator, called as runner.run.simulate."""
-    from runner.golden.cli import default_simulate
+    from collide2d.runner.golden.cli import default_simulate
 
     return default_simulate
 
@@ -117,9 +118,9 @@ def golden_simulate():
 def golden_check(request, golden_root, golden_load, golden_simulate, tmp_path_factory):
     """check(path): run the scenario file `path` and compare it with its golden (or, with
     --update-goldens, bless it); fails the test with the text `collide2d check` prints."""
-    from runner.golden import bless_run, check_run, shown_path
-    from runner.golden.cli import run_scenario, scenario_errors
-    from runner.golden.store import SCENARIOS_DIR, GoldenError, GoldenStore
+    from collide2d.runner.golden import bless_run, check_run, shown_path
+    from collide2d.runner.golden.cli import run_scenario, scenario_errors
+    from collide2d.runner.golden.store import SCENARIOS_DIR, GoldenError, GoldenStore
 
     config = request.config
 
@@ -168,7 +169,7 @@ def pytest_terminal_summary(terminalreporter, exitstatus, config) -> None:
     names = {v for k, v in props if k == PROP_NAME}
     if not names:
         return
-    from runner.golden.store import GoldenError, GoldenStore, scenario_files
+    from collide2d.runner.golden.store import GoldenError, GoldenStore, scenario_files
 
     try:
         root = _root(config)

@@ -35,8 +35,8 @@ import zlib
 import numpy as np
 from PIL import Image, UnidentifiedImageError
 
-from engine.events import event_dict, format_event
-from runner.outputs import encode_png, final_csv_text
+from collide2d.engine.events import event_dict, format_event
+from collide2d.runner.outputs import encode_png, final_csv_text
 
 # The golden folder's layout version; a reader refuses other versions with a clear message.
 FORMAT_VERSION = 1

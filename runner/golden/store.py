@@ -35,7 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
-from runner.golden import serialize as ser
+from collide2d.runner.golden import serialize as ser
 
 GOLDENS_DIR = "goldens"
 SCENARIOS_DIR = "scenarios"

@@ -3,7 +3,7 @@ the code under test."""
 
 import numpy as np
 
-from engine.world import Bodies
+from collide2d.engine.world import Bodies
 
 
 def random_boxes(n, seed, world, size=8.0, speed=60.0, mass_range=(0.2, 5.0)):

@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from engine.broadphase import (
+from collide2d.engine.broadphase import (
     CELL_MARGIN,
     GRID_FILINGS_PER_OBJECT,
     MAX_CELLS_PER_OBJECT,

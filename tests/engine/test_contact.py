@@ -13,7 +13,7 @@ from engine_refs import pixel_corners, ref_hull
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from engine.contact import (
+from collide2d.engine.contact import (
     box_next_contact,
     box_overlap_axis,
     box_penetration,
@@ -25,9 +25,9 @@ from engine.contact import (
     polygon_sweep,
     rounded_sweep,
 )
-from engine.events import AXIS_NORMAL, AXIS_X, AXIS_XY, AXIS_Y
-from engine.shapes import edge_normals, pixel_hull
-from engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON
+from collide2d.engine.events import AXIS_NORMAL, AXIS_X, AXIS_XY, AXIS_Y
+from collide2d.engine.shapes import edge_normals, pixel_hull
+from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON
 
 INF = math.inf
 

@@ -5,7 +5,7 @@ import json
 import numpy as np
 import pytest
 
-from engine.events import (
+from collide2d.engine.events import (
     AXIS_X,
     EV_PAIR,
     EV_WALL,

@@ -14,8 +14,8 @@ from engine_refs import pixel_corners, random_boxes, ref_hull
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from engine.errors import NoRoom, Runaway
-from engine.events import (
+from collide2d.engine.errors import NoRoom, Runaway
+from collide2d.engine.events import (
     AXIS_NAMES,
     AXIS_X,
     AXIS_XY,
@@ -27,10 +27,10 @@ from engine.events import (
     SIDE_RIGHT,
     SIDE_TOP,
 )
-from engine.models import exact as exact_model
-from engine.models import make
-from engine.models.exact import MAX_EVENTS_PER_TICK, EventCapExceeded
-from engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies, WorldSpec, kinetic_energy
+from collide2d.engine.models import exact as exact_model
+from collide2d.engine.models import make
+from collide2d.engine.models.exact import MAX_EVENTS_PER_TICK, EventCapExceeded
+from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies, WorldSpec, kinetic_energy
 
 # --- helpers --------------------------------------------------------------------------------------
 

@@ -2,7 +2,7 @@
 
 import pytest
 
-from engine.motion import MAX_PERIOD_TICKS, paper_rate
+from collide2d.engine.motion import MAX_PERIOD_TICKS, paper_rate
 
 
 @pytest.mark.parametrize(

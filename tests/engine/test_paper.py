@@ -10,9 +10,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from engine.events import AXIS_NAMES, EV_PAIR, EV_WALL, SIDE_NAMES
-from engine.models.paper import Model
-from engine.world import Bodies, WorldSpec
+from collide2d.engine.events import AXIS_NAMES, EV_PAIR, EV_WALL, SIDE_NAMES
+from collide2d.engine.models.paper import Model
+from collide2d.engine.world import Bodies, WorldSpec
 
 
 def model(pos, size, vel, *, fps=10, world=(320, 240), static=None):

@@ -13,8 +13,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from engine import raster
-from engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies, WorldSpec
+from collide2d.engine import raster
+from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies, WorldSpec
 
 FAST = settings(max_examples=30, deadline=None)
 
@@ -455,8 +455,8 @@ def test_same_pixels_without_jit():
 import numpy as np, sys
 sys.path.insert(0, TESTS_DIR)
 from test_raster import random_scene
-from engine import raster
-from engine.world import WorldSpec
+from collide2d.engine import raster
+from collide2d.engine.world import WorldSpec
 rng = np.random.default_rng(11)
 bodies = random_scene(rng, 12)
 r = raster.Renderer(WorldSpec(30, 24, 10), bodies)

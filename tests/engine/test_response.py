@@ -7,9 +7,9 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from engine.errors import Runaway
-from engine.events import AXIS_NORMAL, AXIS_X, AXIS_XY
-from engine.response import MAX_FOLDS_PER_STEP, exchange, exchange_along, fold, separate
+from collide2d.engine.errors import Runaway
+from collide2d.engine.events import AXIS_NORMAL, AXIS_X, AXIS_XY
+from collide2d.engine.response import MAX_FOLDS_PER_STEP, exchange, exchange_along, fold, separate
 
 speeds = st.floats(-1e3, 1e3)
 masses = st.sampled_from([1e-5, 0.3, 1.0, 2.5, 7.0, 1e5, 1e10])

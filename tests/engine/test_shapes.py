@@ -5,8 +5,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from engine.shapes import build_cores, edge_normals, pixel_hull
-from engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies
+from collide2d.engine.shapes import build_cores, edge_normals, pixel_hull
+from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies
 
 
 def shoelace(v):

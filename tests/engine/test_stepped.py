@@ -7,11 +7,11 @@ from engine_refs import random_boxes
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from engine.contact import box_overlap_axis
-from engine.events import AXIS_NAMES, EV_PAIR, EV_WALL, SIDE_LEFT, SIDE_RIGHT
-from engine.models import make
-from engine.response import exchange, fold, separate
-from engine.world import KIND_CIRCLE, Bodies, WorldSpec, kinetic_energy, momentum
+from collide2d.engine.contact import box_overlap_axis
+from collide2d.engine.events import AXIS_NAMES, EV_PAIR, EV_WALL, SIDE_LEFT, SIDE_RIGHT
+from collide2d.engine.models import make
+from collide2d.engine.response import exchange, fold, separate
+from collide2d.engine.world import KIND_CIRCLE, Bodies, WorldSpec, kinetic_energy, momentum
 
 
 def boxes_overlap(pos, size):

@@ -10,9 +10,9 @@ import sys
 import numpy as np
 import pytest
 
-from runner import bench
-from runner.cli import main
-from runner.scenario import loads
+from collide2d.runner import bench
+from collide2d.runner.cli import main
+from collide2d.runner.scenario import loads
 
 
 def rows_of(path):

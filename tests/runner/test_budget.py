@@ -15,9 +15,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from runner import budget, outputs
-from runner.cli import main
-from runner.scenario import Limits, load
+from collide2d.runner import budget, outputs
+from collide2d.runner.cli import main
+from collide2d.runner.scenario import Limits, load
 
 SCENE = """version: 1
 name: tiny

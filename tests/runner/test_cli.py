@@ -13,7 +13,7 @@ import imageio.v3 as iio
 import numpy as np
 import pytest
 
-from runner.cli import demo_path, main
+from collide2d.runner.cli import demo_path, main
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENARIOS = ROOT / "scenarios"
@@ -237,7 +237,7 @@ def test_galperin_billiard_counts_pi_to_seven_digits_from_the_command_line(tmp_p
     """Mass ratio 10^12: 3,141,592 collisions, about 1.57 million in each of two ticks, past the
     default cap: the scenario raises it in its model options; counted with no event log."""
     out = subprocess.run(
-        [sys.executable, "-m", "runner", "run", str(GALPERIN), "--out", str(tmp_path)],
+        [sys.executable, "-m", "collide2d", "run", str(GALPERIN), "--out", str(tmp_path)],
         capture_output=True,
         text=True,
         timeout=120,

@@ -17,8 +17,8 @@ import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from runner.cli import main
-from runner.scenario import (
+from collide2d.runner.cli import main
+from collide2d.runner.scenario import (
     BLOCK_KEYS,
     OBJECT_KEYS,
     OUTPUT_KEYS,
@@ -311,7 +311,7 @@ def test_in_a_separate_process_a_broken_file_is_exit_2_without_traceback(tmp_pat
     path = tmp_path / f"{name}.yaml"
     path.write_text(BROKEN[name])
     proc = subprocess.run(
-        [sys.executable, "-m", "runner", "run", str(path), "--out", str(tmp_path / "out")],
+        [sys.executable, "-m", "collide2d", "run", str(path), "--out", str(tmp_path / "out")],
         capture_output=True,
         text=True,
         timeout=120,

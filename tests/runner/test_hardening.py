@@ -17,8 +17,8 @@ import imageio.v3 as iio
 import pytest
 from PIL import Image
 
-from runner.cli import main
-from runner.scenario import ScenarioError, load
+from collide2d.runner.cli import main
+from collide2d.runner.scenario import ScenarioError, load
 
 ROOT = Path(__file__).resolve().parents[2]
 DATA = Path(__file__).parent / "data"
@@ -79,7 +79,7 @@ def refuse_cheaply(argv) -> tuple[int, float, int]:
 
 def cli(*argv, env=None, timeout=120) -> subprocess.CompletedProcess:
     return subprocess.run(
-        [sys.executable, "-m", "runner", *map(str, argv)],
+        [sys.executable, "-m", "collide2d", *map(str, argv)],
         capture_output=True,
         text=True,
         timeout=timeout,
@@ -360,7 +360,7 @@ def test_a_killed_run_leaves_the_old_run_whole_and_the_next_run_cleans_up(tmp_pa
 
     long = scenario(tmp_path, ticks=20000, file="long")
     proc = subprocess.Popen(
-        [sys.executable, "-m", "runner", "run", str(long), "--out", str(out), "--png", "--quiet"],
+        [sys.executable, "-m", "collide2d", "run", str(long), "--out", str(out), "--png", "--quiet"],
         cwd=ROOT,
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,

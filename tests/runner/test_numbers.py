@@ -26,12 +26,12 @@ import yaml
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
-from engine.world import Bodies, kinetic_energy, momentum
-from runner import run as run_module
-from runner import yamlsafe
-from runner.cli import main
-from runner.run import RunStopped, simulate
-from runner.scenario import (
+from collide2d.engine.world import Bodies, kinetic_energy, momentum
+from collide2d.runner import run as run_module
+from collide2d.runner import yamlsafe
+from collide2d.runner.cli import main
+from collide2d.runner.run import RunStopped, simulate
+from collide2d.runner.scenario import (
     MAX_INTEGER,
     MAX_MASS,
     MAX_SEED,

@@ -21,8 +21,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from PIL import Image, ImageSequence
 
-from engine.events import AXIS_X, EV_PAIR, EV_WALL, SIDE_LEFT, empty_events
-from runner import outputs
+from collide2d.engine.events import AXIS_X, EV_PAIR, EV_WALL, SIDE_LEFT, empty_events
+from collide2d.runner import outputs
 
 PALETTE = np.array(
     [[0, 0, 0], [255, 0, 0], [0, 255, 0], [1, 2, 3], [250, 128, 7]],
@@ -106,7 +106,7 @@ def test_killed_gif_writer_leaves_old_gif_whole(tmp_path):
     script = textwrap.dedent(
         f"""
         import os, signal, numpy as np
-        from runner import outputs
+        from collide2d.runner import outputs
         pal = np.array({PALETTE.tolist()}, np.uint8)
         g = outputs.GifWriter({str(target)!r}, pal, 8, 6, 10, 50)
         for i in range(20):

@@ -11,9 +11,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from engine.raster import Renderer
-from runner.run import drive, simulate
-from runner.scenario import load
+from collide2d.engine.raster import Renderer
+from collide2d.runner.run import drive, simulate
+from collide2d.runner.scenario import load
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENARIOS = ROOT / "scenarios"
@@ -75,7 +75,7 @@ def test_no_log_gives_the_same_state_and_no_events(name, overrides):
 
 def test_no_frames_means_no_renderer(monkeypatch):
     # with no frame asked for, nothing is rasterised at all
-    import runner.run as run_module
+    import collide2d.runner.run as run_module
 
     def refuse(*args, **kwargs):
         raise AssertionError("a renderer was made for a run that asked for no frame")

@@ -17,8 +17,8 @@ from pathlib import Path
 
 import pytest
 
-from runner import outputs, rundir
-from runner.cli import main
+from collide2d.runner import outputs, rundir
+from collide2d.runner.cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENE = """version: 1

@@ -14,10 +14,10 @@ import numpy as np
 import pytest
 import yaml
 
-from engine import motion
-from engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON
-from runner import yamlsafe as ys
-from runner.scenario import (
+from collide2d.engine import motion
+from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON
+from collide2d.runner import yamlsafe as ys
+from collide2d.runner.scenario import (
     TOP_KEYS,
     Limits,
     ScenarioError,
@@ -25,7 +25,7 @@ from runner.scenario import (
     loads,
     polygon_problem,
 )
-from runner.schema import json_schema
+from collide2d.runner.schema import json_schema
 
 DATA = Path(__file__).parent / "data"
 BASE = "version: 1\nworld: {width: 100, height: 80, fps: 10}\n"

@@ -15,13 +15,13 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from engine.events import EV_WALL, EVENT_DTYPE
-from engine.models import MODEL_NAMES, ModelUnavailable
-from engine.raster import round_positions
-from engine.world import Bodies, WorldSpec
-from runner import stress
-from runner.cli import main
-from runner.generate import first_overlap
+from collide2d.engine.events import EV_WALL, EVENT_DTYPE
+from collide2d.engine.models import MODEL_NAMES, ModelUnavailable
+from collide2d.engine.raster import round_positions
+from collide2d.engine.world import Bodies, WorldSpec
+from collide2d.runner import stress
+from collide2d.runner.cli import main
+from collide2d.runner.generate import first_overlap
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -369,7 +369,7 @@ def test_stress_refuses_an_unknown_scene_and_a_linked_report_folder(tmp_path, ca
 
 def test_collide2d_stress_quick_passes_and_reports_every_case(tmp_path):
     proc = subprocess.run(
-        [sys.executable, "-m", "runner", "stress", "--quick", "--out", str(tmp_path)],
+        [sys.executable, "-m", "collide2d", "stress", "--quick", "--out", str(tmp_path)],
         capture_output=True,
         text=True,
         timeout=300,

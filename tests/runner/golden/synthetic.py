@@ -26,8 +26,8 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from engine.events import EVENT_DTYPE
-from engine.world import WorldSpec
+from collide2d.engine.events import EVENT_DTYPE
+from collide2d.engine.world import WorldSpec
 
 BASE = {
     "name": "demo",
@@ -63,7 +63,7 @@ def load(path, *, overrides=None, limits=None):
     text = Path(path).read_text()
     data = json.loads(text)
     if "error" in data:
-        from runner.scenario import ScenarioError
+        from collide2d.runner.scenario import ScenarioError
 
         raise ScenarioError(path, 1, 1, data["error"])
     g = data["golden"]

@@ -6,7 +6,7 @@ import json
 
 import pytest
 
-from runner.golden import cli
+from collide2d.runner.golden import cli
 
 from . import synthetic
 

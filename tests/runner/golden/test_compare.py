@@ -8,8 +8,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from runner.golden.compare import compare_events, compare_final, compare_frame
-from runner.golden.serialize import pixel_sha256
+from collide2d.runner.golden.compare import compare_events, compare_final, compare_frame
+from collide2d.runner.golden.serialize import pixel_sha256
 
 WALL = {"tick": 2, "t": 0.5, "type": "wall", "id": 1, "side": "left"}
 PAIR = {"tick": 3, "t": 0.75, "type": "pair", "a": 0, "b": 1, "axis": "x", "xdiff": 2, "ydiff": 5}

@@ -17,8 +17,8 @@ import zlib
 
 import pytest
 
-from runner.golden import cli
-from runner.golden import serialize as ser
+from collide2d.runner.golden import cli
+from collide2d.runner.golden import serialize as ser
 
 from . import synthetic
 

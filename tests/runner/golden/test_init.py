@@ -6,9 +6,9 @@ import json
 
 import pytest
 
-from runner.golden import CREATED, UNCHANGED, UPDATED, bless_run, check_run
-from runner.golden import serialize as ser
-from runner.golden.store import GoldenStore
+from collide2d.runner.golden import CREATED, UNCHANGED, UPDATED, bless_run, check_run
+from collide2d.runner.golden import serialize as ser
+from collide2d.runner.golden.store import GoldenStore
 
 from . import synthetic
 

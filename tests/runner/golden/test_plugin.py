@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from runner.golden import cli
-from runner.golden.store import GoldenStore
+from collide2d.runner.golden import cli
+from collide2d.runner.golden.store import GoldenStore
 
 from . import synthetic
 
@@ -18,7 +18,7 @@ CONFTEST = """
 import pytest
 import golden_synthetic
 
-pytest_plugins = ["runner.golden.plugin"]
+pytest_plugins = ["collide2d.runner.golden.plugin"]
 
 
 @pytest.fixture(scope="session")

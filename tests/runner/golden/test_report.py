@@ -7,9 +7,9 @@ import re
 
 import numpy as np
 
-from runner.golden import report
-from runner.golden.compare import compare_frame
-from runner.golden.serialize import decode_png
+from collide2d.runner.golden import report
+from collide2d.runner.golden.compare import compare_frame
+from collide2d.runner.golden.serialize import decode_png
 
 
 def _pair():

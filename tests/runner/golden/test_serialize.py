@@ -14,8 +14,8 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 from PIL import Image
 
-from engine.events import EVENT_DTYPE, event_dict, format_event
-from runner.golden import serialize as ser
+from collide2d.engine.events import EVENT_DTYPE, event_dict, format_event
+from collide2d.runner.golden import serialize as ser
 
 from . import synthetic
 

@@ -10,10 +10,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from runner.golden import golden_files
-from runner.golden import serialize as ser
-from runner.golden import store as st
-from runner.golden.store import GoldenMissing, GoldenStore, GoldenUnreadable, WritesRefused
+from collide2d.runner.golden import golden_files
+from collide2d.runner.golden import serialize as ser
+from collide2d.runner.golden import store as st
+from collide2d.runner.golden.store import GoldenMissing, GoldenStore, GoldenUnreadable, WritesRefused
 
 from . import synthetic
 
