@@ -282,7 +282,8 @@ def test_the_cap_is_refused_under_another_model_at_its_place(tmp_path, capsys):
     assert not (tmp_path / "galperin-pi").exists()
 
 
-def test_check_and_bless_take_the_cap(tmp_path, capsys):
+def test_check_and_bless_take_the_cap(tmp_path, capsys, monkeypatch):
+    monkeypatch.delenv("CI", raising=False)  # bless writes goldens, which CI never does
     (tmp_path / "scenarios").mkdir()
     galperin_small(tmp_path / "scenarios", "model: exact")
     args = ["--root", str(tmp_path), "--quiet", "--max-events-per-tick", "1000"]
