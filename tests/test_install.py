@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 import zipfile
@@ -51,6 +52,13 @@ def test_the_command_runs_in_a_folder_with_its_own_engine_and_runner(tmp_path):
 
 
 def test_a_wheel_installs_only_collide2d_and_runs_beside_a_users_packages(tmp_path):
+    # built from a copy, so that the build leaves nothing in the checkout
+    source = tmp_path / "source"
+    ignore = shutil.ignore_patterns("__pycache__", "*.egg-info", "build")
+    for part in ("collide2d", "engine", "runner"):
+        shutil.copytree(ROOT / part, source / part, ignore=ignore)
+    for part in ("pyproject.toml", "README.md"):
+        shutil.copy(ROOT / part, source / part)
     wheels = tmp_path / "wheels"
     build = subprocess.run(
         [
@@ -62,7 +70,7 @@ def test_a_wheel_installs_only_collide2d_and_runs_beside_a_users_packages(tmp_pa
             "-q",
             "-w",
             str(wheels),
-            str(ROOT),
+            str(source),
         ],
         capture_output=True,
         text=True,
