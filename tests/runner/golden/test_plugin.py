@@ -18,7 +18,7 @@ CONFTEST = """
 import pytest
 import golden_synthetic
 
-pytest_plugins = ["collide2d.runner.golden.plugin"]
+# no `pytest_plugins` line: the plugin comes from collide2d's pytest11 entry point
 
 
 @pytest.fixture(scope="session")
