@@ -30,7 +30,7 @@ from typing import TYPE_CHECKING
 import yaml
 
 if TYPE_CHECKING:
-    from collide2d.runner.scenario import Limits
+    from collide2d.runner.limits import Limits
 
 MAX_YAML_DEPTH = 64  # nesting levels of YAML collections
 MAX_SHOWN_CHARS = 40  # characters of a text quoted in a message

@@ -17,9 +17,9 @@ import yaml
 from collide2d.engine import motion
 from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON
 from collide2d.runner import yamlsafe as ys
+from collide2d.runner.limits import Limits
 from collide2d.runner.scenario import (
     TOP_KEYS,
-    Limits,
     ScenarioError,
     load,
     loads,
