@@ -9,8 +9,13 @@ offending YAML node. Nothing large is allocated before every count has been chec
 `Limits`.
 
 Reading goes in two steps: `runner.yamlsafe` turns the text into a node tree within the bounds of
-`Limits` (safe tags only, depth, aliases, size, value count); then the tree is walked by hand, so
-every value is checked where it stands and every error carries its node's place.
+`Limits` (`runner.limits`: safe tags only, depth, aliases, size, value count); then the tree is
+walked by hand, so every value is checked where it stands and every error carries its node's place.
+`runner.nodes` reads single nodes (typed, located); this module reads the top level, the world, the
+model, the tick count and the overrides; `runner.objects` reads the objects and generate blocks
+under the model's `ModelRules`; `runner.outputspec` reads `output` and `golden`; `runner.assemble`
+builds the `Bodies` and the palette and checks the placement. Every name the format defines is
+importable from here (`__all__`), wherever it is defined.
 
 Values follow YAML 1.1 as PyYAML reads it (`yes` is a boolean, `0x1f` an integer), with one
 addition: an unquoted number in exponent form such as `1e3` or `1.5E-7`, a string to YAML 1.1, is
