@@ -25,6 +25,7 @@ MAX_INTEGER = 2**63 - 1  # the largest whole number a field takes unless it has 
 
 
 def is_number(v) -> bool:
+    """Whether a read value is a number (booleans are not)."""
     return isinstance(v, (int, float)) and not isinstance(v, bool)
 
 
@@ -49,6 +50,7 @@ class Nodes:
 
     @staticmethod
     def prefix(*origins) -> str:
+        """The start of a message caused by command-line options ("--fps 3: "), or ""."""
         given = [o for o in origins if o]
         return " ".join(given) + ": " if given else ""
 

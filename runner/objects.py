@@ -142,6 +142,8 @@ class Listed:
 
 @dataclass
 class Block:
+    """One generate block, checked, before its objects are drawn."""
+
     spec: gen.BlockSpec
     kind: int
     mass: float
