@@ -14,7 +14,8 @@ from __future__ import annotations
 import argparse
 
 from collide2d.engine.models import MODEL_NAMES
-from collide2d.runner.scenario import DEFAULT_MAX_EVENTS_PER_TICK, Limits
+from collide2d.runner.limits import Limits
+from collide2d.runner.scenario import DEFAULT_MAX_EVENTS_PER_TICK
 
 _LIMIT_OPTIONS = (
     ("--max-objects", "max_objects", "objects in a scenario"),

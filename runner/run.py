@@ -31,8 +31,9 @@ from collide2d.engine.raster import Renderer
 from collide2d.engine.world import kinetic_energy, momentum
 from collide2d.runner import budget, outputs, rundir
 from collide2d.runner.frames import FrameRule
+from collide2d.runner.limits import Limits
 from collide2d.runner.progress import Progress
-from collide2d.runner.scenario import Limits, Scenario, ScenarioError
+from collide2d.runner.scenario import Scenario, ScenarioError
 
 # Ticks per model call when nothing else ends a chunk: large enough that the kernel dominates,
 # small enough that events stream out and progress moves.

@@ -14,9 +14,10 @@ one (`_NUMBER_LIKE_RE`, a superset of YAML 1.1's forms and of the exponent form 
 linear time); every other long plain scalar is text, and YAML's number patterns are never tried on
 it (see `_composing`). So every number is read at a cost linear in its text, and every integer a
 scenario holds is below 16**98 (about 1e118), far inside float64's range. Then `yaml.compose` with
-the safe loader (libyaml's when available) builds the node tree that `runner.scenario` walks by
-hand. `value` and `describe` read scalar nodes for it; a plain scalar YAML takes for an integer but
-that makes none (`0x_`: its digits are all underscores) is read as its text.
+the safe loader (libyaml's when available) builds the node tree that the scenario readers walk by
+hand (`runner.nodes`, typed and located, under `runner.scenario`). `value` and `describe` read
+scalar nodes for them; a plain scalar YAML takes for an integer but that makes none (`0x_`: its
+digits are all underscores) is read as its text.
 """
 
 from __future__ import annotations
@@ -25,12 +26,10 @@ import functools
 import hashlib
 import os
 import re
-from typing import TYPE_CHECKING
 
 import yaml
 
-if TYPE_CHECKING:
-    from collide2d.runner.scenario import Limits
+from collide2d.runner.limits import Limits
 
 MAX_YAML_DEPTH = 64  # nesting levels of YAML collections
 MAX_SHOWN_CHARS = 40  # characters of a text quoted in a message

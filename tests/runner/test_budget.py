@@ -17,7 +17,8 @@ from hypothesis import strategies as st
 
 from collide2d.runner import budget, outputs
 from collide2d.runner.cli import main
-from collide2d.runner.scenario import Limits, load
+from collide2d.runner.limits import Limits
+from collide2d.runner.scenario import load
 
 SCENE = """version: 1
 name: tiny

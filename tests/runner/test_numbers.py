@@ -30,6 +30,7 @@ from collide2d.engine.world import Bodies, kinetic_energy, momentum
 from collide2d.runner import run as run_module
 from collide2d.runner import yamlsafe
 from collide2d.runner.cli import main
+from collide2d.runner.limits import Limits
 from collide2d.runner.run import RunStopped, simulate
 from collide2d.runner.scenario import (
     MAX_INTEGER,
@@ -37,7 +38,6 @@ from collide2d.runner.scenario import (
     MAX_SEED,
     MAX_SPEED,
     MIN_MASS,
-    Limits,
     ScenarioError,
     loads,
 )

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from collide2d.runner import validate
-from collide2d.runner.scenario import Limits
+from collide2d.runner.limits import Limits
 from collide2d.runner.schema import json_schema
 
 DATA = Path(__file__).parent / "data"

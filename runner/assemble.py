@@ -1,0 +1,132 @@
+"""Objects to arrays: the checked objects and blocks of a scenario become `Bodies` and a palette.
+
+Listed objects are checked first (each inside the world, no two overlapping; touching is fine), then
+each generate block is drawn by `runner.generate` around them; the per-object arrays hold the listed
+objects first, then each block's objects, in id order. Colours are indexed into a palette of at most
+PALETTE_SIZE rows: row 0 the background, then each distinct object colour in order of first use.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from collide2d.engine.world import Bodies, WorldSpec
+from collide2d.runner import generate as gen
+from collide2d.runner.nodes import Nodes, fmt
+from collide2d.runner.objects import Block, Listed
+
+PALETTE_SIZE = 256  # palette rows: the background and up to 255 object colours
+
+
+def bodies(reader: Nodes, listed: list[Listed], blocks: list[Block], world: WorldSpec, background):
+    n_listed = len(listed)
+    pos = np.array([o.pos for o in listed], np.float64).reshape(-1, 2)
+    size = np.array([o.size for o in listed], np.float64).reshape(-1, 2)
+    check_placement(reader, listed, pos, size, world)
+
+    palette = [background]
+    index: dict[tuple[int, int, int], int] = {}
+
+    def color_index(rgb, node) -> int:
+        if rgb not in index:
+            if len(palette) >= PALETTE_SIZE:
+                raise reader.error(
+                    node,
+                    f"too many colours: the palette holds {PALETTE_SIZE} "
+                    f"(the background and {PALETTE_SIZE - 1} object "
+                    "colours)",
+                )
+            index[rgb] = len(palette)
+            palette.append(rgb)
+        return index[rgb]
+
+    listed_colors = [color_index(o.color, o.color_node or o.node) for o in listed]
+    block_colors = [color_index(b.color, b.color_node or b.node) for b in blocks]
+
+    try:
+        drawn = gen.generate(world.width, world.height, pos, size, [b.spec for b in blocks])
+    except gen.PlacementError as exc:
+        raise reader.error(blocks[exc.block].node, f"generate[{exc.block}]: {exc}") from None
+
+    counts = [b.spec.count for b in blocks]
+    n = n_listed + sum(counts)
+    rep = np.array(counts, np.int64)
+
+    def per_object(listed_values, block_values, dtype):
+        a = np.asarray(listed_values, dtype).reshape(n_listed)
+        b = np.repeat(np.asarray(block_values, dtype).reshape(len(blocks)), rep)
+        return np.concatenate([a, b])
+
+    kind = per_object([o.kind for o in listed], [b.kind for b in blocks], np.int8)
+    static = per_object([o.static for o in listed], [b.static for b in blocks], bool)
+    mass = per_object([o.mass for o in listed], [b.mass for b in blocks], np.float64)
+    mass[static] = np.inf
+    color = per_object(listed_colors, block_colors, np.uint8)
+    fill = per_object([o.fill for o in listed], [b.fill for b in blocks], bool)
+    all_pos = np.concatenate([pos] + [d[0] for d in drawn]).reshape(n, 2)
+    all_vel = np.concatenate(
+        [np.array([o.vel for o in listed], np.float64).reshape(-1, 2)] + [d[1] for d in drawn]
+    ).reshape(n, 2)
+    block_size = [
+        np.broadcast_to(np.asarray(b.spec.size, np.float64), (c, 2))
+        for b, c in zip(blocks, counts, strict=True)
+    ]
+    all_size = np.concatenate([size] + block_size).reshape(n, 2)
+    nverts = np.zeros(n, np.int64)
+    nverts[:n_listed] = [0 if o.verts is None else o.verts.shape[0] for o in listed]
+    vert_start = np.concatenate([[0], np.cumsum(nverts)]).astype(np.int64)
+    polys = [o.verts for o in listed if o.verts is not None]
+    verts = np.concatenate(polys).astype(np.int64) if polys else np.zeros((0, 2), np.int64)
+    bodies = Bodies(
+        kind=kind,
+        pos=all_pos,
+        size=all_size,
+        vel=all_vel,
+        mass=mass,
+        static=static,
+        color=color,
+        fill=fill,
+        vert_start=vert_start,
+        verts=verts,
+    )
+
+    names: list = [o.name for o in listed]
+    lines: list = [o.node.start_mark.line + 1 for o in listed]
+    for b, c in zip(blocks, counts, strict=True):
+        names.extend([f"{b.name}-{j}" for j in range(c)] if b.name is not None else [None] * c)
+        lines.extend([b.node.start_mark.line + 1] * c)
+    return bodies, tuple(names), tuple(lines), np.array(palette, np.uint8).reshape(-1, 3)
+
+
+def check_placement(reader: Nodes, listed: list[Listed], pos, size, world: WorldSpec) -> None:
+    """Every listed box inside the world, no two overlapping (touching is fine)."""
+    if not listed:
+        return
+    end = pos + size
+    outside = np.any((pos < 0) | (end > np.array([world.width, world.height])), axis=1)
+    if outside.any():
+        i = int(np.argmax(outside))
+        raise reader.error(
+            listed[i].node,
+            f"objects[{i}] lies outside the world: its box "
+            f"{_box_text(pos[i], size[i])} must fit in [0, {world.width}) x "
+            f"[0, {world.height})",
+        )
+    found = gen.first_overlap(pos, size)
+    if found is not None:
+        a, b = found
+        la = listed[a].node.start_mark.line + 1
+        lb = listed[b].node.start_mark.line + 1
+        raise reader.error(
+            listed[b].node,
+            f"objects[{b}] (line {lb}) overlaps objects[{a}] "
+            f"(line {la}) at the start: boxes {_box_text(pos[b], size[b])} and "
+            f"{_box_text(pos[a], size[a])}",
+        )
+
+
+def _box_text(p, s) -> str:
+    """The half-open box [x, x+w) x [y, y+h) as text."""
+    x0, x1 = fmt(float(p[0])), fmt(float(p[0] + s[0]))
+    y0, y1 = fmt(float(p[1])), fmt(float(p[1] + s[1]))
+    return f"[{x0}, {x1}) x [{y0}, {y1})"

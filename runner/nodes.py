@@ -1,0 +1,185 @@
+"""Typed, located reading of YAML nodes: a value of the expected kind, or a ScenarioError at it.
+
+`runner.yamlsafe` turns text into a node tree within bounds; `Nodes` reads that tree one node at a
+time and knows nothing of scenarios: a mapping (unknown keys refused with a did-you-mean, repeated
+keys refused, `<<` merge keys as in YAML 1.1), a list, a single value, text, a boolean, a number
+(finite; `-0.0` read as `0.0`), a whole number (a float with no fraction counts, as in JSON Schema;
+at most MAX_INTEGER unless the field says less), a colour, an [x, y] pair and a choice among names.
+Each refusal is `FILE:LINE:COL: error: MESSAGE` at the node it is about. The scenario's section
+readers (`runner.scenario`, `runner.objects`, `runner.outputspec`) extend `Nodes`.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+
+import numpy as np
+import yaml
+
+from collide2d.runner import colors
+from collide2d.runner import yamlsafe as ys
+from collide2d.runner.yamlsafe import ScenarioError
+
+MAX_INTEGER = 2**63 - 1  # the largest whole number a field takes unless it has its own bound
+
+
+def is_number(v) -> bool:
+    """Whether a read value is a number (booleans are not)."""
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+def fmt(v) -> str:
+    """A number as a user would write it (1e+15 rather than 1000000000000000)."""
+    if isinstance(v, float) and v.is_integer() and abs(v) < 1e15:
+        return str(int(v))
+    if isinstance(v, float) and abs(v) >= 1e15:
+        return np.format_float_scientific(v, trim="-")
+    return repr(v) if isinstance(v, float) else str(v)
+
+
+class Nodes:
+    """Located reading of the nodes of one file: `path` names it in every error."""
+
+    def __init__(self, path: str):
+        self.path = str(path)
+
+    def error(self, node, message: str) -> ScenarioError:
+        mark = node.start_mark if node is not None else None
+        return ys.mark_error(self.path, mark, message)
+
+    @staticmethod
+    def prefix(*origins) -> str:
+        """The start of a message caused by command-line options ("--fps 3: "), or ""."""
+        given = [o for o in origins if o]
+        return " ".join(given) + ": " if given else ""
+
+    def mapping(self, node, where: str, keys: tuple[str, ...]) -> dict:
+        """{key: (key node, value node)} of a mapping; unknown and repeated keys refused."""
+        if not isinstance(node, yaml.MappingNode):
+            raise self.error(
+                node, f"{where} must be a mapping of keys to values, not {ys.describe(node)}"
+            )
+        out: dict[str, tuple] = {}
+        merged = []
+        for knode, vnode in node.value:
+            if isinstance(knode, yaml.ScalarNode) and knode.tag == ys.CORE_TAG + "merge":
+                merged.append(vnode)
+                continue
+            if not isinstance(knode, yaml.ScalarNode) or not isinstance(ys.value(knode), str):
+                raise self.error(knode, f"keys in {where} must be names, not {ys.describe(knode)}")
+            key = knode.value
+            if key in out:
+                first = out[key][0].start_mark.line + 1
+                raise self.error(knode, f"duplicate key '{key}' in {where} (first on line {first})")
+            if key not in keys:
+                near = difflib.get_close_matches(key, keys, n=1)
+                hint = (
+                    f"did you mean '{near[0]}'?" if near else "expected one of " + ", ".join(keys)
+                )
+                raise self.error(knode, f"unknown key '{key}' in {where}; {hint}")
+            out[key] = (knode, vnode)
+        for vnode in merged:
+            sources = vnode.value if isinstance(vnode, yaml.SequenceNode) else [vnode]
+            for src in sources:
+                for key, item in self.mapping(src, where, keys).items():
+                    out.setdefault(key, item)
+        return out
+
+    def seq(self, node, what: str, min_len: int = 0) -> list:
+        if not isinstance(node, yaml.SequenceNode):
+            raise self.error(node, f"{what} must be a list, not {ys.describe(node)}")
+        if len(node.value) < min_len:
+            raise self.error(node, f"{what} needs at least {min_len} items, not {len(node.value)}")
+        return node.value
+
+    def scalar(self, node, what: str):
+        if not isinstance(node, yaml.ScalarNode):
+            raise self.error(node, f"{what} must be a single value, not {ys.describe(node)}")
+        return ys.value(node)
+
+    def string(self, node, what: str) -> str:
+        v = self.scalar(node, what)
+        if not isinstance(v, str):
+            raise self.error(node, f"{what} must be text, not {ys.describe(node)} (quote it)")
+        return v
+
+    def boolean(self, node, what: str) -> bool:
+        v = self.scalar(node, what)
+        if not isinstance(v, bool):
+            raise self.error(node, f"{what} must be true or false, not {ys.describe(node)}")
+        return v
+
+    def number(self, node, what: str, *, lo=None, hi=None, lo_open=False, unit=""):
+        """A finite int or float (ints kept exact) in [lo, hi] (or (lo, hi] with lo_open)."""
+        v = self.scalar(node, what)
+        if not is_number(v):
+            raise self.error(node, f"{what} must be a number, not {ys.describe(node)}")
+        if isinstance(v, float) and not math.isfinite(v):
+            raise self.error(node, f"{what} must be a finite number, not {node.value}")
+        if isinstance(v, int) and abs(v) > 1e300:
+            raise self.error(node, f"{what} {node.value} is too large a number")
+        if v == 0:
+            v = v + 0  # -0.0 is read as 0.0
+        if lo is not None and (v <= lo if lo_open else v < lo):
+            bound = "more than" if lo_open else "at least"
+            raise self.error(node, f"{what} must be {bound} {fmt(lo)}{unit}, not {fmt(v)}")
+        if hi is not None and v > hi:
+            raise self.error(node, f"{what} must be at most {fmt(hi)}{unit}, not {fmt(v)}")
+        return v
+
+    def integer(self, node, what: str, *, lo=None, hi=None, of="", unit="") -> int:
+        """A whole number (a float with no fraction counts) in [lo, hi]; hi is MAX_INTEGER unless
+        given, and a given lo is at least -MAX_INTEGER.
+
+        `of` completes "a whole number" in messages (" of pixels"), `unit` follows the bounds.
+        """
+        v = self.scalar(node, what)
+        if isinstance(v, float) and math.isfinite(v) and v.is_integer():
+            v = int(v)
+        if not is_number(v) or not isinstance(v, int):
+            raise self.error(node, f"{what} must be a whole number{of}, not {ys.describe(node)}")
+        lo = -MAX_INTEGER if lo is None else lo
+        hi = MAX_INTEGER if hi is None else hi
+        shown = str(v) if len(str(v)) <= 24 else node.value  # 1e300 rather than its 301 digits
+        if v < lo:
+            raise self.error(node, f"{what} must be at least {lo}{unit}, not {shown}")
+        if v > hi:
+            raise self.error(node, f"{what} must be at most {hi}{unit}, not {shown}")
+        return v
+
+    def color(self, node, what: str) -> tuple[int, int, int]:
+        if isinstance(node, yaml.SequenceNode):
+            items = node.value
+            if len(items) != 3:
+                raise self.error(
+                    node, f"{what} as a list needs 3 values [r, g, b], not {len(items)}"
+                )
+            r, g, b = (self.integer(n, f"{what} component", lo=0, hi=255) for n in items)
+            return (r, g, b)
+        v = self.scalar(node, what)
+        if not isinstance(v, str):
+            raise self.error(
+                node, f"{what} must be a colour name, #rrggbb or [r, g, b], not {ys.describe(node)}"
+            )
+        try:
+            return colors.parse_color_text(v)
+        except ValueError as exc:
+            raise self.error(node, f"{what}: {exc}") from None
+
+    def pair(self, node, what: str) -> tuple[list, list]:
+        """([x node, y node], [x, y]) of a two-number list."""
+        items = self.seq(node, what)
+        if len(items) != 2:
+            raise self.error(node, f"{what} must be a list of 2 numbers [x, y], not {len(items)}")
+        values = [self.number(n, f"{what} {axis}") for n, axis in zip(items, "xy", strict=True)]
+        return items, values
+
+    def choice(self, node, what: str, options: tuple[str, ...], origin=None) -> str:
+        v = self.scalar(node, what)
+        if not isinstance(v, str) or v not in options:
+            shown = f"'{v}'" if isinstance(v, str) else ys.describe(node)
+            near = difflib.get_close_matches(v, options, n=1) if isinstance(v, str) else []
+            hint = f"did you mean '{near[0]}'?" if near else "expected " + " | ".join(options)
+            raise self.error(node, f"{self.prefix(origin)}unknown {what} {shown}; {hint}")
+        return v
