@@ -50,7 +50,8 @@ import numpy as np
 
 from collide2d.engine import models
 from collide2d.engine.events import EV_PAIR
-from collide2d.engine.world import WorldSpec, kinetic_energy
+from collide2d.engine.invariants import kinetic_energy
+from collide2d.engine.world import WorldSpec
 
 # subprocess, tempfile, csv and io are imported where used: `collide2d` loads this module for its
 # parser, and a run should not pay for them.

@@ -15,7 +15,7 @@ import traceback
 from importlib import resources
 
 from collide2d.engine.models import ModelUnavailable
-from collide2d.runner import bench, stress, validate
+from collide2d.runner import bench, validate
 from collide2d.runner.golden import cli as golden_cli
 from collide2d.runner.options import (
     add_cap_argument,
@@ -27,6 +27,7 @@ from collide2d.runner.options import (
 )
 from collide2d.runner.run import RunOptions, RunStopped, run_to_dir
 from collide2d.runner.scenario import ScenarioError, load
+from collide2d.runner.stress import cli as stress_cli
 
 EXIT_OK = 0
 EXIT_DIFFERENCE = 1
@@ -114,7 +115,7 @@ def build_parser() -> argparse.ArgumentParser:
     register_run(subparsers)
     golden_cli.register(subparsers)
     validate.register(subparsers)
-    stress.register(subparsers)
+    stress_cli.register(subparsers)
     bench.register(subparsers)
     for sub in subparsers.choices.values():
         sub.add_argument(
