@@ -1,6 +1,6 @@
 """Steps per second of each model on the standard scene, in process (issue: fast at every scale).
 
-The standard scene of `collide2d bench` (runner.bench.standard_scene: N boxes 10x10 px covering
+The standard scene of `collide2d bench` (runner.bench.scenes.standard_scene: N boxes 10x10 px covering
 5 % of a 4:3 world, speeds 10-100 px/s in random directions, 60 fps, seed 1), stepped through the
 model's `advance` with the event log off, after a warm-up call so that loading the kernels is not
 timed; the median of REPEATS runs, each about TARGET_S seconds long. It prints steps/s and the
@@ -19,7 +19,8 @@ import statistics
 import time
 
 from collide2d.engine import models
-from collide2d.runner.bench import SCALING_N, standard_scene
+from collide2d.runner.bench.scaling import SCALING_N
+from collide2d.runner.bench.scenes import standard_scene
 from collide2d.runner.scenario import loads
 
 REPEATS = 3
