@@ -18,7 +18,7 @@ from collide2d.engine import models
 EXIT_OK = 0
 EXIT_BAD_INPUT = 2
 
-PARTS = ("scaling", "error", "peers", "skips", "targets")
+PARTS = ("scaling", "error", "peers", "skips", "targets", "paper", "exact", "raster")
 DEFAULT_PARTS = ("scaling", "error", "skips", "targets")
 REPORT_DIR = "bench"
 
@@ -27,8 +27,11 @@ def cmd_bench(args: argparse.Namespace) -> int:
     from collide2d.runner import outputs
     from collide2d.runner.bench import (
         error,
+        exact,
+        paper,
         peers,
         plots,
+        raster,
         report,
         scaling,
         scenes,
@@ -46,7 +49,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
     in_process = args.in_process or quick
     folder = Path(args.scenarios) if args.scenarios else scenes.PROJECT_SCENARIOS
     missing = [n for n in scenes.NEEDED_SCENARIOS if not (folder / f"{n}.yaml").is_file()]
-    if missing and set(parts) - {"scaling", "peers"}:
+    if missing and set(parts) - {"scaling", "peers", "exact"}:
         print(
             f"collide2d bench: error: {folder} lacks {missing[0]}.yaml; point "
             "--scenarios at the project's scenarios/ folder",
@@ -87,6 +90,12 @@ def cmd_bench(args: argparse.Namespace) -> int:
         rows += skips.skips(quick, echo, folder)
     if "targets" in parts:
         rows += targets.targets(quick, echo, folder)
+    if "paper" in parts:
+        rows += paper.paper(quick, echo, folder)
+    if "exact" in parts:
+        rows += exact.exact(quick, echo)
+    if "raster" in parts:
+        rows += raster.raster(quick, echo, folder)
     seconds = time.perf_counter() - began
     target.mkdir(parents=True, exist_ok=True)
     args_line = "collide2d bench " + " ".join(sys.argv[2:]) if len(sys.argv) > 1 else "bench"
@@ -108,9 +117,10 @@ def register(subparsers) -> None:
         description="Benchmark the models: the standard scene at several N (steps/s through "
         "`collide2d run`, events/s, time per stage), the benchmark scenarios at a ladder of fps "
         "and substeps against the exact model (run time against error, Pareto plot), what each "
-        "skip saves, and the section IV targets; with --peers, pymunk on the same scene. Writes "
-        "OUT/bench/bench.csv, bench.md and, with matplotlib, scaling.png and "
-        "runtime_vs_error.png.",
+        "skip saves, and the section IV targets; with --peers, pymunk on the same scene; with "
+        "--part, also the paper model three ways, the exact model's events/s and the drawing and "
+        "writing of frames. Writes OUT/bench/bench.csv, bench.md and, with matplotlib, "
+        "scaling.png and runtime_vs_error.png.",
     )
     p.add_argument("--out", default="out", metavar="DIR", help="output folder (default: out)")
     p.add_argument("--quick", action="store_true", help="small and short everything (seconds)")
@@ -119,7 +129,7 @@ def register(subparsers) -> None:
         "--part",
         action="append",
         choices=PARTS,
-        help="run only this part (repeat; default: all but peers)",
+        help="run only this part (repeat; default: scaling, error, skips, targets)",
     )
     p.add_argument(
         "--n", action="append", type=_positive, metavar="N", help="scaling at this N (repeat)"

@@ -18,6 +18,12 @@ from collide2d.runner.bench.scenes import (
     STANDARD_SPEEDS,
 )
 
+# The parts whose rows are one figure each (`value`, described by `note`), and their titles.
+FIGURE_PARTS = {
+    "paper": "Paper model: the section IV demo",
+    "exact": "Exact model: events per second",
+    "raster": "Drawing and writing frames",
+}
 COLUMNS = (
     "part",
     "scene",
@@ -179,6 +185,13 @@ def markdown(rows: list[dict], args_line: str, seconds: float) -> str:
         header = ["skip", "scene", "with s", "without s", "saving"]
         keys = ["note", "scene", "with_s", "without_s", "saving"]
         lines += _table(header, [[r.get(k) for k in keys] for r in part]) + [""]
+    for name, title in FIGURE_PARTS.items():
+        part = [r for r in rows if r["part"] == name]
+        if part:
+            lines += [f"## {title}", ""]
+            header = ["what", "scene", "N", "figure"]
+            keys = ["note", "scene", "n", "value"]
+            lines += _table(header, [[r.get(k) for k in keys] for r in part]) + [""]
     return "\n".join(lines) + "\n"
 
 

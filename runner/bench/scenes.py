@@ -61,3 +61,20 @@ def standard_scene(n: int, model: str, ticks: int = 1) -> str:
         f"speed: {{min: {lo}, max: {hi}}}, seed: {STANDARD_SEED}}}\n"
         "output: {frames: none, gif: false, events: false}\n"
     )
+
+
+def chain_scene(ticks: int = 1) -> str:
+    """The two-body chain of the exact part, as scenario text: boxes of masses 1 and 3 bouncing
+    between each other and the walls of a 320x240 world at 1e5 px/s, 10 fps."""
+    return (
+        "version: 1\n"
+        "name: two-body-chain\n"
+        "description: The two-body chain of collide2d bench, many events per tick.\n"
+        "world: {width: 320, height: 240, fps: 10}\n"
+        "model: exact\n"
+        f"ticks: {ticks}\n"
+        "objects:\n"
+        "  - {shape: box, size: 10, position: [50, 115], velocity: [100000, 0], mass: 1}\n"
+        "  - {shape: box, size: 10, position: [200, 115], velocity: [-150000, 0], mass: 3}\n"
+        "output: {frames: none, gif: false, events: false}\n"
+    )
