@@ -90,4 +90,3 @@ class Bodies:
             vert_start=np.zeros(n + 1, np.int64),
             verts=np.zeros((0, 2), np.int64),
         )
-
