@@ -70,7 +70,8 @@ SHIFTS_PER_OBJECT = 8
 # crossing (~1e-12 px) can never hide a touching neighbour two cells away.
 CELL_MARGIN = 1.01
 # Aim for about this many moving objects per cell when they are sparse: larger cells mean fewer
-# cell crossings but more neighbours to test. Tuned on benchmarks/bench_exact.py (10,000 boxes).
+# cell crossings but more neighbours to test. Tuned on a gas of 10,000 boxes (`collide2d bench
+# --part exact`).
 TARGET_PER_CELL = 0.6
 # The grid never has more cells than this per moving object (and at least one cell).
 MAX_CELLS_PER_OBJECT = 4

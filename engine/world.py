@@ -90,24 +90,3 @@ class Bodies:
             vert_start=np.zeros(n + 1, np.int64),
             verts=np.zeros((0, 2), np.int64),
         )
-
-
-def kinetic_energy(mass: np.ndarray, static: np.ndarray, vel: np.ndarray) -> float:
-    """Total kinetic energy, sum of m|v|^2/2 over movable objects (px^2/s^2 per unit mass).
-
-    Finite for every scenario the loader accepts (its mass and speed bounds see to it); a velocity
-    past about 1e154 px/s would give inf, returned without a floating-point warning for the caller
-    to judge. Never -0.0.
-    """
-    m = np.where(static, 0.0, mass)
-    with np.errstate(over="ignore", invalid="ignore"):
-        return float(0.5 * np.sum(m * np.einsum("ij,ij->i", vel, vel))) + 0.0
-
-
-def momentum(mass: np.ndarray, static: np.ndarray, vel: np.ndarray) -> tuple[float, float]:
-    """Total momentum (px/s per unit mass) over movable objects; finite like `kinetic_energy`,
-    never -0.0."""
-    m = np.where(static, 0.0, mass)
-    with np.errstate(over="ignore", invalid="ignore"):
-        p = (m[:, None] * vel).sum(axis=0)
-    return float(p[0]) + 0.0, float(p[1]) + 0.0

@@ -1,10 +1,11 @@
 """The `collide2d` command line (also `python -m collide2d`): parse, dispatch, map errors to exits.
 
 Each subcommand lives with what it drives (`run` here; `validate`/`schema` in runner.validate;
-`check`/`bless` in runner.golden.cli) and registers itself on the parser. Exit status: 0 fine,
-1 a check found a difference, 2 bad input or usage, 3 an unexpected error (one line naming the
-scenario; the traceback too with `--debug`). A refused scenario prints
-`FILE:LINE:COL: error: MESSAGE` on stderr and writes nothing.
+`check`/`bless` in runner.golden.cli; `stress` and `bench` in runner.stress.cli and
+runner.bench.cli, which load the rest of their packages only when their command runs) and registers
+itself on the parser. Exit status: 0 fine, 1 a check found a difference, 2 bad input or usage, 3 an
+unexpected error (one line naming the scenario; the traceback too with `--debug`). A refused
+scenario prints `FILE:LINE:COL: error: MESSAGE` on stderr and writes nothing.
 """
 
 from __future__ import annotations
@@ -15,7 +16,8 @@ import traceback
 from importlib import resources
 
 from collide2d.engine.models import ModelUnavailable
-from collide2d.runner import bench, stress, validate
+from collide2d.runner import validate
+from collide2d.runner.bench import cli as bench_cli
 from collide2d.runner.golden import cli as golden_cli
 from collide2d.runner.options import (
     add_cap_argument,
@@ -27,6 +29,7 @@ from collide2d.runner.options import (
 )
 from collide2d.runner.run import RunOptions, RunStopped, run_to_dir
 from collide2d.runner.scenario import ScenarioError, load
+from collide2d.runner.stress import cli as stress_cli
 
 EXIT_OK = 0
 EXIT_DIFFERENCE = 1
@@ -114,8 +117,8 @@ def build_parser() -> argparse.ArgumentParser:
     register_run(subparsers)
     golden_cli.register(subparsers)
     validate.register(subparsers)
-    stress.register(subparsers)
-    bench.register(subparsers)
+    stress_cli.register(subparsers)
+    bench_cli.register(subparsers)
     for sub in subparsers.choices.values():
         sub.add_argument(
             "--debug", action="store_true", help="print the traceback of an unexpected error"

@@ -27,8 +27,8 @@ import numpy as np
 from collide2d.engine import models
 from collide2d.engine.errors import Runaway
 from collide2d.engine.events import empty_events
+from collide2d.engine.invariants import kinetic_energy, momentum
 from collide2d.engine.raster import Renderer
-from collide2d.engine.world import kinetic_energy, momentum
 from collide2d.runner import budget, outputs, rundir
 from collide2d.runner.frames import FrameRule
 from collide2d.runner.limits import Limits

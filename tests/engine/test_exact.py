@@ -27,10 +27,11 @@ from collide2d.engine.events import (
     SIDE_RIGHT,
     SIDE_TOP,
 )
+from collide2d.engine.invariants import kinetic_energy
 from collide2d.engine.models import exact as exact_model
 from collide2d.engine.models import make
 from collide2d.engine.models.exact import MAX_EVENTS_PER_TICK, EventCapExceeded
-from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies, WorldSpec, kinetic_energy
+from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies, WorldSpec
 
 # --- helpers --------------------------------------------------------------------------------------
 

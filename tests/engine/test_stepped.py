@@ -9,9 +9,10 @@ from hypothesis import strategies as st
 
 from collide2d.engine.contact import box_overlap_axis
 from collide2d.engine.events import AXIS_NAMES, EV_PAIR, EV_WALL, SIDE_LEFT, SIDE_RIGHT
+from collide2d.engine.invariants import kinetic_energy, momentum
 from collide2d.engine.models import make
 from collide2d.engine.response import exchange, fold, separate
-from collide2d.engine.world import KIND_CIRCLE, Bodies, WorldSpec, kinetic_energy, momentum
+from collide2d.engine.world import KIND_CIRCLE, Bodies, WorldSpec
 
 
 def boxes_overlap(pos, size):

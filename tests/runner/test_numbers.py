@@ -26,7 +26,8 @@ import yaml
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
-from collide2d.engine.world import Bodies, kinetic_energy, momentum
+from collide2d.engine.invariants import kinetic_energy, momentum
+from collide2d.engine.world import Bodies
 from collide2d.runner import run as run_module
 from collide2d.runner import yamlsafe
 from collide2d.runner.cli import main

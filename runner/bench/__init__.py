@@ -1,0 +1,44 @@
+"""The `bench` command: how fast each model runs, and how far from the reference it lands.
+
+Input: the command line (`collide2d bench [--quick] [--peers] [--part P] [--n N] [--out DIR]`),
+the benchmark scenarios `scenarios/bench_*.yaml` and the standard scene built here. Output, under
+`OUT/bench/` (each file written whole through a temporary name): `bench.csv` (one row per
+measurement, the columns of `report.COLUMNS`), `bench.md` (the same as tables, with the headline
+ratios first) and, when matplotlib is installed (the optional `plot` extra), `scaling.png` and
+`runtime_vs_error.png`. Progress goes to stderr unless `--quiet`; the headline table to stdout.
+
+The parts, each selectable with `--part`:
+- scaling: the standard scene (N boxes 10x10 px covering 5 % of a 4:3 world, speeds 10-100 px/s in
+  random directions, 60 fps, seed 1) under each model at each N: steps/s measured through
+  `collide2d run` as a user runs it, in a subprocess, start-up excluded by subtracting a 1-tick run
+  (`--in-process` times `runner.run.drive` instead, the same way); body-steps/s; events/s (events
+  per tick of a logged run times steps/s); the time per step of each stage (move, broad phase,
+  narrow phase, response, from `Model.profile`, where the model has stages) and the time to
+  render one frame.
+- error: each benchmark scenario under each model at a ladder of fps and substeps, against the
+  exact model at the scenario's fps: run time, missed collisions (per pair, collisions of the
+  reference the run does not have), collision-count error (pair events of the run minus the
+  reference's), kinetic energy drift (relative), largest penetration (the deepest box overlap at a
+  tick's end, px) and position error over a short horizon (mean distance to the reference
+  HORIZON_S seconds after the reference's first collision, px; long horizons are chaotic). A row
+  is on the Pareto front when no other row of its scenario is both faster and closer.
+- peers: with `--peers` and pymunk installed (the optional `bench` extra), pymunk steps the same
+  standard scene in the same run (`pymunk_steps_per_second`), and the stepped model's ratio to it
+  is printed.
+- skips: for each thing a run skips when a scene does not need it, the same work with and
+  without the skip, and the saving (time without / time with).
+- targets: the paper's section IV demo headless (ticks/s through the model's `advance`) and the
+  wall time of `collide2d run` on a small scenario once kernels are cached.
+- paper, exact, raster (only when asked for with `--part`): the paper model on the section IV demo
+  headless with and without the event log and through `runner.run.drive`; the exact model's
+  events/s on a two-body chain and on the standard scene; `Renderer.draw` frames/s, a GIF's and a
+  PNG frame's time on the section IV demo's boxes.
+
+One module per concept: `scenes` (the standard scene and where the benchmark scenarios are),
+`timing` (how a run is timed), one module per part (`scaling`, `peers`, `error`, `skips`,
+`targets`, `paper`, `exact`, `raster`), `report` (bench.csv and bench.md), `plots` (the PNG plots)
+and `cli` (the subcommand; it loads the parts only when `collide2d bench` runs).
+
+Quote ratios from one run: absolute times move with the machine and its load. `--quick` shrinks
+every part (small N, short runs, one repeat, in-process timing) to a few seconds, for tests.
+"""

@@ -1,0 +1,157 @@
+"""The `bench` subcommand: its arguments, and the run that drives the parts and writes the report.
+
+`register` adds the subcommand without loading the parts; `cmd_bench` loads them when
+`collide2d bench` runs, runs the parts asked for (default: all but peers) and writes
+OUT/bench/bench.csv, bench.md and the plots. Exit status: 0, or 2 on bad input (a scenarios folder
+without the benchmark scenarios, a report folder that is a symbolic link).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from collide2d.engine import models
+
+EXIT_OK = 0
+EXIT_BAD_INPUT = 2
+
+PARTS = ("scaling", "error", "peers", "skips", "targets", "paper", "exact", "raster")
+DEFAULT_PARTS = ("scaling", "error", "skips", "targets")
+REPORT_DIR = "bench"
+
+
+def cmd_bench(args: argparse.Namespace) -> int:
+    from collide2d.runner import outputs
+    from collide2d.runner.bench import (
+        error,
+        exact,
+        paper,
+        peers,
+        plots,
+        raster,
+        report,
+        scaling,
+        scenes,
+        skips,
+        targets,
+        timing,
+    )
+
+    parts = tuple(dict.fromkeys(args.part)) if args.part else DEFAULT_PARTS
+    if args.peers and "peers" not in parts:
+        parts += ("peers",)
+    quick = args.quick
+    ns = args.n or list(scaling.QUICK_N if quick else scaling.SCALING_N)
+    models_ = args.model or list(models.MODEL_NAMES)
+    in_process = args.in_process or quick
+    folder = Path(args.scenarios) if args.scenarios else scenes.PROJECT_SCENARIOS
+    missing = [n for n in scenes.NEEDED_SCENARIOS if not (folder / f"{n}.yaml").is_file()]
+    if missing and set(parts) - {"scaling", "peers", "exact"}:
+        print(
+            f"collide2d bench: error: {folder} lacks {missing[0]}.yaml; point "
+            "--scenarios at the project's scenarios/ folder",
+            file=sys.stderr,
+        )
+        return EXIT_BAD_INPUT
+    target = Path(args.out) / REPORT_DIR
+    if target.is_symlink():
+        print(f"collide2d bench: error: {target} is a symbolic link", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    echo = timing.Echo(args.quiet)
+    began = time.perf_counter()
+    rows: list[dict] = []
+    if "scaling" in parts:
+        rows += scaling.scaling(models_, ns, quick, in_process, echo)
+    if "peers" in parts:
+        if peers.pymunk_available():
+            ours = {
+                r["n"]: r["steps_per_s"]
+                for r in rows
+                if r["part"] == "scaling" and r["model"] == "stepped"
+            }
+            missing = [n for n in ns if n not in ours]
+            if missing:
+                extra = scaling.scaling(["stepped"], missing, quick, in_process, echo)
+                ours.update({r["n"]: r["steps_per_s"] for r in extra})
+                rows += extra
+            rows += peers.peers(ns, ours, quick, echo)
+        else:
+            print(
+                "collide2d bench: pymunk is not installed (pip install 'collide2d[bench]'); "
+                "no peers",
+                file=sys.stderr,
+            )
+    if "error" in parts:
+        rows += error.error_ladder(scenes.BENCH_SCENARIOS, models_, quick, echo, folder)
+    if "skips" in parts:
+        rows += skips.skips(quick, echo, folder)
+    if "targets" in parts:
+        rows += targets.targets(quick, echo, folder)
+    if "paper" in parts:
+        rows += paper.paper(quick, echo, folder)
+    if "exact" in parts:
+        rows += exact.exact(quick, echo)
+    if "raster" in parts:
+        rows += raster.raster(quick, echo, folder)
+    seconds = time.perf_counter() - began
+    target.mkdir(parents=True, exist_ok=True)
+    args_line = "collide2d bench " + " ".join(sys.argv[2:]) if len(sys.argv) > 1 else "bench"
+    outputs.atomic_write_text(target / "bench.csv", report.csv_text(rows))
+    outputs.atomic_write_text(target / "bench.md", report.markdown(rows, args_line, seconds))
+    written = ["bench.csv", "bench.md"] + plots.plots(rows, target)
+    if not args.quiet:
+        for what, figure in report.headline(rows):
+            print(f"{figure:>14}  {what}")
+        print(f"bench: {len(rows)} rows in {seconds:.1f}s -> {target} ({', '.join(written)})")
+    return EXIT_OK
+
+
+def register(subparsers) -> None:
+    """Add the `bench` subcommand to an argparse subparsers object."""
+    p = subparsers.add_parser(
+        "bench",
+        help="run time against error; scaling; pymunk as a peer; what the skips save",
+        description="Benchmark the models: the standard scene at several N (steps/s through "
+        "`collide2d run`, events/s, time per stage), the benchmark scenarios at a ladder of fps "
+        "and substeps against the exact model (run time against error, Pareto plot), what each "
+        "skip saves, and the section IV targets; with --peers, pymunk on the same scene; with "
+        "--part, also the paper model three ways, the exact model's events/s and the drawing and "
+        "writing of frames. Writes OUT/bench/bench.csv, bench.md and, with matplotlib, "
+        "scaling.png and runtime_vs_error.png.",
+    )
+    p.add_argument("--out", default="out", metavar="DIR", help="output folder (default: out)")
+    p.add_argument("--quick", action="store_true", help="small and short everything (seconds)")
+    p.add_argument("--peers", action="store_true", help="also time pymunk (the `bench` extra)")
+    p.add_argument(
+        "--part",
+        action="append",
+        choices=PARTS,
+        help="run only this part (repeat; default: scaling, error, skips, targets)",
+    )
+    p.add_argument(
+        "--n", action="append", type=_positive, metavar="N", help="scaling at this N (repeat)"
+    )
+    p.add_argument(
+        "--model", action="append", choices=models.MODEL_NAMES, help="only this model (repeat)"
+    )
+    p.add_argument(
+        "--in-process",
+        action="store_true",
+        help="time runs through runner.run.drive in this process instead of `collide2d run`",
+    )
+    p.add_argument(
+        "--scenarios",
+        metavar="DIR",
+        help="folder of the benchmark scenarios (default: the project's scenarios/)",
+    )
+    p.add_argument("--quiet", action="store_true", help="no progress, no summary")
+    p.set_defaults(func=cmd_bench)
+
+
+def _positive(text: str) -> int:
+    from collide2d.runner.options import positive_int
+
+    return positive_int(text)

@@ -1,0 +1,123 @@
+"""The peers part of `collide2d bench`: pymunk steps the same standard scene (the `bench` extra).
+
+pymunk's space steps at 1/STANDARD_FPS s with boxes of mass 1 and infinite moment, elasticity 1,
+friction 0 and four static walls; the better of its bounding-box tree and its spatial hash is kept,
+and the stepped model's steps/s from the scaling part is divided by pymunk's.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+from collide2d.runner.bench.scenes import STANDARD_FPS, STANDARD_SIZE_PX, standard_scene
+from collide2d.runner.bench.timing import PROBE_S, QUICK_TARGET_S, REPEATS, TARGET_S, median
+
+# pymunk's spatial hash gets cells of this many box sides and this many cells per object.
+PYMUNK_HASH_SIDES = 2.0
+PYMUNK_HASH_CELLS_PER_OBJECT = 10
+PYMUNK_WARMUP_STEPS = 10
+# The issue's target (stepped at least 5x pymunk's steps/s) is for N = 1,000 and up.
+PEER_TARGET_MIN_N = 1_000
+
+
+def pymunk_available() -> bool:
+    try:
+        import pymunk  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def _pymunk_space(scenario, hashed: bool):
+    """The standard scene as a pymunk space: boxes of mass 1 and infinite moment (no rotation),
+    elasticity 1, friction 0, four static walls, no gravity."""
+    import pymunk
+
+    space = pymunk.Space()
+    space.gravity = (0.0, 0.0)
+    n = scenario.bodies.n
+    if hashed:
+        space.use_spatial_hash(
+            PYMUNK_HASH_SIDES * STANDARD_SIZE_PX, max(1000, PYMUNK_HASH_CELLS_PER_OBJECT * n)
+        )
+    w, h = scenario.world.width, scenario.world.height
+    corners = ((0, 0), (w, 0), (w, h), (0, h))
+    for k in range(4):
+        wall = pymunk.Segment(space.static_body, corners[k], corners[(k + 1) % 4], 0.0)
+        wall.elasticity = 1.0
+        wall.friction = 0.0
+        space.add(wall)
+    b = scenario.bodies
+    for (x, y), (bw, bh), (vx, vy) in zip(
+        b.pos.tolist(), b.size.tolist(), b.vel.tolist(), strict=True
+    ):
+        body = pymunk.Body(1.0, math.inf)
+        body.position = (x + bw / 2, y + bh / 2)
+        body.velocity = (vx, vy)
+        shape = pymunk.Poly.create_box(body, (bw, bh))
+        shape.elasticity = 1.0
+        shape.friction = 0.0
+        space.add(body, shape)
+    return space
+
+
+def pymunk_steps_per_second(n: int, target: float, repeats: int) -> tuple[float, str]:
+    """pymunk's steps/s on the standard scene with n boxes, the median of `repeats` timed runs of
+    about `target` s after a warm-up; the better of its default tree and its spatial hash."""
+    from collide2d.runner.scenario import loads
+
+    scenario = loads(standard_scene(n, "stepped"))
+    dt = 1.0 / STANDARD_FPS
+    best, how = 0.0, ""
+    for hashed in (False, True):
+        space = _pymunk_space(scenario, hashed)
+        for _ in range(PYMUNK_WARMUP_STEPS):
+            space.step(dt)
+        began = time.perf_counter()
+        steps = 0
+        while time.perf_counter() - began < min(target, PROBE_S) or steps < 2:
+            space.step(dt)
+            steps += 1
+        per = (time.perf_counter() - began) / steps
+        ticks = max(2, int(target / per))
+        rates = []
+        for _ in range(repeats):
+            began = time.perf_counter()
+            for _ in range(ticks):
+                space.step(dt)
+            rates.append(ticks / (time.perf_counter() - began))
+        rate = median(rates)
+        if rate > best:
+            best, how = rate, "spatial hash" if hashed else "bounding-box tree"
+    return best, how
+
+
+def peers(ns: list[int], ours: dict[int, float], quick: bool, echo) -> list[dict]:
+    """pymunk on the standard scene at each N, and the stepped model's ratio to it (`ours`: the
+    stepped model's steps/s by N, from this run's scaling part)."""
+    import pymunk
+
+    rows = []
+    target = QUICK_TARGET_S if quick else TARGET_S / 2
+    repeats = 1 if quick else REPEATS
+    for n in ns:
+        rate, how = pymunk_steps_per_second(n, target, repeats)
+        row = {
+            "part": "peers",
+            "scene": "standard",
+            "model": f"pymunk {pymunk.version}",
+            "n": n,
+            "fps": STANDARD_FPS,
+            "steps_per_s": rate,
+            "body_steps_per_s": rate * n,
+            "ns_per_body_step": 1e9 / (rate * n),
+            "peer_steps_per_s": rate,
+            "note": how,
+        }
+        if n in ours:
+            row["ratio"] = ours[n] / rate
+        rows.append(row)
+        said = f", stepped/pymunk = {row['ratio']:.2f}" if "ratio" in row else ""
+        echo(f"peers    pymunk  n={n:<7d} {rate:12,.1f} steps/s ({how}){said}")
+    return rows

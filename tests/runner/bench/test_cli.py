@@ -1,0 +1,51 @@
+"""`collide2d bench`: a tiny run of a part (`--quick`, small N) through the command line, peers
+without pymunk, and a scenarios folder that lacks the benchmark scenarios."""
+
+from __future__ import annotations
+
+import csv
+import math
+
+from collide2d.runner.bench import peers
+from collide2d.runner.cli import main
+
+
+def rows_of(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def test_quick_scaling_through_the_command_line_writes_csv_and_markdown(tmp_path, capsys):
+    code = main(
+        ["bench", "--quick", "--part", "scaling", "--n", "40", "--model", "stepped"]
+        + ["--model", "paper", "--out", str(tmp_path)]
+    )
+    assert code == 0
+    folder = tmp_path / "bench"
+    rows = rows_of(folder / "bench.csv")
+    assert [(r["part"], r["model"], r["n"]) for r in rows] == [
+        ("scaling", "stepped", "40"),
+        ("scaling", "paper", "40"),
+    ]
+    for r in rows:
+        steps = float(r["steps_per_s"])
+        assert steps > 0 and math.isclose(float(r["body_steps_per_s"]), 40 * steps, rel_tol=1e-5)
+        assert float(r["move_ms"]) >= 0 and float(r["render_ms"]) > 0
+    md = (folder / "bench.md").read_text()
+    assert "## Scaling: the standard scene" in md and "| stepped | 40 |" in md
+    assert "bench: 2 rows" in capsys.readouterr().out
+
+
+def test_peers_without_pymunk_say_so_and_still_succeed(tmp_path, monkeypatch, capsys):
+    monkeypatch.setattr(peers, "pymunk_available", lambda: False)
+    code = main(["bench", "--quick", "--part", "peers", "--out", str(tmp_path), "--quiet"])
+    assert code == 0
+    assert "pymunk is not installed" in capsys.readouterr().err
+    assert (tmp_path / "bench" / "bench.csv").exists()
+
+
+def test_a_folder_without_the_benchmark_scenarios_is_refused(tmp_path, capsys):
+    code = main(["bench", "--quick", "--part", "error", "--scenarios", str(tmp_path)])
+    assert code == 2
+    assert "lacks bench_tunnelling.yaml" in capsys.readouterr().err
+    assert not (tmp_path / "bench").exists()

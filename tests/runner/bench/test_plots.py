@@ -1,0 +1,30 @@
+"""runner.bench.plots: written with matplotlib, skipped without it."""
+
+from __future__ import annotations
+
+import sys
+
+import pytest
+
+from collide2d.runner.bench import plots
+
+
+def test_without_matplotlib_the_csv_and_markdown_still_come_out(tmp_path, monkeypatch):
+    monkeypatch.setitem(sys.modules, "matplotlib", None)
+    rows = [{"part": "error", "scene": "s", "model": "exact", "run_time_s": 0.1}]
+    assert plots.plots(rows, tmp_path) == []
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_plots_are_written_with_matplotlib(tmp_path):
+    pytest.importorskip("matplotlib")
+    rows = [
+        {"part": "scaling", "model": "stepped", "n": 50, "steps_per_s": 100.0},
+        {"part": "scaling", "model": "stepped", "n": 500, "steps_per_s": 10.0},
+        {"part": "error", "scene": "s", "model": "exact", "run_time_s": 0.1,
+         "position_error_px": 0.0, "pareto": "yes"},
+        {"part": "error", "scene": "s", "model": "paper", "run_time_s": 0.01,
+         "position_error_px": 3.0, "pareto": "yes"},
+    ]  # fmt: skip
+    assert plots.plots(rows, tmp_path) == ["scaling.png", "runtime_vs_error.png"]
+    assert (tmp_path / "runtime_vs_error.png").read_bytes()[:4] == b"\x89PNG"
