@@ -18,6 +18,7 @@ from importlib import resources
 from collide2d.engine.models import ModelUnavailable
 from collide2d.runner import validate
 from collide2d.runner.bench import cli as bench_cli
+from collide2d.runner.exitcodes import EXIT_BAD_INPUT, EXIT_OK, EXIT_UNEXPECTED
 from collide2d.runner.golden import cli as golden_cli
 from collide2d.runner.options import (
     add_cap_argument,
@@ -30,11 +31,6 @@ from collide2d.runner.options import (
 from collide2d.runner.run import RunOptions, RunStopped, run_to_dir
 from collide2d.runner.scenario import ScenarioError, load
 from collide2d.runner.stress import cli as stress_cli
-
-EXIT_OK = 0
-EXIT_DIFFERENCE = 1
-EXIT_BAD_INPUT = 2
-EXIT_UNEXPECTED = 3
 
 
 def demo_path() -> str:

@@ -66,6 +66,7 @@ import yaml
 
 from collide2d.engine.models import MODEL_NAMES
 from collide2d.engine.models.exact import MAX_EVENTS_PER_TICK, no_room, no_room_message
+from collide2d.engine.shapes import GEOMETRIES
 from collide2d.engine.world import Bodies, WorldSpec
 from collide2d.runner import assemble
 from collide2d.runner import yamlsafe as ys
@@ -162,7 +163,6 @@ MAX_EVENT_CAP = 2**53
 MAX_NAME_LENGTH = 100  # characters in a scenario name (it names a folder)
 NAME_PATTERN = r"[a-z0-9_-][a-z0-9._-]*"  # scenario names; never "." or "..", never a path
 NAME_FOR_TEXT = "scenario"  # the name of a scenario read from text without one
-GEOMETRIES = ("box", "exact")
 
 _NAME_RE = re.compile(NAME_PATTERN + r"\Z")
 

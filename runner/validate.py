@@ -14,6 +14,7 @@ import argparse
 import json
 import sys
 
+from collide2d.runner.exitcodes import EXIT_BAD_INPUT, EXIT_OK
 from collide2d.runner.options import (
     add_limit_arguments,
     add_override_arguments,
@@ -22,9 +23,6 @@ from collide2d.runner.options import (
 )
 from collide2d.runner.scenario import ScenarioError, load
 from collide2d.runner.schema import json_schema
-
-EXIT_OK = 0
-EXIT_BAD_INPUT = 2
 
 
 def run_validate(args: argparse.Namespace) -> int:

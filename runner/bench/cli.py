@@ -14,9 +14,7 @@ import time
 from pathlib import Path
 
 from collide2d.engine import models
-
-EXIT_OK = 0
-EXIT_BAD_INPUT = 2
+from collide2d.runner.exitcodes import EXIT_BAD_INPUT, EXIT_OK
 
 PARTS = ("scaling", "error", "peers", "skips", "targets", "paper", "exact", "raster")
 DEFAULT_PARTS = ("scaling", "error", "skips", "targets")

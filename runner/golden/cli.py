@@ -24,6 +24,7 @@ import traceback
 from functools import partial
 from pathlib import Path
 
+from collide2d.runner.exitcodes import EXIT_BAD_INPUT, EXIT_DIFFERENCE, EXIT_OK, EXIT_UNEXPECTED
 from collide2d.runner.golden import bless_run, check_run, golden_frames, report, shown_path
 from collide2d.runner.golden.store import (
     GOLDENS_DIR,
@@ -36,14 +37,9 @@ from collide2d.runner.golden.store import (
     scenario_files,
 )
 
-EXIT_OK = 0
-EXIT_DIFFERENT = 1
-EXIT_USAGE = 2
-EXIT_UNEXPECTED = 3
-
 
 class _Usage(Exception):
-    """Bad input: the message goes to stderr and the command exits with EXIT_USAGE. `located`
+    """Bad input: the message goes to stderr and the command exits with EXIT_BAD_INPUT. `located`
     messages (a refused scenario's `FILE:LINE:COL: error: ...`) are printed as they are."""
 
     def __init__(self, message: str, *, located: bool = False):
@@ -52,7 +48,7 @@ class _Usage(Exception):
 
     def exit(self) -> int:
         print(str(self) if self.located else f"collide2d: error: {self}", file=sys.stderr)
-        return EXIT_USAGE
+        return EXIT_BAD_INPUT
 
 
 def default_load(path, **kwargs):
@@ -165,11 +161,11 @@ def check_command(args, *, load=default_load, simulate=default_simulate) -> int:
     failed = [o for o in outcomes if not o.ok]
     said = f", {errors} not checked (errors above)" if errors else ""
     print(f"{len(outcomes) - len(failed)} passed, {len(failed)} failed{said}")
-    return max(status, EXIT_DIFFERENT if failed else EXIT_OK)
+    return max(status, EXIT_DIFFERENCE if failed else EXIT_OK)
 
 
 def _scenario_failed(args, doing: str, path, scn, exc: Exception) -> int:
-    """Report what stopped one scenario on stderr; returns its exit status: EXIT_USAGE for a
+    """Report what stopped one scenario on stderr; returns its exit status: EXIT_BAD_INPUT for a
     refusal (a bad scenario or run, a link in the way), EXIT_UNEXPECTED for anything else (one
     line naming the scenario; the traceback too with --debug)."""
     if isinstance(exc, _refusals()):
@@ -177,7 +173,7 @@ def _scenario_failed(args, doing: str, path, scn, exc: Exception) -> int:
         if isinstance(exc, GoldenError):
             text = f"collide2d: error: {scn.name}: {text}"
         print(text, file=sys.stderr, flush=True)
-        return EXIT_USAGE
+        return EXIT_BAD_INPUT
     detail = " ".join(str(exc).split())[:300]
     print(
         f"collide2d: unexpected error while {doing} {scn.name} ({shown_path(path)}): "
@@ -229,7 +225,7 @@ def bless_command(args, *, load=default_load, simulate=default_simulate) -> int:
                 store.remove(name)
             except GoldenError as exc:
                 print(f"collide2d: error: {exc}", file=sys.stderr, flush=True)
-                status = max(status, EXIT_USAGE)
+                status = max(status, EXIT_BAD_INPUT)
                 continue
             print(f"{'removed':<9} {name}: no scenario uses it")
     elif not args.scenarios:

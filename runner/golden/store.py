@@ -36,6 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from collide2d.runner.golden import serialize as ser
+from collide2d.runner.scenario import NAME_PATTERN
 
 GOLDENS_DIR = "goldens"
 SCENARIOS_DIR = "scenarios"
@@ -46,7 +47,7 @@ TMP_SUFFIX = ".tmp"
 NEW, OLD = "new", "old"
 _LEFTOVER_RE = re.compile(r"(?P<pid>\d+)\.[0-9a-f]{8}\.(?P<kind>new|old)\.tmp")
 # A golden folder's name: a scenario name that cannot leave goldens/ or hide as a dot-folder.
-_NAME_RE = re.compile(r"[a-z0-9_-][a-z0-9._-]*")
+_NAME_RE = re.compile(NAME_PATTERN)
 # Values of CI that mean "not in CI".
 _CI_OFF = ("", "0", "false", "no")
 # The largest golden file read, in bytes (a golden folder stays within a few MB, SPEC §7).

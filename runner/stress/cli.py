@@ -12,10 +12,7 @@ import sys
 import time
 
 from collide2d.engine.models import MODEL_NAMES
-
-EXIT_OK = 0
-EXIT_BROKEN = 1
-EXIT_BAD_INPUT = 2
+from collide2d.runner.exitcodes import EXIT_BAD_INPUT, EXIT_DIFFERENCE, EXIT_OK
 
 
 def cmd_stress(args: argparse.Namespace) -> int:
@@ -66,7 +63,7 @@ def cmd_stress(args: argparse.Namespace) -> int:
             f"stress: {len(results)} cases, {len(broken)} failed, in {total:.1f}s -> "
             f"{target / 'report.md'}"
         )
-    return EXIT_BROKEN if broken else EXIT_OK
+    return EXIT_DIFFERENCE if broken else EXIT_OK
 
 
 def register(subparsers) -> None:
