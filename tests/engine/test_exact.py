@@ -30,7 +30,14 @@ from collide2d.engine.events import (
 from collide2d.engine.models import exact as exact_model
 from collide2d.engine.models import make
 from collide2d.engine.models.exact import MAX_EVENTS_PER_TICK, EventCapExceeded
-from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies, WorldSpec, kinetic_energy
+from collide2d.engine.world import (
+    KIND_BOX,
+    KIND_CIRCLE,
+    KIND_POLYGON,
+    Bodies,
+    WorldSpec,
+    kinetic_energy,
+)
 
 # --- helpers --------------------------------------------------------------------------------------
 
