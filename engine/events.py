@@ -4,6 +4,14 @@ A model's `advance()` returns a numpy array of `EVENT_DTYPE` records in the orde
 happened. `format_event` turns one record into the `events.jsonl` line of SPEC section 5, with
 floats written one fixed way (`format_number`) so that logs diff line by line and the same run gives
 the same bytes.
+
+The event log the models write while they run is one layout for all three: rows (k, 7) int64
+(columns ROW_TICK ... ROW_YDIFF: tick, type, a, b, code, xdiff, ydiff; xdiff/ydiff -1 but in the
+paper model) and times (k,) float64, the event's `t` (the paper model keeps no times: its `t` is
+the tick's end, tick / fps, given when the rows become records). `new_log` makes the buffers,
+`put_event` writes a row inside a kernel (the caller made room), `log_event` writes one and grows
+the buffers when full, `grown` doubles a buffer between kernel calls, and `event_records` turns
+the first n rows into EVENT_DTYPE records.
 """
 
 from __future__ import annotations
@@ -12,6 +20,7 @@ import json
 import math
 
 import numpy as np
+from numba import njit
 
 EV_WALL = 0
 EV_PAIR = 1
@@ -80,3 +89,72 @@ def event_dict(rec) -> dict:
 def format_event(rec) -> str:
     """The events.jsonl line (no newline) of one record: `{"tick": 6, "t": 0.6, ...}`."""
     return json.dumps(event_dict(rec))
+
+
+# --- the event log the models write ------------------------------------------------------------
+
+# Columns of the log's rows (int64).
+ROW_TICK, ROW_TYPE, ROW_A, ROW_B, ROW_CODE, ROW_XDIFF, ROW_YDIFF = range(7)
+ROW_COLUMNS = 7
+# Rows of a fresh log; it doubles when full.
+LOG_ROWS = 1024
+
+
+def new_log(log: bool = True, rows: int = LOG_ROWS) -> tuple[np.ndarray, np.ndarray]:
+    """Empty log buffers (rows (k, 7) int64, times (k,) float64); one row when `log` is False."""
+    k = rows if log else 1
+    return np.empty((k, ROW_COLUMNS), np.int64), np.empty(k)
+
+
+@njit(cache=True, inline="always")
+def put_row(rows, n, tick, kind, a, b, code, xdiff, ydiff):
+    """Write row n (the caller made room); returns n + 1."""
+    rows[n, ROW_TICK] = tick
+    rows[n, ROW_TYPE] = kind
+    rows[n, ROW_A] = a
+    rows[n, ROW_B] = b
+    rows[n, ROW_CODE] = code
+    rows[n, ROW_XDIFF] = xdiff
+    rows[n, ROW_YDIFF] = ydiff
+    return n + 1
+
+
+@njit(cache=True, inline="always")
+def put_event(rows, times, n, tick, t, kind, a, b, code):
+    """Write event n at time t (s; no xdiff/ydiff) (the caller made room); returns n + 1."""
+    times[n] = t
+    return put_row(rows, n, tick, kind, a, b, code, -1, -1)
+
+
+@njit(cache=True)
+def log_event(rows, times, n, tick, t, kind, a, b, code):
+    """Write event n, doubling the buffers first when full; returns the (rows, times) to use."""
+    if n >= rows.shape[0]:
+        more_rows = np.empty((max(2 * rows.shape[0], 16), ROW_COLUMNS), np.int64)
+        more_rows[:n] = rows[:n]
+        more_times = np.empty(more_rows.shape[0])
+        more_times[:n] = times[:n]
+        rows, times = more_rows, more_times
+    put_event(rows, times, n, tick, t, kind, a, b, code)
+    return rows, times
+
+
+def grown(a: np.ndarray, extra: int = 0) -> np.ndarray:
+    """a with twice its rows (and `extra` more), the old rows kept."""
+    out = np.empty((2 * a.shape[0] + extra,) + a.shape[1:], a.dtype)
+    out[: a.shape[0]] = a
+    return out
+
+
+def event_records(rows: np.ndarray, times: np.ndarray, n: int) -> np.ndarray:
+    """The first n logged events as EVENT_DTYPE records."""
+    out = np.zeros(n, dtype=EVENT_DTYPE)
+    out["tick"] = rows[:n, ROW_TICK]
+    out["t"] = times[:n]
+    out["type"] = rows[:n, ROW_TYPE]
+    out["a"] = rows[:n, ROW_A]
+    out["b"] = rows[:n, ROW_B]
+    out["code"] = rows[:n, ROW_CODE]
+    out["xdiff"] = rows[:n, ROW_XDIFF]
+    out["ydiff"] = rows[:n, ROW_YDIFF]
+    return out

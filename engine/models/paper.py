@@ -39,25 +39,35 @@ import time
 import numpy as np
 from numba import njit
 
-from collide2d.engine.broadphase import KEY_MASK, KEY_SHIFT, candidates, choose, sort_keys, workspace
+from collide2d.engine.broadphase import (
+    KEY_MASK,
+    KEY_SHIFT,
+    candidates,
+    choose,
+    sort_keys,
+    workspace,
+)
 from collide2d.engine.events import (
     AXIS_X,
     AXIS_XY,
     AXIS_Y,
     EV_PAIR,
     EV_WALL,
-    EVENT_DTYPE,
+    ROW_TICK,
     SIDE_BOTTOM,
     SIDE_LEFT,
     SIDE_RIGHT,
     SIDE_TOP,
+    event_records,
+    grown,
+    new_log,
+    put_row,
 )
 from collide2d.engine.motion import paper_rate
 from collide2d.engine.world import Bodies, WorldSpec
 
-# Columns of the kernel's event rows (int64); `t` is added in Python as tick / fps.
-_TICK, _TYPE, _A, _B, _CODE, _XDIFF, _YDIFF = range(7)
-_EVENT_COLS = 7
+# The kernel writes the event log of events.py without its times: `t` is added in Python as the
+# tick's end, tick / fps.
 # Room for events and candidate pairs before the buffers grow (rows; they double when full).
 _INITIAL_ROWS = 1024
 # The candidate list is made with every reach box grown by a margin (px) and kept until some object
@@ -78,20 +88,11 @@ _STAGE_MOVE, _STAGE_WALLS, _STAGE_PAIRS = range(3)
 # What a call of the kernel ends with: done, or stopped for more room (grow, call again).
 _DONE, _LOG_FULL, _KEYS_FULL = range(3)
 
+# The kernel allocates nothing and only touches arrays handed to it, so it is compiled without
+# numba's reference counting (`_nrt=False`, a private numba option; tests/engine/test_kernels.py
+# compiles every kernel that uses it, so an upgrade that drops it fails loudly): counting
+# references at every inlined helper took most of the run time on event-heavy scenes (~85 %).
 _kernel = njit(cache=True, _nrt=False)
-
-
-@njit(cache=True, inline="always")
-def _record(ev, n_ev, tick, kind, a, b, code, xdiff, ydiff):
-    """Write one event row at n_ev (the caller made room); returns the new count."""
-    ev[n_ev, _TICK] = tick
-    ev[n_ev, _TYPE] = kind
-    ev[n_ev, _A] = a
-    ev[n_ev, _B] = b
-    ev[n_ev, _CODE] = code
-    ev[n_ev, _XDIFF] = xdiff
-    ev[n_ev, _YDIFF] = ydiff
-    return n_ev + 1
 
 
 @njit(cache=True, inline="always")
@@ -134,7 +135,7 @@ def _walls(pos, room, step, disp, tick, log, ev, n_ev, st):
             disp[i, ax] = 0
             st[_S_WALLS] += 1
             if log:
-                n_ev = _record(ev, n_ev, tick, EV_WALL, i, -1, side, -1, -1)
+                n_ev = put_row(ev, n_ev, tick, EV_WALL, i, -1, side, -1, -1)
     return n_ev
 
 
@@ -198,7 +199,7 @@ def _pairs(pos, size, step, disp, near, n_near, tick, log, ev, n_ev, st):
                 disp[i, ax] = 0
         st[_S_PAIR_EVENTS] += 1
         if log:
-            n_ev = _record(ev, n_ev, tick, EV_PAIR, a, b, axis, xdiff, ydiff)
+            n_ev = put_row(ev, n_ev, tick, EV_PAIR, a, b, axis, xdiff, ydiff)
     return n_ev
 
 
@@ -284,7 +285,7 @@ class Model:
         self.movable = ~np.asarray(bodies.static, bool) if skip else np.ones(n, bool)
         limit = np.array([world.width, world.height], np.int64)
         self._room = np.ascontiguousarray(limit - self.size)
-        self._ev = np.empty((_INITIAL_ROWS, _EVENT_COLS), np.int64)
+        self._ev = new_log(True, _INITIAL_ROWS)[0]
         self._st = np.zeros(_S_SIZE, np.int64)
         self._st[_S_KEYS] = -1
         self._st[_S_PAIRS] = n >= 2 and (bool(self.movable.any()) or not skip)
@@ -327,11 +328,7 @@ class Model:
             if status == _DONE:
                 break
             if status == _LOG_FULL:
-                grown = np.empty(
-                    (2 * self._ev.shape[0] + 2 * self.pos.shape[0], _EVENT_COLS), np.int64
-                )
-                grown[: self._ev.shape[0]] = self._ev
-                self._ev = grown
+                self._ev = grown(self._ev, 2 * self.pos.shape[0])
             else:
                 rows = 2 * int(self._st[_S_NEEDED])
                 self._bp = (
@@ -340,7 +337,8 @@ class Model:
                     + self._bp[4:]
                 )
         self.tick = int(self._st[_S_TICK])
-        return _event_records(self._ev[: self._st[_S_EVENTS]], self.fps)
+        n = int(self._st[_S_EVENTS])
+        return event_records(self._ev, self._ev[:n, ROW_TICK] / self.fps, n)
 
     def event_counts(self) -> tuple[int, int]:
         """(wall events, pair events) so far, logged or not."""
@@ -431,17 +429,3 @@ def _rates(vel: np.ndarray, fps: int) -> tuple[np.ndarray, np.ndarray]:
     table = np.array([paper_rate(float(v), fps) for v in values], np.int64).reshape(-1, 2)
     rates = table[inverse.reshape(-1)].reshape(vel.shape[0], 2, 2)
     return rates[:, :, 0].copy(), rates[:, :, 1].copy()
-
-
-def _event_records(rows: np.ndarray, fps: int) -> np.ndarray:
-    """Kernel rows -> EVENT_DTYPE records, `t` = the tick's end time in seconds."""
-    out = np.zeros(rows.shape[0], EVENT_DTYPE)
-    out["tick"] = rows[:, _TICK]
-    out["t"] = rows[:, _TICK] / fps
-    out["type"] = rows[:, _TYPE]
-    out["a"] = rows[:, _A]
-    out["b"] = rows[:, _B]
-    out["code"] = rows[:, _CODE]
-    out["xdiff"] = rows[:, _XDIFF]
-    out["ydiff"] = rows[:, _YDIFF]
-    return out

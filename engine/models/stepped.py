@@ -24,7 +24,7 @@ objects are never listed, and with no movable object (or fewer than two objects)
 skipped; the `skip=False` option turns both skips off, and `broadphase` ("sweep", "grid",
 "cells") forces a method instead of the scene's choice (for tests and `collide2d bench`).
 
-The event log helpers (`log_event`, `event_records`) serve the exact model too.
+Events go to the one event log of events.py.
 """
 
 from __future__ import annotations
@@ -50,18 +50,18 @@ from collide2d.engine.contact import box_overlap_axis, penetration
 from collide2d.engine.events import (
     EV_PAIR,
     EV_WALL,
-    EVENT_DTYPE,
     SIDE_BOTTOM,
     SIDE_LEFT,
     SIDE_RIGHT,
     SIDE_TOP,
+    event_records,
+    log_event,
+    new_log,
 )
 from collide2d.engine.response import exchange, fold, separate
 from collide2d.engine.shapes import GEOMETRIES, build_cores
 from collide2d.engine.world import Bodies, WorldSpec
 
-# Rows of a fresh event buffer; it doubles when full.
-LOG_ROWS = 1024
 # The candidate list's margin, px: this many of the fastest object's step (|v|·dt), within
 # [MARGIN_MIN_PX, MARGIN_MAX_SIDES x the median box side]. A wider margin remakes the list less
 # often but lists more pairs; tuned on the standard scene of `collide2d bench`.
@@ -80,50 +80,6 @@ CANDIDATES_PER_OBJECT = 4
 # more than this many rows of the grid on average (a row holds about sqrt(n) objects in a
 # squarish world; see the kernels' section).
 REORDER_ROWS = 2.0
-
-
-# --- event log buffers (shared with the exact model) -------------------------------------------
-
-
-@njit(cache=True)
-def log_event(rows, times, n, tick, t, kind, a, b, code):
-    """Write event n into the buffers, doubling them when full; returns the (rows, times) to use.
-
-    rows (k, 5) int64: tick, type, a, b, code; times (k,) float64: t in seconds.
-    """
-    if n >= rows.shape[0]:
-        grown = np.empty((max(2 * rows.shape[0], 16), 5), np.int64)
-        grown[:n] = rows[:n]
-        grown_t = np.empty(grown.shape[0])
-        grown_t[:n] = times[:n]
-        rows, times = grown, grown_t
-    rows[n, 0] = tick
-    rows[n, 1] = kind
-    rows[n, 2] = a
-    rows[n, 3] = b
-    rows[n, 4] = code
-    times[n] = t
-    return rows, times
-
-
-def new_log(log: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Empty event buffers (rows, times) for one `advance`."""
-    k = LOG_ROWS if log else 1
-    return np.empty((k, 5), np.int64), np.empty(k)
-
-
-def event_records(rows: np.ndarray, times: np.ndarray, n: int) -> np.ndarray:
-    """The first n buffered events as an EVENT_DTYPE array (xdiff/ydiff -1: not the paper model)."""
-    out = np.zeros(n, dtype=EVENT_DTYPE)
-    out["tick"] = rows[:n, 0]
-    out["t"] = times[:n]
-    out["type"] = rows[:n, 1]
-    out["a"] = rows[:n, 2]
-    out["b"] = rows[:n, 3]
-    out["code"] = rows[:n, 4]
-    out["xdiff"] = -1
-    out["ydiff"] = -1
-    return out
 
 
 # --- the stages of one step ---------------------------------------------------------------------

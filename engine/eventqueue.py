@@ -1,0 +1,220 @@
+"""The exact model's event queue: a 4-ary heap of predicted events in preallocated arrays.
+
+An entry is a time (HT, float64), a key and the two invalidation counters its objects had when it
+was predicted (HI, int64), and a contact normal (HN, float64). Keys pack (rank, a, b, code) into
+one int64, so ties in time go as cell crossings, then walls by (id, side), then pairs by (a, b).
+An entry is stale once either object's counter (column CNT of N) has changed; stale entries are
+skipped when popped and dropped by `compact` when the heap is full. The heap's size is st[S_HEAP_N].
+Events closer in time than `instant(t)` are one instant (rounding, not physics, parts them) and
+`first_of_instant` takes them in key order. The caller makes sure there is room before a push
+(`has_room`); `grown` doubles an array between kernel calls.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from collide2d.engine.exactstate import CNT, S_HEAP_N, hot
+
+# Children per heap node: a 4-ary heap is half as deep as a binary one, and its four children
+# share a cache line.
+ARITY = 4
+
+
+# the contact normal (code and normal as contact.py gives them).
+HKEY, HCA, HCB = range(3)
+
+# Heap keys: rank, a, b (or a wall side / crossing direction) and contact code in one int64, so that
+# ties in time resolve as crossings, then walls by (id, side), then pairs by (a, b).
+RANK_CROSS = 0
+RANK_WALL = 1
+RANK_PAIR = 2
+ID_BITS = 25  # ids below 2**25 (33 million objects)
+ID_MASK = (1 << ID_BITS) - 1
+B_SHIFT = 4
+A_SHIFT = B_SHIFT + ID_BITS
+RANK_SHIFT = A_SHIFT + ID_BITS
+MAX_OBJECTS = 1 << ID_BITS
+
+
+# Events closer in time than max(INSTANT_S, INSTANT_REL·t) are one instant: what parts them is
+# rounding (a few units in the last place of t, or of a pixel coordinate over a speed), not
+# physics, so they go in key order. At most INSTANT_STACK entries of one instant are compared.
+INSTANT_S = 1e-12
+INSTANT_REL = 2.0**-46
+INSTANT_STACK = 1024
+
+# --- heap keys and entries ---------------------------------------------------------------------
+
+
+@hot
+def make_key(rank, a, b, code):
+    return (rank << RANK_SHIFT) | (a << A_SHIFT) | (b << B_SHIFT) | code
+
+
+@hot
+def split_key(key):
+    """(rank, a, b, code) of a heap key."""
+    return (
+        key >> RANK_SHIFT,
+        (key >> A_SHIFT) & ID_MASK,
+        (key >> B_SHIFT) & ID_MASK,
+        key & 15,
+    )
+
+
+@hot
+def is_valid(HI, i, N):
+    """Entry i is valid while its objects' counters are those it was predicted with."""
+    rank, a, b, _ = split_key(HI[i, HKEY])
+    if N[a, CNT] != HI[i, HCA]:
+        return False
+    return rank != RANK_PAIR or N[b, CNT] == HI[i, HCB]
+
+
+# --- the heap; the caller makes sure there is room before an event -----------------------------
+
+
+@hot
+def _earlier(HT, HI, i, t, key):
+    """Entry i comes strictly before (t, key)."""
+    return HT[i] < t or (HT[i] == t and HI[i, HKEY] < key)
+
+
+@hot
+def _put(HT, HI, HN, i, t, key, ca, cb, nx, ny):
+    HT[i] = t
+    HI[i, HKEY], HI[i, HCA], HI[i, HCB] = key, ca, cb
+    HN[i, 0], HN[i, 1] = nx, ny
+
+
+@hot
+def _move(HT, HI, HN, i, j):
+    """Entry j moves to slot i."""
+    _put(HT, HI, HN, i, HT[j], HI[j, HKEY], HI[j, HCA], HI[j, HCB], HN[j, 0], HN[j, 1])
+
+
+@hot
+def _sift_up(HT, HI, HN, i, t, key, ca, cb, nx, ny):
+    """Place an entry at hole i, moving it up past later parents."""
+    while i > 0:
+        p = (i - 1) // ARITY
+        if _earlier(HT, HI, p, t, key) or (HT[p] == t and HI[p, HKEY] == key):
+            break
+        _move(HT, HI, HN, i, p)
+        i = p
+    _put(HT, HI, HN, i, t, key, ca, cb, nx, ny)
+
+
+@hot
+def _sift_down(HT, HI, HN, n, i, t, key, ca, cb, nx, ny):
+    """Place an entry at hole i of a heap of n, moving it down past earlier children."""
+    while True:
+        first = ARITY * i + 1
+        if first >= n:
+            break
+        c = first
+        for m in range(first + 1, min(first + ARITY, n)):
+            if _earlier(HT, HI, m, HT[c], HI[c, HKEY]):
+                c = m
+        if not _earlier(HT, HI, c, t, key):
+            break
+        _move(HT, HI, HN, i, c)
+        i = c
+    _put(HT, HI, HN, i, t, key, ca, cb, nx, ny)
+
+
+@hot
+def push(HT, HI, HN, st, t, key, ca, cb, nx, ny):
+    """Add an entry (there is room)."""
+    n = st[S_HEAP_N]
+    st[S_HEAP_N] = n + 1
+    _sift_up(HT, HI, HN, n, t, key, ca, cb, nx, ny)
+
+
+@hot
+def pop(HT, HI, HN, st):
+    """Remove and return the earliest entry (t, key, ca, cb, nx, ny)."""
+    top = (HT[0], HI[0, HKEY], HI[0, HCA], HI[0, HCB], HN[0, 0], HN[0, 1])
+    n = st[S_HEAP_N] - 1
+    st[S_HEAP_N] = n
+    if n > 0:
+        _sift_down(HT, HI, HN, n, 0, HT[n], HI[n, HKEY], HI[n, HCA], HI[n, HCB], HN[n, 0], HN[n, 1])
+    return top
+
+
+@hot
+def remove(HT, HI, HN, st, k):
+    """Remove and return entry k (t, key, ca, cb, nx, ny); the last entry takes its place."""
+    entry = (HT[k], HI[k, HKEY], HI[k, HCA], HI[k, HCB], HN[k, 0], HN[k, 1])
+    n = st[S_HEAP_N] - 1
+    st[S_HEAP_N] = n
+    if k < n:
+        t, key, ca, cb, nx, ny = HT[n], HI[n, HKEY], HI[n, HCA], HI[n, HCB], HN[n, 0], HN[n, 1]
+        if k > 0 and not _earlier(HT, HI, (k - 1) // ARITY, t, key):
+            _sift_up(HT, HI, HN, k, t, key, ca, cb, nx, ny)
+        else:
+            _sift_down(HT, HI, HN, n, k, t, key, ca, cb, nx, ny)
+    return entry
+
+
+@hot
+def instant(t):
+    """Events closer to t than this (s) happen at one instant: rounding, not physics, parts them."""
+    return max(INSTANT_S, abs(t) * INSTANT_REL)
+
+
+@hot
+def first_of_instant(HT, HI, st, N, stack):
+    """The entry to take next: of the valid entries at the top's instant, the one with the
+    smallest key, so that simultaneous events go walls first, then pairs in (a, b) order,
+    whatever rounding did to their times. Those entries are the heap's top subtree of times
+    within the instant; `stack` is scratch for walking it."""
+    n = st[S_HEAP_N]
+    bound = HT[0] + instant(HT[0])
+    best = 0
+    sp = 0
+    for c in range(1, min(1 + ARITY, n)):
+        if HT[c] <= bound:
+            stack[sp] = c
+            sp += 1
+    while sp > 0:
+        sp -= 1
+        k = stack[sp]
+        if HI[k, HKEY] < HI[best, HKEY] and is_valid(HI, k, N):
+            best = k
+        for c in range(ARITY * k + 1, min(ARITY * k + 1 + ARITY, n)):
+            if HT[c] <= bound and sp < stack.shape[0]:
+                stack[sp] = c
+                sp += 1
+    return best
+
+
+@njit(cache=True)
+def compact(HT, HI, HN, st, N):
+    """Drop stale entries and rebuild the heap in place; returns the free room."""
+    keep = 0
+    for i in range(st[S_HEAP_N]):
+        if is_valid(HI, i, N):
+            _move(HT, HI, HN, keep, i)
+            keep += 1
+    for i in range((keep - 2) // ARITY, -1, -1):
+        _sift_down(
+            HT, HI, HN, keep, i, HT[i], HI[i, HKEY], HI[i, HCA], HI[i, HCB], HN[i, 0], HN[i, 1]
+        )
+    st[S_HEAP_N] = keep
+    return HT.shape[0] - keep
+
+
+@hot
+def has_room(room, HT, HI, HN, st, N):
+    """Whether `room` more entries fit, dropping stale entries first if they would not."""
+    return HT.shape[0] - st[S_HEAP_N] >= room or compact(HT, HI, HN, st, N) >= room
+
+
+def grown(a: np.ndarray) -> np.ndarray:
+    """a with twice the rows, the old rows kept."""
+    out = np.empty((2 * a.shape[0],) + a.shape[1:], a.dtype)
+    out[: a.shape[0]] = a
+    return out

@@ -1,0 +1,55 @@
+"""The exact model's state layout: the columns of its arrays, its scalar state, its statuses.
+
+The exact model (engine/models/exact.py) keeps its objects in two arrays, floats F (n, 8) and ints
+N (n, 8), and its counters in `st` (int64) and `stf` (float64); the event queue (eventqueue.py),
+the grid lists (cells.py) and the predictions (prediction.py) all read them by the names below.
+The `hot` and `kernel` decorators the exact model's kernels are compiled with live here too.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+# Columns of F (n, 8) float64: position (top-left, px) valid at the object's own clock TLOC (s),
+# velocity (px/s), box size (px), inverse mass (0 for static objects).
+X, Y, VX, VY, TLOC, SW, SH, INV_MASS = range(8)
+# Columns of N (n, 8) int64: invalidation counter, static flag, contact shape kind, grid cell,
+# next / previous object in that cell's list (-1 for none), last query stamp (static objects),
+# the partner of its last event if that was a pair (-1 otherwise).
+CNT, STATIC, SHAPE, CELL, NEXT, PREV, STAMP, PARTNER = range(8)
+
+# A prediction job (one row of `jobs`): the object, the partner to leave out (-1: none), and its
+# mode: JOB_EVENT (after an event of the object), JOB_FIRST (the first prediction: only static
+# objects and higher ids, each pair once), JOB_CONTACTS (only contacts, no horizon: the extra
+# predictions of `repredict="all"`).
+J_OBJ, J_SKIP, J_HIGHER = range(3)
+JOB_EVENT, JOB_FIRST, JOB_CONTACTS = range(3)
+# Rows of `jobs`: the (at most two) objects an event touched, and one for the extra predictions.
+JOB_ROWS = 3
+J_EXTRA = 2
+
+
+# Cell-crossing directions.
+DIR_LEFT, DIR_RIGHT, DIR_UP, DIR_DOWN = range(4)
+
+# Scalar state st (int64): heap size, ticks done, events in the current tick, query stamp, event
+# rows written in this `advance`, objects given their first prediction, wall events and pair
+# events so far (logged or not). stf (float64): the current time, s.
+S_HEAP_N, S_TICK, S_TICK_EVENTS, S_STAMP, S_LOGGED, S_FIRST, S_WALLS, S_PAIRS = range(8)
+SF_T_NOW = 0
+
+
+STATUS_DONE = 0
+STATUS_CAP = 1
+STATUS_HEAP_FULL = 2
+STATUS_LOG_FULL = 3
+
+INF = np.inf
+# Small helpers are inlined into the kernels (`hot`). The kernels (`kernel`) allocate nothing and
+# only touch arrays handed to them, so they are compiled without numba's reference counting
+# (`_nrt=False`, a private numba option; tests/engine/test_kernels.py compiles every kernel that
+# uses it, so an upgrade that drops it fails loudly): counting references to those arrays at every
+# inlined helper took ~85 % of the run time on event-heavy scenes.
+hot = njit(cache=True, inline="always")
+kernel = njit(cache=True, _nrt=False)

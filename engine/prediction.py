@@ -1,0 +1,186 @@
+"""The exact model's predictions: an object's next wall contact, cell crossing and contacts.
+
+A prediction job (a row of `jobs`, see exactstate.py) names an object; `predict` pushes its
+horizon (the first of its next wall contact and its next cell crossing) and its contacts with the
+objects in the 3×3 cells around it that come no later than the horizon. A pair is swept from the
+later of its two clocks (contact.next_contact), so a predicted time depends only on the pair's
+state.
+"""
+
+from __future__ import annotations
+
+from numba import njit
+
+from collide2d.engine.cells import C_HEAD
+from collide2d.engine.contact import box_next_contact, box_reach, next_contact
+from collide2d.engine.eventqueue import RANK_CROSS, RANK_PAIR, RANK_WALL, make_key, push
+from collide2d.engine.events import SIDE_BOTTOM, SIDE_LEFT, SIDE_RIGHT, SIDE_TOP
+from collide2d.engine.exactstate import (
+    CELL,
+    CNT,
+    DIR_DOWN,
+    DIR_LEFT,
+    DIR_RIGHT,
+    DIR_UP,
+    INF,
+    J_HIGHER,
+    J_OBJ,
+    J_SKIP,
+    JOB_CONTACTS,
+    JOB_FIRST,
+    NEXT,
+    S_STAMP,
+    SH,
+    SHAPE,
+    STAMP,
+    SW,
+    TLOC,
+    VX,
+    VY,
+    X,
+    Y,
+    hot,
+    kernel,
+)
+from collide2d.engine.world import KIND_BOX
+
+
+@hot
+def _wall_time(i, F, world):
+    """(t, side) of i's next wall contact (its box touching a wall line), (inf, -1) if none."""
+    t_best = INF
+    side = -1
+    if F[i, VX] > 0.0:
+        t_best, side = F[i, TLOC] + (world[0] - F[i, SW] - F[i, X]) / F[i, VX], SIDE_RIGHT
+    elif F[i, VX] < 0.0:
+        t_best, side = F[i, TLOC] + F[i, X] / -F[i, VX], SIDE_LEFT
+    if F[i, VY] > 0.0:
+        t = F[i, TLOC] + (world[1] - F[i, SH] - F[i, Y]) / F[i, VY]
+        if t < t_best:
+            t_best, side = t, SIDE_BOTTOM
+    elif F[i, VY] < 0.0:
+        t = F[i, TLOC] + F[i, Y] / -F[i, VY]
+        if t < t_best:
+            t_best, side = t, SIDE_TOP
+    return t_best, side
+
+
+@hot
+def _cross_time(i, F, N, world):
+    """(t, direction) when i's box centre next leaves its grid cell, (inf, -1) if never."""
+    cell, gnx, gny = world[3], world[4], world[5]
+    gx = N[i, CELL] % gnx
+    gy = N[i, CELL] // gnx
+    cx = F[i, X] + 0.5 * F[i, SW]
+    cy = F[i, Y] + 0.5 * F[i, SH]
+    t_best = INF
+    d = -1
+    if F[i, VX] > 0.0 and gx < gnx - 1:
+        t_best, d = F[i, TLOC] + ((gx + 1) * cell - cx) / F[i, VX], DIR_RIGHT
+    elif F[i, VX] < 0.0 and gx > 0:
+        t_best, d = F[i, TLOC] + (gx * cell - cx) / F[i, VX], DIR_LEFT
+    if F[i, VY] > 0.0 and gy < gny - 1:
+        t = F[i, TLOC] + ((gy + 1) * cell - cy) / F[i, VY]
+        if t < t_best:
+            t_best, d = t, DIR_DOWN
+    elif F[i, VY] < 0.0 and gy > 0:
+        t = F[i, TLOC] + (gy * cell - cy) / F[i, VY]
+        if t < t_best:
+            t_best, d = t, DIR_UP
+    return t_best, d
+
+
+@njit(cache=True)
+def _shape_contact(a, b, qx, qy, ux, uy, now, F, N, C):
+    """next_contact for a pair with a circle or polygon; cores C = (radius, start, verts,
+    normals)."""
+    radius, start, verts, normals = C
+    return next_contact(
+        qx,
+        qy,
+        ux,
+        uy,
+        N[a, SHAPE],
+        F[a, SW],
+        F[a, SH],
+        radius[a],
+        verts[start[a] : start[a + 1]],
+        normals[start[a] : start[a + 1]],
+        N[b, SHAPE],
+        F[b, SW],
+        F[b, SH],
+        radius[b],
+        verts[start[b] : start[b + 1]],
+        normals[start[b] : start[b + 1]],
+        now,
+    )
+
+
+@hot
+def _predict_pair(i, j, t_now, horizon, F, N, C, HT, HI, HN, st):
+    """Push the next contact of i and j if it comes no later than `horizon` (s).
+
+    The pair is swept from the later of the two objects' clocks, so that only one position is
+    carried forward and the predicted time does not depend on when the question is asked.
+    """
+    a = min(i, j)
+    b = max(i, j)
+    t0 = max(F[a, TLOC], F[b, TLOC])
+    qx = (F[b, X] + F[b, VX] * (t0 - F[b, TLOC])) - (F[a, X] + F[a, VX] * (t0 - F[a, TLOC]))
+    qy = (F[b, Y] + F[b, VY] * (t0 - F[b, TLOC])) - (F[a, Y] + F[a, VY] * (t0 - F[a, TLOC]))
+    ux = F[b, VX] - F[a, VX]
+    uy = F[b, VY] - F[a, VY]
+    if not box_reach(qx, qy, ux, uy, F[a, SW], F[a, SH], F[b, SW], F[b, SH], horizon - t0):
+        return
+    now = t_now - t0
+    if N[a, SHAPE] == KIND_BOX and N[b, SHAPE] == KIND_BOX:
+        t, code, nx, ny = box_next_contact(
+            qx, qy, ux, uy, F[a, SW], F[a, SH], F[b, SW], F[b, SH], now
+        )
+    else:
+        t, code, nx, ny = _shape_contact(a, b, qx, qy, ux, uy, now, F, N, C)
+    t = max(t0 + t, t_now)
+    if t <= horizon:
+        push(HT, HI, HN, st, t, make_key(RANK_PAIR, a, b, code), N[a, CNT], N[b, CNT], nx, ny)
+
+
+@kernel
+def predict(jobs, k, t_now, F, N, C, cells, s_start, s_items, HT, HI, HN, st, world):
+    """Run prediction job k for object i: push its horizon (the first of its next wall contact
+    and its next cell crossing) and its contacts with the objects in the 3×3 cells around it
+    that come no later than that."""
+    i, skip, mode = jobs[k, J_OBJ], jobs[k, J_SKIP], jobs[k, J_HIGHER]
+    higher = mode == JOB_FIRST
+    t_wall, side = _wall_time(i, F, world)
+    t_cross, d = _cross_time(i, F, N, world)
+    if mode == JOB_CONTACTS:
+        pass
+    elif t_cross <= t_wall and t_cross < INF:
+        key = make_key(RANK_CROSS, i, d, d)
+        push(HT, HI, HN, st, max(t_cross, t_now), key, N[i, CNT], 0, 0.0, 0.0)
+    elif t_wall < INF:
+        key = make_key(RANK_WALL, i, side, side)
+        push(HT, HI, HN, st, max(t_wall, t_now), key, N[i, CNT], 0, 0.0, 0.0)
+    horizon = max(min(t_wall, t_cross), t_now)
+    gnx, gny = world[4], world[5]
+    gx = N[i, CELL] % gnx
+    gy = N[i, CELL] // gnx
+    st[S_STAMP] += 1
+    for cy in range(max(gy - 1, 0), min(gy + 1, gny - 1) + 1):
+        for cx in range(max(gx - 1, 0), min(gx + 1, gnx - 1) + 1):
+            c = cy * gnx + cx
+            j = cells[c, C_HEAD]
+            while j >= 0:
+                if j != i and j != skip and not (higher and j < i):
+                    _predict_pair(i, j, t_now, horizon, F, N, C, HT, HI, HN, st)
+                j = N[j, NEXT]
+            for m in range(s_start[c], s_start[c + 1]):
+                j = s_items[m]
+                if N[j, STAMP] != st[S_STAMP] and j != skip:
+                    N[j, STAMP] = st[S_STAMP]
+                    _predict_pair(i, j, t_now, horizon, F, N, C, HT, HI, HN, st)
+
+
+@hot
+def set_job(jobs, k, i, skip, higher):
+    jobs[k, J_OBJ], jobs[k, J_SKIP], jobs[k, J_HIGHER] = i, skip, higher
