@@ -13,6 +13,7 @@ dropped.
 pixels. The pixel loops are numba kernels over arrays; with `NUMBA_DISABLE_JIT=1` the same source
 runs as plain Python.
 """
+
 from __future__ import annotations
 
 import numpy as np

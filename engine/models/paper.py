@@ -44,7 +44,6 @@ from collide2d.engine.broadphase import (
     KEY_SHIFT,
     candidates,
     choose,
-    sort_keys,
     workspace,
 )
 from collide2d.engine.events import (
@@ -64,6 +63,7 @@ from collide2d.engine.events import (
     put_row,
 )
 from collide2d.engine.motion import paper_rate
+from collide2d.engine.sort import sort_keys
 from collide2d.engine.world import Bodies, WorldSpec
 
 # The kernel writes the event log of events.py without its times: `t` is added in Python as the

@@ -42,8 +42,6 @@ from collide2d.engine.broadphase import (
     METHOD_SWEEP,
     candidates,
     choose,
-    heap_argsort,
-    sort_keys,
     workspace,
 )
 from collide2d.engine.contact import box_overlap_axis, penetration
@@ -60,6 +58,7 @@ from collide2d.engine.events import (
 )
 from collide2d.engine.response import exchange, fold, separate
 from collide2d.engine.shapes import GEOMETRIES, build_cores
+from collide2d.engine.sort import heap_argsort, sort_keys
 from collide2d.engine.world import Bodies, WorldSpec
 
 # The candidate list's margin, px: this many of the fastest object's step (|v|·dt), within

@@ -360,7 +360,17 @@ def test_a_killed_run_leaves_the_old_run_whole_and_the_next_run_cleans_up(tmp_pa
 
     long = scenario(tmp_path, ticks=20000, file="long")
     proc = subprocess.Popen(
-        [sys.executable, "-m", "collide2d", "run", str(long), "--out", str(out), "--png", "--quiet"],
+        [
+            sys.executable,
+            "-m",
+            "collide2d",
+            "run",
+            str(long),
+            "--out",
+            str(out),
+            "--png",
+            "--quiet",
+        ],
         cwd=ROOT,
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,

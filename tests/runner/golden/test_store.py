@@ -13,7 +13,12 @@ import pytest
 from collide2d.runner.golden import golden_files
 from collide2d.runner.golden import serialize as ser
 from collide2d.runner.golden import store as st
-from collide2d.runner.golden.store import GoldenMissing, GoldenStore, GoldenUnreadable, WritesRefused
+from collide2d.runner.golden.store import (
+    GoldenMissing,
+    GoldenStore,
+    GoldenUnreadable,
+    WritesRefused,
+)
 
 from . import synthetic
 

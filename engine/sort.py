@@ -1,0 +1,135 @@
+"""Sorting without allocating, for the broad phase and the models' pair lists.
+
+`sort_order` keeps an order of objects sorted by a key from call to call, mending it by insertion
+sort (objects move a little between calls) or sorting it afresh by heap sort when it is far off;
+`sort_keys` sorts a short list of pair keys in place; `heap_argsort` gives the order of a key
+array (heap sort: O(n log n), compiles quickly, allocates only the result). All numba kernels.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+# An insertion sort that has to shift more than this many places per object falls back to a full
+# sort (a scene that reshuffled, e.g. objects crossing the world in one step).
+SHIFTS_PER_OBJECT = 8
+
+# Pair-key lists up to this long are sorted by insertion, faster than a heap sort there.
+INSERTION_SORT_MAX = 64
+
+
+@njit(cache=True)
+def _heapsort_order(order, key):
+    """Sort `order` in place so that key[order] ascends (heap sort: allocates nothing)."""
+    n = order.shape[0]
+    for root in range(n // 2 - 1, -1, -1):
+        _sift_order(order, key, root, n)
+    for end in range(n - 1, 0, -1):
+        order[0], order[end] = order[end], order[0]
+        _sift_order(order, key, 0, end)
+
+
+@njit(cache=True)
+def _sift_order(order, key, root, n):
+    while True:
+        c = 2 * root + 1
+        if c >= n:
+            return
+        if c + 1 < n and key[order[c + 1]] > key[order[c]]:
+            c += 1
+        if key[order[root]] >= key[order[c]]:
+            return
+        order[root], order[c] = order[c], order[root]
+        root = c
+
+
+@njit(cache=True)
+def sort_order(order, key, sorted_key):
+    """Mend `order` so key[order] ascends, and set sorted_key = key[order].
+
+    order (n,) int64, the order of an earlier call (nearly sorted: objects move a little between
+    calls) is mended by insertion sort, or sorted afresh when it is far off.
+    """
+    n = order.shape[0]
+    for s in range(n):
+        sorted_key[s] = key[order[s]]
+    budget = SHIFTS_PER_OBJECT * n + 16
+    shifts = 0
+    for i in range(1, n):
+        cur = order[i]
+        k = sorted_key[i]
+        j = i - 1
+        while j >= 0 and sorted_key[j] > k:
+            order[j + 1] = order[j]
+            sorted_key[j + 1] = sorted_key[j]
+            j -= 1
+        shifts += i - 1 - j
+        order[j + 1] = cur
+        sorted_key[j + 1] = k
+        if shifts > budget:
+            _heapsort_order(order, key)
+            for s in range(n):
+                sorted_key[s] = key[order[s]]
+            return
+
+
+@njit(cache=True)
+def heap_argsort(keys):
+    """Indices that sort the 1-D `keys` ascending (heapsort: O(n log n), compiles quickly)."""
+    n = keys.shape[0]
+    idx = np.arange(n)
+    for start in range(n // 2 - 1, -1, -1):
+        _sift(keys, idx, start, n)
+    for end in range(n - 1, 0, -1):
+        idx[0], idx[end] = idx[end], idx[0]
+        _sift(keys, idx, 0, end)
+    return idx
+
+
+@njit(cache=True)
+def _sift(keys, idx, root, n):
+    while True:
+        c = 2 * root + 1
+        if c >= n:
+            return
+        if c + 1 < n and keys[idx[c + 1]] > keys[idx[c]]:
+            c += 1
+        if keys[idx[root]] >= keys[idx[c]]:
+            return
+        idx[root], idx[c] = idx[c], idx[root]
+        root = c
+
+
+@njit(cache=True)
+def sort_keys(keys, n):
+    """Sort keys[:n] in place, allocating nothing: insertion sort for the usual handful (the
+    pairs that overlap in one step), a heap sort past INSERTION_SORT_MAX."""
+    if n > INSERTION_SORT_MAX:
+        for root in range(n // 2 - 1, -1, -1):
+            _sift_keys(keys, root, n)
+        for end in range(n - 1, 0, -1):
+            keys[0], keys[end] = keys[end], keys[0]
+            _sift_keys(keys, 0, end)
+        return
+    for i in range(1, n):
+        key = keys[i]
+        j = i - 1
+        while j >= 0 and keys[j] > key:
+            keys[j + 1] = keys[j]
+            j -= 1
+        keys[j + 1] = key
+
+
+@njit(cache=True)
+def _sift_keys(keys, root, n):
+    while True:
+        c = 2 * root + 1
+        if c >= n:
+            return
+        if c + 1 < n and keys[c + 1] > keys[c]:
+            c += 1
+        if keys[root] >= keys[c]:
+            return
+        keys[root], keys[c] = keys[c], keys[root]
+        root = c

@@ -1,0 +1,44 @@
+"""engine/sort.py: each sort gives numpy's order, for nearly sorted and reshuffled input alike."""
+
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from collide2d.engine.sort import heap_argsort, sort_keys, sort_order
+
+keys = st.lists(st.integers(-50, 50), max_size=200).map(lambda v: np.array(v, np.int64))
+
+
+@settings(max_examples=60, deadline=None)
+@given(keys, st.integers(0, 2**32 - 1), st.booleans())
+def test_sort_order_mends_an_earlier_order(key, seed, reshuffle):
+    rng = np.random.default_rng(seed)
+    order = np.argsort(key, kind="stable").astype(np.int64)
+    if reshuffle:
+        rng.shuffle(order)  # far off: the heap sort takes over
+    elif len(order) > 1:
+        i = rng.integers(0, len(order) - 1)
+        order[[i, i + 1]] = order[[i + 1, i]]  # a neighbour swap: insertion sort mends it
+    sorted_key = np.empty_like(key)
+    sort_order(order, key, sorted_key)
+    assert sorted(order.tolist()) == list(range(len(key)))
+    assert np.array_equal(sorted_key, np.sort(key)) and np.array_equal(key[order], sorted_key)
+
+
+@settings(max_examples=60, deadline=None)
+@given(keys)
+def test_sort_keys_sorts_the_first_n_in_place(key):
+    n = len(key) // 2 + len(key) % 2
+    got = key.copy()
+    sort_keys(got, n)
+    assert np.array_equal(got[:n], np.sort(key[:n])) and np.array_equal(got[n:], key[n:])
+
+
+@settings(max_examples=60, deadline=None)
+@given(keys.map(lambda k: k.astype(np.float64)))
+def test_heap_argsort_orders_the_keys(key):
+    idx = heap_argsort(key)
+    assert sorted(idx.tolist()) == list(range(len(key)))
+    assert np.array_equal(key[idx], np.sort(key))
