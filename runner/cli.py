@@ -15,7 +15,6 @@ import sys
 import traceback
 from importlib import resources
 
-from collide2d.engine.models import ModelUnavailable
 from collide2d.runner import validate
 from collide2d.runner.bench import cli as bench_cli
 from collide2d.runner.exitcodes import EXIT_BAD_INPUT, EXIT_OK, EXIT_UNEXPECTED
@@ -129,9 +128,6 @@ def main(argv: list[str] | None = None) -> int:
         return args.func(args)
     except ScenarioError as err:
         print(str(err), file=sys.stderr)
-        return EXIT_BAD_INPUT
-    except ModelUnavailable as err:
-        print(f"collide2d: error: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except RunStopped as err:
         print(str(err), file=sys.stderr)

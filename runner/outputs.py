@@ -10,7 +10,7 @@ which would cost a disk flush per frame, so a power cut may still lose the newes
 
 Encodings are deterministic: the same input gives the same bytes. PNGs carry no metadata and use a
 fixed compression level. The GIF streams frame by frame to disk with exact palette colours, looping
-forever, with whole-centisecond delays scheduled by `gif_schedule` so that its total length is the
+forever, with whole-centisecond delays scheduled by `GifSchedule` so that its total length is the
 run's length to the centisecond.
 """
 
@@ -193,23 +193,6 @@ class _StreamWriter:
             self.abort()
 
 
-def clean_temporaries(folder: str | os.PathLike) -> int:
-    """Remove temporary files this module left in `folder` (not below it) after a killed run.
-
-    Only names of the form `.NAME.PID.XXXXXXXX.tmp` are touched; call it only when no other run is
-    writing into `folder`. Returns how many files were removed.
-    """
-    removed = 0
-    folder = Path(folder)
-    if not folder.is_dir():
-        return 0
-    for entry in sorted(os.scandir(folder), key=lambda e: e.name):
-        if _TEMP_RE.match(entry.name) and entry.is_file(follow_symlinks=False):
-            _remove(Path(entry.path))
-            removed += 1
-    return removed
-
-
 # --------------------------------------------------------------------------------------------
 # PNG
 
@@ -314,15 +297,6 @@ class GifSchedule:
         return self._start_cs(j + 1) - self._start_cs(j)
 
 
-def gif_schedule(n_frames: int, fps: int) -> tuple[np.ndarray, np.ndarray, str | None]:
-    """`GifSchedule` written out: (kept (m,) int64, delays_cs (m,) int64, note); for tests and
-    short runs only, as its arrays are as long as the GIF."""
-    sched = GifSchedule(n_frames, fps)
-    kept = np.array([sched.kept(j) for j in range(sched.count)], dtype=np.int64)
-    delays = np.array([sched.delay_cs(j) for j in range(sched.count)], dtype=np.int64)
-    return kept, delays, sched.note
-
-
 def _gif_palette(palette: np.ndarray) -> bytes:
     """The palette's bytes padded with black to a power-of-two size >= 2 (a GIF colour table)."""
     k = palette.shape[0]
@@ -340,7 +314,7 @@ class GifWriter(_StreamWriter):
     palette (k, 3) uint8 with 1 <= k <= 256 is the scenario's palette; frames are (height, width)
     uint8 indices into it, shown enlarged `scale` times, at `fps` frames per second, looping
     forever. Give `add` every one of the `n_frames` frames in order: frames the schedule drops
-    (`gif_schedule`, above 50 fps) are skipped here. `close` writes the trailer and renames the
+    (`GifSchedule`, above 50 fps) are skipped here. `close` writes the trailer and renames the
     file into place; `abort` removes it and leaves any older GIF at `path` whole. As a context
     manager it closes on success and aborts on an exception. `note` is the schedule's message.
     """

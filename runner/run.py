@@ -75,9 +75,12 @@ def drive(
     log_events: record events and pass each chunk's array to `on_events`.
     """
     bodies = scenario.bodies
-    options = {"substeps": scenario.substeps, "geometry": scenario.geometry}
-    if scenario.model == "exact":
-        options["max_events_per_tick"] = scenario.max_events_per_tick
+    options = models.scenario_options(
+        scenario.model,
+        substeps=scenario.substeps,
+        geometry=scenario.geometry,
+        max_events_per_tick=scenario.max_events_per_tick,
+    )
     try:
         model = models.make(scenario.model, scenario.world, bodies, **options)
     except Runaway as exc:

@@ -20,20 +20,23 @@ import importlib
 from collide2d.engine.world import Bodies, WorldSpec
 
 MODEL_NAMES = ("paper", "stepped", "exact")
-
-
-class ModelUnavailable(Exception):
-    """The named model is not built into this version."""
+# The settings a scenario gives each model (SPEC 2 and 3): the paper model takes none.
+SCENARIO_OPTIONS = {
+    "paper": (),
+    "stepped": ("substeps", "geometry"),
+    "exact": ("geometry", "max_events_per_tick"),
+}
 
 
 def make(name: str, world: WorldSpec, bodies: Bodies, **options):
     """Build the model `name` over `world` and `bodies`; options go to its constructor."""
     if name not in MODEL_NAMES:
         raise ValueError(f"unknown model {name!r}; expected one of {', '.join(MODEL_NAMES)}")
-    try:
-        module = importlib.import_module(f"collide2d.engine.models.{name}")
-    except ModuleNotFoundError as exc:
-        if exc.name == f"collide2d.engine.models.{name}":
-            raise ModelUnavailable(f"model {name!r} is not available yet") from exc
-        raise
+    module = importlib.import_module(f"collide2d.engine.models.{name}")
     return module.Model(world, bodies, **options)
+
+
+def scenario_options(name: str, **settings) -> dict:
+    """Of a scenario's model settings (substeps, geometry, max_events_per_tick), those that
+    model `name` takes."""
+    return {k: v for k, v in settings.items() if k in SCENARIO_OPTIONS[name]}

@@ -353,14 +353,11 @@ class Model:
         self,
         world: WorldSpec,
         bodies: Bodies,
-        substeps: int = 1,
         geometry: str | None = None,
         max_events_per_tick: int = MAX_EVENTS_PER_TICK,
         cell_size: float | None = None,
         repredict: str = "touched",
     ):
-        if int(substeps) != substeps or substeps < 1:
-            raise ValueError(f"substeps must be a whole number >= 1, got {substeps!r}")
         geometry = "exact" if geometry is None else geometry
         if geometry not in GEOMETRIES:
             raise ValueError(f"unknown geometry {geometry!r}; expected one of {GEOMETRIES}")

@@ -265,15 +265,9 @@ class Model:
         self,
         world: WorldSpec,
         bodies: Bodies,
-        substeps: int = 1,
-        geometry: str = "box",
         skip: bool = True,
         broadphase: str | None = None,
     ):
-        if substeps != 1:
-            raise ValueError("the paper model has no substeps")
-        if geometry != "box":
-            raise ValueError("the paper model collides every shape as its box (geometry: box)")
         self.world = world
         self.fps = int(world.fps)
         self.tick = 0

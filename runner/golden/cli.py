@@ -189,10 +189,9 @@ def _scenario_failed(args, doing: str, path, scn, exc: Exception) -> int:
 
 def _refusals() -> tuple:
     """The exception types that refuse one scenario as bad input rather than a bug."""
-    from collide2d.engine.models import ModelUnavailable
     from collide2d.runner.run import RunStopped
 
-    return (GoldenError, ModelUnavailable, RunStopped, *scenario_errors())
+    return (GoldenError, RunStopped, *scenario_errors())
 
 
 def bless_command(args, *, load=default_load, simulate=default_simulate) -> int:

@@ -32,6 +32,5 @@ kernel (`checks.tick_figures`) and the sort-and-sweep kernel `engine.invariants.
 - the same bytes twice: the case runs again in one call per `CHUNK_TICKS` and must end with the same
   positions, velocities and event records, byte for byte.
 
-A model that is not built yet (`engine.models.ModelUnavailable`) is reported as unavailable, not as
-a failure. `--quick` runs the same scenes shorter and smaller; it fits in well under a minute.
+`--quick` runs the same scenes shorter and smaller; it fits in well under a minute.
 """

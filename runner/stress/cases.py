@@ -5,7 +5,7 @@ bytes; and the suite of every case.
 `checks.Checker`, and stops at the first broken invariant or at the model's own error (a runaway);
 then `_rerun` runs the same ticks again, `CHUNK_TICKS` per call, unchecked, and the two runs must
 end with the same positions, velocities, event records and stop, byte for byte. The verdict is
-pass, fail, stopped (a runaway the scene expects, stopped by a clear error) or unavailable.
+pass, fail, or stopped (a runaway the scene expects, stopped by a clear error).
 """
 
 from __future__ import annotations
@@ -14,8 +14,8 @@ import hashlib
 import time
 from dataclasses import dataclass, field
 
-from collide2d.engine.models import ModelUnavailable
 from collide2d.engine.models import make as make_model
+from collide2d.engine.models import scenario_options
 from collide2d.runner.stress.checks import Checker
 from collide2d.runner.stress.scenes import Scene, scenes
 
@@ -24,7 +24,6 @@ CHUNK_TICKS = 65_536
 VERDICT_PASS = "pass"
 VERDICT_FAIL = "fail"
 VERDICT_STOPPED = "stopped"  # a runaway the scene expects, stopped by a clear error
-VERDICT_UNAVAILABLE = "unavailable"
 
 
 @dataclass
@@ -50,7 +49,8 @@ def _stop_message(exc: BaseException) -> str:
 
 
 def _build(scene: Scene, model: str):
-    return make_model(model, scene.world, scene.bodies, substeps=1, geometry="box")
+    options = scenario_options(model, substeps=1, geometry="box")
+    return make_model(model, scene.world, scene.bodies, **options)
 
 
 def run_case(scene: Scene, model: str) -> CaseResult:
@@ -59,10 +59,6 @@ def run_case(scene: Scene, model: str) -> CaseResult:
     began = time.perf_counter()
     try:
         sim = _build(scene, model)
-    except ModelUnavailable as exc:
-        result.verdict = VERDICT_UNAVAILABLE
-        result.note = str(exc)
-        return result
     except Exception as exc:  # a model refusing the scene is a finding, never a crash
         result.verdict = VERDICT_FAIL
         result.problems.append(f"the model refused the scene: {_stop_message(exc)}")

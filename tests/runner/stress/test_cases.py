@@ -11,7 +11,6 @@ import numpy as np
 import pytest
 
 from collide2d.engine.events import EV_WALL, EVENT_DTYPE
-from collide2d.engine.models import ModelUnavailable
 from collide2d.engine.world import Bodies, WorldSpec
 from collide2d.runner.stress import cases, checks
 from collide2d.runner.stress.scenes import Scene
@@ -173,12 +172,3 @@ def test_running_through_an_expected_runaway_fails(monkeypatch):
     r = run_fake(monkeypatch, None, expect_stop=("exact",))
     assert r.verdict == "fail"
     assert "should stop with a clear error" in r.problems[0]
-
-
-def test_an_unavailable_model_is_reported_not_failed(monkeypatch):
-    def unavailable(name, world, bodies, **options):
-        raise ModelUnavailable(f"model {name!r} is not available yet")
-
-    monkeypatch.setattr(cases, "make_model", unavailable)
-    r = cases.run_case(small_scene(), "exact")
-    assert r.verdict == "unavailable" and "not available" in r.note
