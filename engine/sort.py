@@ -77,28 +77,9 @@ def sort_order(order, key, sorted_key):
 @njit(cache=True)
 def heap_argsort(keys):
     """Indices that sort the 1-D `keys` ascending (heapsort: O(n log n), compiles quickly)."""
-    n = keys.shape[0]
-    idx = np.arange(n)
-    for start in range(n // 2 - 1, -1, -1):
-        _sift(keys, idx, start, n)
-    for end in range(n - 1, 0, -1):
-        idx[0], idx[end] = idx[end], idx[0]
-        _sift(keys, idx, 0, end)
+    idx = np.arange(keys.shape[0])
+    _heapsort_order(idx, keys)
     return idx
-
-
-@njit(cache=True)
-def _sift(keys, idx, root, n):
-    while True:
-        c = 2 * root + 1
-        if c >= n:
-            return
-        if c + 1 < n and keys[idx[c + 1]] > keys[idx[c]]:
-            c += 1
-        if keys[idx[root]] >= keys[idx[c]]:
-            return
-        idx[root], idx[c] = idx[c], idx[root]
-        root = c
 
 
 @njit(cache=True)

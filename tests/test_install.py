@@ -51,6 +51,11 @@ def test_the_command_runs_in_a_folder_with_its_own_engine_and_runner(tmp_path):
     assert summary["events"]["pair"] >= 1
 
 
+def pip(*args: str) -> None:
+    proc = subprocess.run([sys.executable, "-m", "pip", *args], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+
+
 def test_a_wheel_installs_only_collide2d_and_runs_beside_a_users_packages(tmp_path):
     # built from a copy, so that the build leaves nothing in the checkout
     source = tmp_path / "source"
@@ -60,22 +65,7 @@ def test_a_wheel_installs_only_collide2d_and_runs_beside_a_users_packages(tmp_pa
     for part in ("pyproject.toml", "README.md"):
         shutil.copy(ROOT / part, source / part)
     wheels = tmp_path / "wheels"
-    build = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "pip",
-            "wheel",
-            "--no-deps",
-            "-q",
-            "-w",
-            str(wheels),
-            str(source),
-        ],
-        capture_output=True,
-        text=True,
-    )
-    assert build.returncode == 0, build.stderr
+    pip("wheel", "--no-deps", "-q", "-w", str(wheels), str(source))
     (wheel,) = wheels.glob("collide2d-*.whl")
     tops = {name.split("/")[0] for name in zipfile.ZipFile(wheel).namelist()}
     assert {t for t in tops if not t.endswith(".dist-info")} == {"collide2d"}
@@ -89,22 +79,7 @@ def test_a_wheel_installs_only_collide2d_and_runs_beside_a_users_packages(tmp_pa
     assert "[pytest11]" in entry_points and "collide2d.runner.golden.plugin" in entry_points
 
     site = tmp_path / "site"
-    install = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "pip",
-            "install",
-            "--no-deps",
-            "-q",
-            "--target",
-            str(site),
-            str(wheel),
-        ],
-        capture_output=True,
-        text=True,
-    )
-    assert install.returncode == 0, install.stderr
+    pip("install", "--no-deps", "-q", "--target", str(site), str(wheel))
     project = user_project(tmp_path)
     # the same source as plain Python: no kernels to compile for a fresh copy
     env = {**os.environ, "PYTHONPATH": str(site), "NUMBA_DISABLE_JIT": "1"}

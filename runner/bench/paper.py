@@ -20,6 +20,20 @@ QUICK_PAPER_TICKS = 20_000
 PAPER_REPEATS = 5
 
 
+def demo_row(part: str, demo, ticks: int, rate: float, note: str) -> dict:
+    """A bench row of the section IV demo run `ticks` ticks at `rate` ticks/s."""
+    return {
+        "part": part,
+        "scene": DEMO_SCENARIO,
+        "model": "paper",
+        "n": demo.bodies.n,
+        "ticks": ticks,
+        "steps_per_s": rate,
+        "value": rate,
+        "note": note,
+    }
+
+
 def paper(quick: bool, echo, folder: Path = PROJECT_SCENARIOS) -> list[dict]:
     """One row per way of running the demo: ticks/s (the demo is read from `folder`)."""
     from collide2d.runner.run import drive
@@ -41,17 +55,6 @@ def paper(quick: bool, echo, folder: Path = PROJECT_SCENARIOS) -> list[dict]:
     rows = []
     for what, run in ways:
         rate = ticks / median(timed(run) for _ in range(repeats))
-        rows.append(
-            {
-                "part": "paper",
-                "scene": DEMO_SCENARIO,
-                "model": "paper",
-                "n": demo.bodies.n,
-                "ticks": ticks,
-                "steps_per_s": rate,
-                "value": rate,
-                "note": what,
-            }
-        )
+        rows.append(demo_row("paper", demo, ticks, rate, what))
         echo(f"paper    {what:50s} {rate:14,.0f}")
     return rows

@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 
 from collide2d.engine import models
+from collide2d.runner.bench.paper import demo_row
 from collide2d.runner.bench.scenes import DEMO_SCENARIO, PROJECT_SCENARIOS, SMALL_SCENARIO
 from collide2d.runner.bench.timing import median, timed
 
@@ -33,18 +34,8 @@ def targets(quick: bool, echo, folder: Path = PROJECT_SCENARIOS) -> list[dict]:
         models.make("paper", demo.world, demo.bodies).advance(ticks, log=False)
 
     rate = ticks / median(timed(headless) for _ in range(repeats))
-    rows = [
-        {
-            "part": "targets",
-            "scene": DEMO_SCENARIO,
-            "model": "paper",
-            "n": demo.bodies.n,
-            "ticks": ticks,
-            "steps_per_s": rate,
-            "value": rate,
-            "note": "section IV demo headless, ticks/s (target >= 1,000,000)",
-        }
-    ]
+    note = "section IV demo headless, ticks/s (target >= 1,000,000)"
+    rows = [demo_row("targets", demo, ticks, rate, note)]
     echo(f"targets  section IV demo headless {rate:14,.0f} ticks/s")
     if not quick:
         path = folder / f"{SMALL_SCENARIO}.yaml"

@@ -311,10 +311,13 @@ def test_far_jumps_fall_back_to_a_full_sort_and_stay_exact():
     assert m.positions().astype(int).tolist() == ref_pos
 
 
-def test_refuses_fractional_positions_and_other_geometry():
+def test_refuses_fractional_positions_and_takes_no_geometry_or_substeps():
     with pytest.raises(ValueError, match="whole-pixel positions"):
         model([[1.5, 2]], 10, [[0, 0]])
-    with pytest.raises(ValueError, match="geometry"):
+    # every shape collides as its box, once per tick: the settings of the other models are errors
+    with pytest.raises(TypeError, match="substeps"):
+        Model(WorldSpec(100, 100, 10), Bodies.boxes([[0, 0]], 10, [[0, 0]]), substeps=2)
+    with pytest.raises(TypeError, match="geometry"):
         Model(WorldSpec(100, 100, 10), Bodies.boxes([[0, 0]], 10, [[0, 0]]), geometry="exact")
 
 
