@@ -1,4 +1,4 @@
-"""Tests of runner/golden/__init__.py: checking a run against its golden, and blessing it."""
+"""Tests of runner/golden/session.py: checking a run against its golden, and blessing it."""
 
 from __future__ import annotations
 
