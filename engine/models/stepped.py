@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import math
 import time
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -118,7 +119,7 @@ def _fold_row(folds, n_folds, e, axis, low, high, first_low):
 def _move_walls(S, dt, folds):
     """Move every object for dt seconds, then reflect it back into the world.
 
-    S: the state arrays (see `Model`). folds (2n, 4) int64 receives a row per object and axis that
+    S: the state arrays (a `State`). folds (2n, 4) int64 receives a row per object and axis that
     folded. Returns (how many rows, the farthest any object now is from its anchor on an axis, px).
     """
     pos, vel, size, inv_mass, static, movable, span, ext, rank, anchor = S
@@ -318,14 +319,14 @@ def _run(world, substeps, tick0, ticks, log, S, exact, cores, rows, times, bp):
     """Run ticks tick0+1 ... tick0+ticks; returns (event buffers, how many events, candidate
     keys, overlap buffer): the buffers that grew replace the caller's.
 
-    S: the state arrays (see `Model`). bp = (keys, near, order, lo, hi, folds, state, params, ws):
+    S: the state arrays (a `State`). bp = (keys, near, order, lo, hi, folds, state, params, ws):
     the candidate list kept between calls (see the module docstring) and scratch; state = [keys
     listed (-1: no list yet), method, whether pairs can happen at all, wall events and pair events
     so far, logged or not (ST_WALLS, ST_PAIRS)]; params = [margin px, grid cell px, drift slack
     px].
     """
     keys, near, order, lo, hi, folds, state, params, ws = bp
-    pos, size, ext = S[0], S[2], S[7]
+    pos, size, ext = S.pos, S.size, S.ext
     width, height, fps = world
     margin, cell, slack = params[0], params[1], params[2]
     method = state[1]
@@ -361,14 +362,25 @@ def _run(world, substeps, tick0, ticks, log, S, exact, cores, rows, times, bp):
     return rows, times, n_ev, keys, near
 
 
+class State(NamedTuple):
+    """The stepped model's state arrays, every row in the broad phase's order (numba takes a
+    named tuple as it takes a tuple; the kernels unpack it by position)."""
+
+    pos: np.ndarray  # (n, 2) float64 top-left corners, px
+    vel: np.ndarray  # (n, 2) float64 px/s
+    size: np.ndarray  # (n, 2) float64 px
+    inv_mass: np.ndarray  # (n,) float64, 0 for static objects
+    static: np.ndarray  # (n,) bool
+    movable: np.ndarray  # (n,) bool: what the broad phase pairs
+    span: np.ndarray  # (n, 2) float64 world side - box side, px
+    ext: np.ndarray  # (n,) int64 the id of each row
+    rank: np.ndarray  # (n,) int64 the row of each id
+    anchor: np.ndarray  # (n, 2) float64 where each was when the candidate list was made, px
+
+
 class Model:
     """Fixed-step elastic model; see the module docstring. Surface as in engine.models.
-
-    State inside, in the broad phase's order: S = (pos (n, 2) px, vel (n, 2) px/s, size (n, 2)
-    px, inv_mass (n,), static (n,), movable (n,) (what the broad phase pairs), span (n, 2) =
-    world side - box side px, ext (n,) the id of each, rank (n,) where each id is, anchor (n, 2)
-    px where each was when the candidate list was made).
-    """
+    Its state is a `State`, in the broad phase's order."""
 
     def __init__(
         self,
@@ -396,7 +408,7 @@ class Model:
         size = np.ascontiguousarray(bodies.size, np.float64).copy()
         span = np.array([world.width, world.height], np.float64) - size
         movable = ~static if skip else np.ones(n, bool)
-        self._S = (
+        self._S = State(
             pos,
             vel,
             size,
@@ -466,10 +478,12 @@ class Model:
                     bp = (keys, near, order, lo, hi, folds, state, params, ws)
                     keys, state[0] = _relist(self._S, margin, state[1], cell, bp)
                 t2 = clock()
-                n_near = _overlapping(self._S[0], self._S[2], self._S[7], keys, state[0], near)
+                n_near = _overlapping(self._S.pos, self._S.size, self._S.ext, keys, state[0], near)
                 if n_near > near.shape[0]:
                     near = np.empty(2 * n_near, np.int64)
-                    n_near = _overlapping(self._S[0], self._S[2], self._S[7], keys, state[0], near)
+                    n_near = _overlapping(
+                        self._S.pos, self._S.size, self._S.ext, keys, state[0], near
+                    )
                 t3 = clock()
                 _pairs(
                     self._S,
@@ -497,15 +511,15 @@ class Model:
 
     def positions(self) -> np.ndarray:
         """(n, 2) float64 top-left corners, px."""
-        return self._by_id(self._S[0])
+        return self._by_id(self._S.pos)
 
     def velocities(self) -> np.ndarray:
         """(n, 2) float64 velocities, px/s."""
-        return self._by_id(self._S[1])
+        return self._by_id(self._S.vel)
 
     def _by_id(self, a: np.ndarray) -> np.ndarray:
         out = np.empty_like(a)
-        out[self._S[7]] = a
+        out[self._S.ext] = a
         return out
 
 
