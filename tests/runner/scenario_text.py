@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from collide2d.runner.scenario import ScenarioError, loads
@@ -39,3 +40,16 @@ def check_refused(text: str, needle: str, fragment: str, nth: int = 0, **kw) -> 
 
 def objects(*lines: str, head: str = BASE) -> str:
     return head + "objects:\n" + "".join(f"  - {line}\n" for line in lines)
+
+
+def any_overlap(pos, size) -> bool:
+    """Whether any two boxes overlap, by an all-pairs array comparison (n up to a few thousand)."""
+    lo, hi = pos, pos + size
+    over = (
+        (lo[:, None, 0] < hi[None, :, 0])
+        & (lo[None, :, 0] < hi[:, None, 0])
+        & (lo[:, None, 1] < hi[None, :, 1])
+        & (lo[None, :, 1] < hi[:, None, 1])
+    )
+    np.fill_diagonal(over, False)
+    return bool(over.any())

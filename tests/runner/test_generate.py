@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
+from scenario_text import any_overlap
 
 from collide2d.runner import generate as gen
 
@@ -31,19 +32,6 @@ def brute_first_overlap(pos, size):
             ):
                 return a, b
     return None
-
-
-def any_overlap(pos, size) -> bool:
-    """Whether any two boxes overlap, by an all-pairs array comparison (n up to a few thousand)."""
-    lo, hi = pos, pos + size
-    over = (
-        (lo[:, None, 0] < hi[None, :, 0])
-        & (lo[None, :, 0] < hi[:, None, 0])
-        & (lo[:, None, 1] < hi[None, :, 1])
-        & (lo[None, :, 1] < hi[:, None, 1])
-    )
-    np.fill_diagonal(over, False)
-    return bool(over.any())
 
 
 # ----------------------------------------------------------------------------- first_overlap

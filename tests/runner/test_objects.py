@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scenario_text import BASE, check_refused, objects
+from scenario_text import BASE, any_overlap, check_refused, objects
 
 from collide2d.engine import motion
 from collide2d.engine.world import KIND_CIRCLE
@@ -104,15 +104,7 @@ def test_generated_objects_fill_the_arrays():
     assert np.all(b.pos == np.floor(b.pos))  # whole pixels
     assert np.all(b.pos >= 0) and np.all(b.pos + b.size <= [320, 240])
     # nothing overlaps: compare every pair
-    lo, hi = b.pos, b.pos + b.size
-    over = (
-        (lo[:, None, 0] < hi[None, :, 0])
-        & (lo[None, :, 0] < hi[:, None, 0])
-        & (lo[:, None, 1] < hi[None, :, 1])
-        & (lo[None, :, 1] < hi[:, None, 1])
-    )
-    np.fill_diagonal(over, False)
-    assert not over.any()
+    assert not any_overlap(b.pos, b.size)
 
 
 def test_generate_is_deterministic_and_seeded():
@@ -253,12 +245,4 @@ def test_generated_objects_avoid_listed_ones():
         + "generate:\n  - {count: 20, shape: box, size: 4, seed: 5}\n"
     )
     b = loads(text).bodies
-    lo, hi = b.pos, b.pos + b.size
-    over = (
-        (lo[:, None, 0] < hi[None, :, 0])
-        & (lo[None, :, 0] < hi[:, None, 0])
-        & (lo[:, None, 1] < hi[None, :, 1])
-        & (lo[None, :, 1] < hi[:, None, 1])
-    )
-    np.fill_diagonal(over, False)
-    assert not over.any()
+    assert not any_overlap(b.pos, b.size)
