@@ -59,8 +59,9 @@ def _round_into(pos, out):
 
 
 @njit(cache=True)
-def _redraw_all(buf, ipos, kind, wh, color, fill, vert_start, verts, ext, scratch):
-    """Clear the frame and draw every object in id order."""
+def _redraw_all(buf, ipos, art, scratch):
+    """Clear the frame and draw every object in id order (`art`: see `Renderer`)."""
+    kind, wh, color, fill, vert_start, verts, ext = art
     h, w = buf.shape
     buf[:, :] = 0
     for i in range(kind.shape[0]):
@@ -77,9 +78,7 @@ def _redraw_all(buf, ipos, kind, wh, color, fill, vert_start, verts, ext, scratc
 
 
 @njit(cache=True)
-def _redraw_dirty(
-    buf, old, new, kind, wh, color, fill, vert_start, verts, ext, scratch, rects, max_area
-):
+def _redraw_dirty(buf, old, new, art, scratch, rects, max_area):
     """Repaint only where something moved; False (frame untouched) when a full redraw is cheaper:
     most objects moved, or too many rectangles (`rects` is their storage), or more than max_area
     pixels to clear.
@@ -90,6 +89,7 @@ def _redraw_dirty(
     frame is cleared and every object meeting one is drawn, clipped to it, in id order, so each of
     those pixels ends up with the colour of the last object covering it, as in a full redraw.
     """
+    kind, wh, color, fill, vert_start, verts, ext = art
     h, w = buf.shape
     n = kind.shape[0]
     count = 0
@@ -203,6 +203,17 @@ class Renderer:
         self._vert_start = np.ascontiguousarray(bodies.vert_start, dtype=np.int64)
         self._verts = np.ascontiguousarray(bodies.verts, dtype=np.int64).reshape(-1, 2)
         self._ext = _extents(self._kind, self._wh, self._vert_start, self._verts)
+        # the drawing data the kernels read, in one tuple: kind, size, colour, fill, vertices
+        # (start, points) and each object's extent around its position
+        self._art = (
+            self._kind,
+            self._wh,
+            self._color,
+            self._fill,
+            self._vert_start,
+            self._verts,
+            self._ext,
+        )
         counts = np.diff(self._vert_start) if n else np.zeros(0, np.int64)
         diam = self._wh[self._kind == KIND_CIRCLE, 0]
         self._scratch = np.empty(
@@ -224,18 +235,7 @@ class Renderer:
         _round_into(np.ascontiguousarray(pos), self._new)
 
     def _full(self) -> np.ndarray:
-        _redraw_all(
-            self._buf,
-            self._new,
-            self._kind,
-            self._wh,
-            self._color,
-            self._fill,
-            self._vert_start,
-            self._verts,
-            self._ext,
-            self._scratch,
-        )
+        _redraw_all(self._buf, self._new, self._art, self._scratch)
         self._old, self._new = self._new, self._old
         self._drawn = True
         self.last_was_full = True
@@ -252,19 +252,7 @@ class Renderer:
         if not self._drawn:
             return self._full()
         done = _redraw_dirty(
-            self._buf,
-            self._old,
-            self._new,
-            self._kind,
-            self._wh,
-            self._color,
-            self._fill,
-            self._vert_start,
-            self._verts,
-            self._ext,
-            self._scratch,
-            self._rects,
-            self._max_area,
+            self._buf, self._old, self._new, self._art, self._scratch, self._rects, self._max_area
         )
         if not done:
             return self._full()
