@@ -14,19 +14,8 @@ from engine_refs import pixel_corners, random_boxes, ref_hull
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
+from collide2d.engine import events as ev
 from collide2d.engine.errors import NoRoom, Runaway
-from collide2d.engine.events import (
-    AXIS_NAMES,
-    AXIS_X,
-    AXIS_XY,
-    AXIS_Y,
-    EV_PAIR,
-    EV_WALL,
-    SIDE_BOTTOM,
-    SIDE_LEFT,
-    SIDE_RIGHT,
-    SIDE_TOP,
-)
 from collide2d.engine.invariants import kinetic_energy
 from collide2d.engine.models import exact as exact_model
 from collide2d.engine.models import make
@@ -155,8 +144,8 @@ def test_free_flight_in_a_walled_box_is_the_reflection_formula_at_any_fps(fps):
     ty = [40 / -vy + 56 * k / -vy for k in range(20) if 40 / -vy + 56 * k / -vy <= 3]
     got = sorted((e[1], e[5]) for e in walls)
     want = sorted(
-        [(t, SIDE_RIGHT if k % 2 == 0 else SIDE_LEFT) for k, t in enumerate(tx)]
-        + [(t, SIDE_TOP if k % 2 == 0 else SIDE_BOTTOM) for k, t in enumerate(ty)]
+        [(t, ev.SIDE_RIGHT if k % 2 == 0 else ev.SIDE_LEFT) for k, t in enumerate(tx)]
+        + [(t, ev.SIDE_TOP if k % 2 == 0 else ev.SIDE_BOTTOM) for k, t in enumerate(ty)]
     )
     assert [s for _, s in got] == [s for _, s in want]
     assert np.allclose([t for t, _ in got], [t for t, _ in want], rtol=1e-13, atol=1e-13)
@@ -171,7 +160,7 @@ def test_the_tunnelling_pair_never_tunnels(fps):
     events = model.advance(12 * fps)
     assert len(events) == 1
     e = events[0]
-    assert (e["type"], e["a"], e["b"], e["code"], e["t"]) == (EV_PAIR, 0, 1, AXIS_X, 5.0)
+    assert (e["type"], e["a"], e["b"], e["code"], e["t"]) == (ev.EV_PAIR, 0, 1, ev.AXIS_X, 5.0)
     assert e["tick"] == 5 * fps  # an event at exactly t = k/fps belongs to tick k
     assert (e["xdiff"], e["ydiff"]) == (-1, -1)
     # Positions are moved to each tick's end (k/fps, rounded): exact up to that rounding.
@@ -185,7 +174,7 @@ def test_two_body_head_on_matches_the_textbook(m1, m2):
     bodies = Bodies.boxes([[100, 45], [300, 45]], 10, [[v1, 0], [v2, 0]], mass=[m1, m2])
     model = make("exact", world, bodies)
     events = model.advance(80)
-    assert [(e["type"], e["a"], e["b"]) for e in events] == [(EV_PAIR, 0, 1)]
+    assert [(e["type"], e["a"], e["b"]) for e in events] == [(ev.EV_PAIR, 0, 1)]
     assert events[0]["t"] == pytest.approx(190 / 40, rel=1e-15)
     u1 = ((m1 - m2) * v1 + 2 * m2 * v2) / (m1 + m2)
     u2 = ((m2 - m1) * v2 + 2 * m1 * v1) / (m1 + m2)
@@ -243,8 +232,8 @@ def test_mass_ratios_count_the_digits_of_pi(digits):
     events = model.advance(100)  # the heavy block then drifts right, far from the far wall
     expected = int(str(math.pi).replace(".", "")[: digits + 1])
     assert len(events) == expected
-    assert set(events["type"][events["type"] == EV_WALL].tolist()) <= {EV_WALL}
-    assert (events["b"][events["type"] == EV_PAIR] == 1).all()
+    assert set(events["type"][events["type"] == ev.EV_WALL].tolist()) <= {ev.EV_WALL}
+    assert (events["b"][events["type"] == ev.EV_PAIR] == 1).all()
     v = model.velocities()
     assert np.isfinite(v).all() and inside(model, bodies, world)
     # Afterwards both move right, the light one no faster than the heavy one: no more contact.
@@ -299,7 +288,7 @@ def test_energy_and_momentum_in_a_pair_only_scene(geometry):
     bodies = Bodies.boxes(inner.pos + 1900, inner.size, inner.vel, mass=inner.mass)
     model = make("exact", world, bodies, geometry=geometry)
     events = model.advance(200)
-    assert (events["type"] == EV_PAIR).sum() > 20 and (events["type"] == EV_WALL).sum() == 0
+    assert (events["type"] == ev.EV_PAIR).sum() > 20 and (events["type"] == ev.EV_WALL).sum() == 0
     v = model.velocities()
     e0 = kinetic_energy(bodies.mass, bodies.static, bodies.vel)
     assert kinetic_energy(bodies.mass, bodies.static, v) == pytest.approx(e0, rel=1e-12)
@@ -314,7 +303,7 @@ def test_energy_with_walls_and_random_masses_over_a_long_run():
     bodies = random_boxes(40, seed=5, world=world, mass_range=(0.01, 100.0))
     model = make("exact", world, bodies)
     events = model.advance(3000)
-    assert (events["type"] == EV_PAIR).sum() > 1000
+    assert (events["type"] == ev.EV_PAIR).sum() > 1000
     e0 = kinetic_energy(bodies.mass, bodies.static, bodies.vel)
     e1 = kinetic_energy(bodies.mass, bodies.static, model.velocities())
     assert e1 == pytest.approx(e0, rel=1e-12)
@@ -349,7 +338,7 @@ def test_mixed_shapes_keep_energy_and_never_overlap():
     for _ in range(100):
         codes.extend(model.advance(1)["code"].tolist())
         assert pairs_overlapping(bodies, model.positions(), 1e-9) == []
-    assert AXIS_NAMES.index("n") in codes  # some contacts were not axis-aligned
+    assert ev.AXIS_NAMES.index("n") in codes  # some contacts were not axis-aligned
     e0 = kinetic_energy(bodies.mass, bodies.static, bodies.vel)
     e1 = kinetic_energy(bodies.mass, bodies.static, model.velocities())
     assert e1 == pytest.approx(e0, rel=1e-12)
@@ -395,7 +384,7 @@ def brute_force(world, pos, size, vel, mass, static, t_end, max_events=400):
         cands = []
         for i in range(n):
             for ax, (lo_side, hi_side) in enumerate(
-                ((SIDE_LEFT, SIDE_RIGHT), (SIDE_TOP, SIDE_BOTTOM))
+                ((ev.SIDE_LEFT, ev.SIDE_RIGHT), (ev.SIDE_TOP, ev.SIDE_BOTTOM))
             ):
                 if v[i][ax] > 0:
                     cands.append(
@@ -427,7 +416,9 @@ def brute_force(world, pos, size, vel, mass, static, t_end, max_events=400):
                 if te < tx and te >= 0:
                     x_last = slabs[0][0] is not None and slabs[0][0] == te
                     y_last = slabs[1][0] is not None and slabs[1][0] == te
-                    code = AXIS_XY if (x_last and y_last) else (AXIS_X if x_last else AXIS_Y)
+                    code = (
+                        ev.AXIS_XY if (x_last and y_last) else (ev.AXIS_X if x_last else ev.AXIS_Y)
+                    )
                     cands.append((te, 2, a, b, code))
         if not cands:
             break
@@ -438,13 +429,13 @@ def brute_force(world, pos, size, vel, mass, static, t_end, max_events=400):
         for i in range(n):
             p[i] = [p[i][0] + v[i][0] * dt, p[i][1] + v[i][1] * dt]
         if rank == 1:
-            ax = 0 if b in (SIDE_LEFT, SIDE_RIGHT) else 1
+            ax = 0 if b in (ev.SIDE_LEFT, ev.SIDE_RIGHT) else 1
             v[a][ax] = -v[a][ax]
-            events.append((now, EV_WALL, a, -1, b))
+            events.append((now, ev.EV_WALL, a, -1, b))
         else:
             changed = False
             for ax in (0, 1):
-                if code == AXIS_XY or code == ax:
+                if code == ev.AXIS_XY or code == ax:
                     u = v[b][ax] - v[a][ax]
                     sign = 1 if (p[b][ax] + w[b][ax] / 2) > (p[a][ax] + w[a][ax] / 2) else -1
                     un = u * sign
@@ -454,7 +445,7 @@ def brute_force(world, pos, size, vel, mass, static, t_end, max_events=400):
                         v[b][ax] -= 2 * un * rb * sign
                         changed = True
             if changed:
-                events.append((now, EV_PAIR, a, b, code))
+                events.append((now, ev.EV_PAIR, a, b, code))
     return events, v
 
 
@@ -516,7 +507,7 @@ def test_walls_come_first_then_pairs_in_order_at_one_instant():
     model = make("exact", world, Bodies.boxes(pos, 10, vel))
     events = model.advance(10)
     firsts = [(e["type"], e["a"], e["b"]) for e in events if e["t"] == 1.0]
-    assert firsts == [(EV_WALL, 3, -1), (EV_PAIR, 0, 1), (EV_PAIR, 1, 2)]
+    assert firsts == [(ev.EV_WALL, 3, -1), (ev.EV_PAIR, 0, 1), (ev.EV_PAIR, 1, 2)]
 
 
 def test_a_static_object_never_moves_and_reflects_what_hits_it():
@@ -526,7 +517,7 @@ def test_a_static_object_never_moves_and_reflects_what_hits_it():
     )
     model = make("exact", world, bodies)
     events = model.advance(30)
-    pairs = [(e["a"], e["b"], e["t"]) for e in events if e["type"] == EV_PAIR]
+    pairs = [(e["a"], e["b"], e["t"]) for e in events if e["type"] == ev.EV_PAIR]
     assert pairs == [(0, 1, 1.75)]
     assert model.positions()[1].tolist() == [100, 0]
     assert model.velocities().tolist() == [[-40, 0], [0, 0]]
@@ -538,7 +529,7 @@ def test_circles_meet_along_the_centre_line_at_the_exact_time():
     model = make("exact", world, bodies)
     events = model.advance(20)
     e = events[0]
-    assert (e["a"], e["b"], AXIS_NAMES[e["code"]]) == (0, 1, "n")
+    assert (e["a"], e["b"], ev.AXIS_NAMES[e["code"]]) == (0, 1, "n")
     assert e["t"] == pytest.approx((50 - 16) / 40, rel=1e-14)  # centres 20 apart: dx = 16
     n = np.array([0.8, 0.6])
     v = model.velocities()
@@ -558,8 +549,8 @@ def test_a_circle_passes_a_corner_its_box_would_hit():
     bodies = shapes(kinds, pos, size, vel, static=[True, False])
     exact = make("exact", world, bodies)
     as_box = make("exact", world, bodies, geometry="box")
-    assert (exact.advance(60)["type"] == EV_PAIR).sum() == 0
-    assert (as_box.advance(60)["type"] == EV_PAIR).sum() == 1
+    assert (exact.advance(60)["type"] == ev.EV_PAIR).sum() == 0
+    assert (as_box.advance(60)["type"] == ev.EV_PAIR).sum() == 1
 
 
 def test_a_triangle_lands_on_a_box_when_its_pixels_touch():
@@ -576,7 +567,7 @@ def test_a_triangle_lands_on_a_box_when_its_pixels_touch():
     )
     model = make("exact", world, bodies)
     e = model.advance(30)[0]
-    assert (e["a"], e["b"], e["code"], e["t"]) == (0, 1, AXIS_Y, 2.0)
+    assert (e["a"], e["b"], e["code"], e["t"]) == (0, 1, ev.AXIS_Y, 2.0)
     assert model.velocities()[0].tolist() == [0, -20]
 
 
@@ -668,7 +659,7 @@ def test_event_counts_match_the_log_with_or_without_it():
     for _ in range(5):
         quiet.append(b.advance(10, log=False))
     kinds = np.bincount(logged["type"], minlength=2)
-    assert a.event_counts() == b.event_counts() == (kinds[EV_WALL], kinds[EV_PAIR])
+    assert a.event_counts() == b.event_counts() == (kinds[ev.EV_WALL], kinds[ev.EV_PAIR])
     assert kinds.min() > 0 and sum(map(len, quiet)) == 0
 
 
