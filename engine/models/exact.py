@@ -57,6 +57,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from collide2d.engine import events
 from collide2d.engine.broadphase import grid_cell, grid_dims
 from collide2d.engine.cells import build_grid, cell_insert, cell_remove, room_around, room_needed
 from collide2d.engine.errors import EventCapExceeded, NoRoom
@@ -87,9 +88,6 @@ from collide2d.engine.events import (
     SIDE_LEFT,
     SIDE_RIGHT,
     SIDE_TOP,
-    event_records,
-    grown,
-    new_log,
     put_event,
 )
 from collide2d.engine.exactstate import (
@@ -423,22 +421,22 @@ class Model:
         """Run `ticks` ticks; the events in the order they happened (empty when log is False)."""
         if self._broken:
             raise self._broken
-        rows, times = new_log(log)
+        rows, times = events.new_log(log)
         self._st[S_LOGGED] = 0
         target = self.tick + int(ticks)
         while True:
             status = self._call(target, bool(log), self.max_events_per_tick, rows, times)
             if status == STATUS_HEAP_FULL:
-                self._heap = [grown(a) for a in self._heap]
+                self._heap = [events.grown(a) for a in self._heap]
             elif status == STATUS_LOG_FULL:
-                rows, times = grown(rows), grown(times)
+                rows, times = events.grown(rows), events.grown(times)
             elif status == STATUS_CAP:
                 self._broken = self._runaway()
                 raise self._broken
             else:
                 break
         self.tick = int(self._st[S_TICK])
-        return event_records(rows, times, int(self._st[S_LOGGED]))
+        return events.event_records(rows, times, int(self._st[S_LOGGED]))
 
     def _call(self, target, log, cap, rows, times) -> int:
         """One call of the kernel `_run` on the model's state; its status."""
@@ -483,10 +481,10 @@ class Model:
         )
         counts = st[S_WALLS : S_PAIRS + 1].copy()
         st[S_LOGGED] = 0
-        rows, times = new_log(True, RECENT)
+        rows, times = events.new_log(True, RECENT)
         cap = int(st[S_TICK_EVENTS]) + RECENT
         while self._call(int(st[S_TICK]) + 1, True, cap, rows, times) == STATUS_HEAP_FULL:
-            self._heap = [grown(a) for a in self._heap]
+            self._heap = [events.grown(a) for a in self._heap]
         st[S_WALLS : S_PAIRS + 1] = counts  # the counts stay those of the events before the stop
         t = float(self._stf[SF_T_NOW])
         n = int(st[S_LOGGED])
