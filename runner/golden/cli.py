@@ -76,24 +76,33 @@ def register(subparsers, *, load=None, simulate=None) -> None:
     """Add `check` and `bless` to an argparse subparsers object."""
     load = load or default_load
     simulate = simulate or default_simulate
-    p = subparsers.add_parser(
-        "check",
-        help="compare runs with their goldens",
-        description="Run scenarios and compare them with goldens/; exit 1 on any difference.",
+    commands = (
+        (
+            "check",
+            check_command,
+            "compare runs with their goldens",
+            "Run scenarios and compare them with goldens/; exit 1 on any difference.",
+        ),
+        (
+            "bless",
+            bless_command,
+            "write goldens anew",
+            "Run scenarios and write their goldens atomically; print what changed.",
+        ),
     )
-    p.add_argument("scenarios", nargs="*", metavar="SCENARIO", help="file or name (default: all)")
-    p.add_argument("--report", metavar="DIR", help="write expected/actual/diff images and HTML")
-    _common(p)
-    p.set_defaults(func=partial(check_command, load=load, simulate=simulate))
-    p = subparsers.add_parser(
-        "bless",
-        help="write goldens anew",
-        description="Run scenarios and write their goldens atomically; print what changed.",
-    )
-    p.add_argument("scenarios", nargs="*", metavar="SCENARIO", help="file or name (default: all)")
-    p.add_argument("--prune", action="store_true", help="remove goldens no scenario uses")
-    _common(p)
-    p.set_defaults(func=partial(bless_command, load=load, simulate=simulate))
+    for name, command, summary, description in commands:
+        p = subparsers.add_parser(name, help=summary, description=description)
+        p.add_argument(
+            "scenarios", nargs="*", metavar="SCENARIO", help="file or name (default: all)"
+        )
+        if name == "check":
+            p.add_argument(
+                "--report", metavar="DIR", help="write expected/actual/diff images and HTML"
+            )
+        else:
+            p.add_argument("--prune", action="store_true", help="remove goldens no scenario uses")
+        _common(p)
+        p.set_defaults(func=partial(command, load=load, simulate=simulate))
 
 
 def _common(p) -> None:
