@@ -21,7 +21,6 @@ import io
 import json
 import os
 import re
-import secrets
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -29,6 +28,7 @@ import numpy as np
 from PIL import GifImagePlugin, Image
 
 from collide2d.engine.events import format_event, format_number
+from collide2d.runner import swapdir
 
 # zlib level of every PNG (0-9): fixed so that the same pixels give the same bytes.
 PNG_COMPRESS_LEVEL = 6
@@ -44,7 +44,7 @@ GIF_MAX_COLORS = 256
 # Events formatted and written at once by EventsWriter: bounds the text held in memory (~5 MB).
 EVENTS_PER_WRITE = 65_536
 
-TEMP_SUFFIX = ".tmp"
+# A temporary file of NAME: `.NAME.PID.HEX.tmp` (`swapdir.temp_name` without a kind).
 _TEMP_RE = re.compile(r"^\..+\.\d+\.[0-9a-f]{8}\.tmp$")
 
 
@@ -60,7 +60,7 @@ def _open_temp(path: Path) -> tuple[Path, int]:
     """
     flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0)
     while True:
-        tmp = path.with_name(f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}{TEMP_SUFFIX}")
+        tmp = path.with_name(swapdir.temp_name(path.name))
         try:
             return tmp, os.open(tmp, flags, 0o666)
         except FileExistsError:

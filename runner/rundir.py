@@ -6,8 +6,9 @@ over) and writes every file into a fresh sibling folder `OUT/.NAME.PID.XXXXXXXX.
 all of it is written does the staging folder take the place of `OUT/NAME`: in one atomic exchange
 of the two names where the system offers one (Linux `renameat2`), else by moving the old folder
 aside and the new one in, a step that the next run under the lock finishes if it was cut between
-the two renames. So `OUT/NAME` always holds one complete run, the old or the new. On any failure
-the staging folder is removed and the old run stays as it was.
+the two renames (the names, the swap and that recovery are `runner.swapdir`'s). So `OUT/NAME`
+always holds one complete run, the old or the new. On any failure the staging folder is removed
+and the old run stays as it was.
 
 Nothing is followed through a symbolic link: a link at `OUT/NAME` or inside it is refused, and the
 old folder is removed only when it holds nothing but the files a run writes, so a file a user put
@@ -17,14 +18,12 @@ there is never deleted (the run is refused and names it instead).
 from __future__ import annotations
 
 import contextlib
-import ctypes
-import errno
 import os
 import re
-import secrets
-import shutil
 import stat
 from pathlib import Path
+
+from collide2d.runner import swapdir
 
 try:
     import fcntl
@@ -34,10 +33,7 @@ except ImportError:  # pragma: no cover - not on POSIX
 # The names a run writes in OUT/NAME (and `frames/frame_*.png` below it).
 RUN_FILES = ("animation.gif", "events.jsonl", "final.csv", "summary.json", "viewer.html")
 FRAME_FILE_RE = re.compile(r"^frame_\d{6,}\.png$")
-STAGE_SUFFIX = ".run.tmp"
-OLD_SUFFIX = ".old.tmp"
-_AT_FDCWD = -100
-_RENAME_EXCHANGE = 2
+STAGE = "run"  # the kind of a staging folder: `OUT/.NAME.PID.XXXXXXXX.run.tmp`
 
 
 class OutputBusy(Exception):
@@ -46,16 +42,6 @@ class OutputBusy(Exception):
 
 class OutputRefused(Exception):
     """OUT/NAME cannot be replaced safely (a link, or files no run writes); str(err) says why."""
-
-
-def _leftover_re(name: str) -> re.Pattern:
-    return re.compile(
-        rf"^\.{re.escape(name)}\.\d+\.[0-9a-f]{{8}}({re.escape(STAGE_SUFFIX)}|{re.escape(OLD_SUFFIX)})$"
-    )
-
-
-def _sibling(root: Path, name: str, suffix: str) -> Path:
-    return root / f".{name}.{os.getpid()}.{secrets.token_hex(4)}{suffix}"
 
 
 class RunLock:
@@ -146,52 +132,14 @@ def clean_leftovers(root: Path, name: str) -> None:
     Staging folders are removed. An old folder moved aside is put back when OUT/NAME is missing
     (the run was cut between its two renames), and removed otherwise.
     """
-    pattern = _leftover_re(name)
-    target = root / name
-    for entry in sorted(os.scandir(root), key=lambda e: e.name):
-        if not pattern.match(entry.name) or not entry.is_dir(follow_symlinks=False):
-            continue
-        if entry.name.endswith(OLD_SUFFIX) and not os.path.lexists(target):
-            os.rename(entry.path, target)
-        else:
-            shutil.rmtree(entry.path)
+    swapdir.recover(Path(root) / name, swapdir.leftovers(root, name, (STAGE, swapdir.OLD)))
 
 
 def new_stage(root: Path, name: str) -> Path:
     """A new empty staging folder for NAME in OUT."""
-    while True:
-        stage = _sibling(root, name, STAGE_SUFFIX)
-        try:
-            stage.mkdir()
-            return stage
-        except FileExistsError:
-            continue
-
-
-def _exchange(a: Path, b: Path) -> bool:
-    """Swap the names a and b in one atomic step; False when the system cannot."""
-    libc = ctypes.CDLL(None, use_errno=True)
-    renameat2 = getattr(libc, "renameat2", None)
-    if renameat2 is None:
-        return False
-    done = renameat2(_AT_FDCWD, os.fsencode(a), _AT_FDCWD, os.fsencode(b), _RENAME_EXCHANGE)
-    if done == 0:
-        return True
-    code = ctypes.get_errno()
-    if code in (errno.ENOSYS, errno.EINVAL, errno.ENOTSUP):
-        return False
-    raise OSError(code, os.strerror(code), str(b))
+    return swapdir.make_temp(root, name, STAGE)
 
 
 def swap_in(stage: Path, target: Path) -> None:
     """Put the complete staging folder at `target`, replacing the old run, and remove the old."""
-    if not os.path.lexists(target):
-        os.rename(stage, target)
-        return
-    if _exchange(stage, target):
-        shutil.rmtree(stage)  # now the old run
-        return
-    old = _sibling(target.parent, target.name, OLD_SUFFIX)
-    os.rename(target, old)
-    os.rename(stage, target)
-    shutil.rmtree(old)
+    swapdir.swap_in(stage, target, atomic=True)

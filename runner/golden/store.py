@@ -17,9 +17,10 @@ A write builds the whole new golden in a sibling temporary folder `goldens/.NAME
 instant leaves either the old golden whole or the new one whole: between the two renames the old
 golden waits whole under its aside name, where `read` finds it and the next write puts it back.
 Leftovers are recognised by that exact name pattern, only as real folders, and a live process's own
-temporaries are left alone. A golden whose files all equal what is on disk is not rewritten.
-Nothing is ever written when the `CI` environment variable is set, and a golden folder is only
-removed by `remove` (the `--prune` of `bless`).
+temporaries are left alone (the names, the swap and the recovery are `runner.swapdir`'s). A golden
+whose files all equal what is on disk is not rewritten. Nothing is ever written when the `CI`
+environment variable is set, and a golden folder is only removed by `remove` (the `--prune` of
+`bless`).
 """
 
 from __future__ import annotations
@@ -27,25 +28,22 @@ from __future__ import annotations
 import json
 import os
 import re
-import secrets
-import shutil
 import stat
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from collide2d.runner import swapdir
 from collide2d.runner.golden import serialize as ser
 from collide2d.runner.scenario import NAME_PATTERN
 
 GOLDENS_DIR = "goldens"
 SCENARIOS_DIR = "scenarios"
 SCENARIO_SUFFIXES = (".yaml", ".yml")
-# A write's temporary folders next to goldens/NAME: `.NAME.PID.HEX.new.tmp` (the new golden being
-# built) and `.NAME.PID.HEX.old.tmp` (the old golden moved aside during the swap).
-TMP_SUFFIX = ".tmp"
-NEW, OLD = "new", "old"
-_LEFTOVER_RE = re.compile(r"(?P<pid>\d+)\.[0-9a-f]{8}\.(?P<kind>new|old)\.tmp")
+# The kinds of a write's temporary folders next to goldens/NAME: `.NAME.PID.HEX.new.tmp` (the new
+# golden being built) and `.NAME.PID.HEX.old.tmp` (the old golden moved aside during the swap).
+NEW, OLD = "new", swapdir.OLD
 # A golden folder's name: a scenario name that cannot leave goldens/ or hide as a dot-folder.
 _NAME_RE = re.compile(NAME_PATTERN)
 # Values of CI that mean "not in CI".
@@ -191,10 +189,10 @@ class GoldenStore:
         st = _lstat(folder)
         if st is None:
             # A write killed between its two renames left the old golden whole, aside.
-            aside = [p for p, pid, kind in self._leftovers(name) if kind == OLD]
-            if not aside:
+            aside = swapdir.newest_aside(self._leftovers(name))
+            if aside is None:
                 raise GoldenMissing(f"no golden for {name}: {shown_path(folder)} does not exist")
-            folder = max(aside, key=_mtime)
+            folder = aside
         elif stat.S_ISLNK(st.st_mode):
             raise GoldenUnreadable(f"golden {name}: {link_message(folder)}")
         elif not stat.S_ISDIR(st.st_mode):
@@ -230,35 +228,14 @@ class GoldenStore:
         changed = sorted(rel for rel in files if old.get(rel) != files[rel])
         if not changed and not extra:
             return []
-        new = self._temp(name, NEW)
+        new = swapdir.make_temp(self.dir, name, NEW)
         try:
             _build(new, files)
         except BaseException:
-            _remove_tree(new)
+            swapdir.remove_tree(new)
             raise
-        self._swap(folder, new, name, exists=st is not None)
+        swapdir.swap_in(new, folder)  # two renames: a kill between them is what `read` handles
         return changed
-
-    def _swap(self, folder: Path, new: Path, name: str, *, exists: bool) -> None:
-        """Rename `new` into place at `folder`, the old folder (when `exists`) aside first."""
-        aside = None
-        try:
-            if exists:
-                aside = self._temp(name, OLD, create=False)
-                os.rename(folder, aside)
-            os.rename(new, folder)
-        except BaseException:
-            if aside is not None and _lstat(folder) is None and _lstat(aside) is not None:
-                try:
-                    os.rename(aside, folder)
-                    aside = None
-                except OSError:
-                    pass  # the next write or read recovers it
-            _remove_tree(new)
-            raise
-        _fsync_dir(self.dir)
-        if aside is not None:
-            _remove_tree(aside)
 
     def remove(self, name: str) -> None:
         """Delete golden folder `name` (what `bless --prune` does to an unused golden)."""
@@ -273,9 +250,9 @@ class GoldenStore:
             raise GoldenError(link_message(folder))
         if not stat.S_ISDIR(st.st_mode):
             raise GoldenError(f"{shown_path(folder)} is not a folder; remove it by hand")
-        aside = self._temp(name, OLD, create=False)
+        aside = swapdir.temp_path(self.dir, name, OLD)
         os.rename(folder, aside)
-        _remove_tree(aside)
+        swapdir.remove_tree(aside)
 
     def recover(self, name: str) -> None:
         """Tidy what interrupted writes of golden `name` left: put an old golden moved aside back
@@ -285,44 +262,13 @@ class GoldenStore:
             return
         self.check_dir()
         folder = self.folder(name)
-        leftovers = [x for x in self._leftovers(name) if x[1] == os.getpid() or not _alive(x[1])]
-        if _lstat(folder) is None:
-            aside = [p for p, _pid, kind in leftovers if kind == OLD]
-            if aside:
-                back = max(aside, key=_mtime)
-                os.rename(back, folder)
-                leftovers = [x for x in leftovers if x[0] != back]
-        for path, _pid, _kind in leftovers:
-            _remove_tree(path)
+        ours = [x for x in self._leftovers(name) if x[1] == os.getpid() or not swapdir.alive(x[1])]
+        swapdir.recover(folder, ours)
 
     def _leftovers(self, name: str) -> list[tuple[Path, int, str]]:
         """(path, pid, kind) of the temporary folders of golden `name` in goldens/, real folders
         only."""
-        prefix = f".{check_name(name)}."
-        out = []
-        try:
-            entries = list(os.scandir(self.dir))
-        except FileNotFoundError:
-            return []
-        for entry in entries:
-            m = _LEFTOVER_RE.fullmatch(entry.name[len(prefix) :])
-            if entry.name.startswith(prefix) and m and entry.is_dir(follow_symlinks=False):
-                out.append((Path(entry.path), int(m["pid"]), m["kind"]))
-        return sorted(out)
-
-    def _temp(self, name: str, kind: str, *, create: bool = True) -> Path:
-        """A fresh temporary folder name of ours for golden `name` (created when `create`)."""
-        while True:
-            path = self.dir / f".{name}.{os.getpid()}.{secrets.token_hex(4)}.{kind}{TMP_SUFFIX}"
-            if not create:
-                if _lstat(path) is None:
-                    return path
-                continue
-            try:
-                os.mkdir(path)
-                return path
-            except FileExistsError:
-                continue
+        return swapdir.leftovers(self.dir, check_name(name), (NEW, OLD))
 
 
 def _ci_message() -> str:
@@ -360,26 +306,6 @@ def _lstat(path):
         return os.lstat(path)
     except (FileNotFoundError, NotADirectoryError):
         return None
-
-
-def _mtime(path: Path) -> int:
-    st = _lstat(path)
-    return st.st_mtime_ns if st is not None else 0
-
-
-def _alive(pid: int) -> bool:
-    """True when process `pid` runs (POSIX); elsewhere every other process counts as gone."""
-    if os.name != "posix":
-        return False
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    except OSError:
-        return False
-    return True
 
 
 def _below(base: Path, rel: str, name: str) -> Path:
@@ -519,7 +445,7 @@ def _build(folder: Path, files: dict) -> None:
             dirs.add(path.parent)
         _write_new(path, files[rel])
     for d in sorted(dirs, key=lambda p: -len(p.parts)):
-        _fsync_dir(d)
+        swapdir.fsync_dir(d)
 
 
 def _write_new(path: Path, data: bytes) -> None:
@@ -533,27 +459,3 @@ def _write_new(path: Path, data: bytes) -> None:
         os.fsync(fd)
     finally:
         os.close(fd)
-
-
-def _fsync_dir(path: Path) -> None:
-    """Flush a folder's entries to disk (where the platform allows opening a folder)."""
-    try:
-        fd = os.open(path, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0))
-    except OSError:
-        return
-    try:
-        os.fsync(fd)
-    except OSError:
-        pass
-    finally:
-        os.close(fd)
-
-
-def _remove_tree(path: Path) -> None:
-    """Remove the temporary folder `path` of ours: links inside are removed, never followed;
-    `path` itself must be a real folder."""
-    st = _lstat(path)
-    if st is None:
-        return
-    if stat.S_ISDIR(st.st_mode):
-        shutil.rmtree(path, ignore_errors=True)

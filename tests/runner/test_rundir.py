@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from collide2d.runner import outputs, rundir
+from collide2d.runner import outputs, rundir, swapdir
 from collide2d.runner.cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -166,13 +166,13 @@ def test_a_full_disk_at_any_write_keeps_the_old_run_and_names_the_file(first, ca
 def test_a_swap_cut_between_its_renames_is_finished_by_the_next_run(first, monkeypatch):
     short, long, out = first
     before = files(out / "busy")
-    monkeypatch.setattr(rundir, "_exchange", lambda a, b: False)  # no atomic exchange here
+    monkeypatch.setattr(swapdir, "exchange", lambda a, b: False)  # no atomic exchange here
     renames = [0]
     real_rename = os.rename
 
     def cut(a, b):
         renames[0] += 1
-        if renames[0] == 2:  # old moved aside, new not yet in: the process dies here
+        if renames[0] >= 2:  # old moved aside, new not yet in: the process dies here
             raise KeyboardInterrupt
         return real_rename(a, b)
 
@@ -194,7 +194,7 @@ def test_the_atomic_exchange_replaces_the_old_run_in_one_step(first, monkeypatch
     monkeypatch.setattr(os, "rename", lambda a, b: renames.append((a, b)))
     stage = rundir.new_stage(out, "busy")
     (stage / "final.csv").write_text("new\n")
-    if not rundir._exchange(stage, out / "busy"):
+    if not swapdir.exchange(stage, out / "busy"):
         pytest.skip("this system has no atomic exchange of names")
     assert (out / "busy" / "final.csv").read_text() == "new\n"
     assert (stage / "summary.json").exists()  # the old run, now under the staging name

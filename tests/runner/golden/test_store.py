@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -146,7 +147,7 @@ _EFFECTS = [
     (os, "replace"),
     (os, "unlink"),
     (os, "rmdir"),
-    (st.shutil, "rmtree"),
+    (shutil, "rmtree"),
 ]
 
 

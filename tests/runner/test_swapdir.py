@@ -1,0 +1,126 @@
+"""Tests of runner/swapdir.py: temporary names, leftovers, the swap, recovery, no link followed."""
+
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+import sys
+
+import pytest
+
+from collide2d.runner import swapdir
+
+
+def _folder(path, text):
+    path.mkdir()
+    (path / "file.txt").write_text(text)
+    return path
+
+
+def _dead_pid() -> int:
+    proc = subprocess.Popen([sys.executable, "-c", "pass"])
+    proc.wait()
+    return proc.pid
+
+
+def test_temporary_names_carry_the_pid_and_the_kind():
+    pid = os.getpid()
+    assert re.fullmatch(
+        rf"\.demo\.{pid}\.[0-9a-f]{{8}}\.new\.tmp", swapdir.temp_name("demo", "new")
+    )
+    assert re.fullmatch(rf"\.a\.png\.{pid}\.[0-9a-f]{{8}}\.tmp", swapdir.temp_name("a.png"))
+    assert swapdir.temp_name("demo", "new") != swapdir.temp_name("demo", "new")
+
+
+def test_a_temporary_folder_is_made_or_only_named(tmp_path):
+    made = swapdir.make_temp(tmp_path, "demo", "run")
+    named = swapdir.temp_path(tmp_path, "demo", "old")
+    assert made.is_dir() and made.name.endswith(".run.tmp")
+    assert not os.path.lexists(named) and named.name.endswith(".old.tmp")
+
+
+def test_leftovers_are_real_folders_of_that_name_and_kind(tmp_path):
+    pid = _dead_pid()
+    ours = [f".demo.{pid}.0123abcd.run.tmp", f".demo.{pid}.0123abcd.old.tmp"]
+    others = [
+        f".demo.{pid}.0123abcd.new.tmp",  # a kind not asked for
+        f".other.{pid}.0123abcd.old.tmp",  # another name
+        f".demo.x.{pid}.0123abcd.old.tmp",  # another name, sharing the prefix
+        f".demo.{pid}.0123abc.old.tmp",  # seven hex digits
+        f".demo.{pid}.0123abcd.tmp",  # no kind
+    ]
+    for name in ours + others:
+        (tmp_path / name).mkdir()
+    (tmp_path / f".demo.{pid}.89abcdef.old.tmp").symlink_to(tmp_path / ours[0])
+    (tmp_path / f".demo.{pid}.456789ab.run.tmp").write_text("a file, not a folder")
+    found = swapdir.leftovers(tmp_path, "demo", ("run", "old"))
+    assert found == sorted((tmp_path / n, pid, n.split(".")[-2]) for n in ours)
+    assert swapdir.leftovers(tmp_path / "missing", "demo", ("old",)) == []
+
+
+def test_a_swap_replaces_the_folder_whole_and_leaves_no_temporary(tmp_path):
+    target = tmp_path / "demo"
+    swapdir.swap_in(_folder(tmp_path / "first", "one"), target)
+    assert (target / "file.txt").read_text() == "one"
+    for atomic in (False, True):
+        swapdir.swap_in(_folder(tmp_path / "next", f"atomic={atomic}"), target, atomic=atomic)
+        assert (target / "file.txt").read_text() == f"atomic={atomic}"
+        assert os.listdir(tmp_path) == ["demo"]
+
+
+def test_a_swap_whose_second_rename_fails_puts_the_old_folder_back(tmp_path, monkeypatch):
+    target = _folder(tmp_path / "demo", "old")
+    new = _folder(tmp_path / "new", "new")
+    real_rename, calls = os.rename, []
+
+    def rename(src, dst):
+        calls.append(dst)
+        if len(calls) == 2:
+            raise OSError("disk full (simulated)")
+        real_rename(src, dst)
+
+    monkeypatch.setattr(os, "rename", rename)
+    with pytest.raises(OSError, match="simulated"):
+        swapdir.swap_in(new, target)
+    assert (target / "file.txt").read_text() == "old"
+    assert os.listdir(tmp_path) == ["demo"]  # the new folder removed, nothing aside
+
+
+def test_recovery_puts_the_newest_old_folder_back_when_the_target_is_missing(tmp_path):
+    target = tmp_path / "demo"
+    older = _folder(swapdir.temp_path(tmp_path, "demo", "old"), "older")
+    newer = _folder(swapdir.temp_path(tmp_path, "demo", "old"), "newer")
+    os.utime(older, ns=(1, 1))
+    _folder(swapdir.temp_path(tmp_path, "demo", "new"), "half built")
+    found = swapdir.leftovers(tmp_path, "demo", ("new", "old"))
+    assert swapdir.newest_aside(found) == newer
+    swapdir.recover(target, found)
+    assert (target / "file.txt").read_text() == "newer"
+    assert os.listdir(tmp_path) == ["demo"]
+    # With the target in place every leftover goes.
+    _folder(swapdir.temp_path(tmp_path, "demo", "old"), "stale")
+    swapdir.recover(target, swapdir.leftovers(tmp_path, "demo", ("old",)))
+    assert (target / "file.txt").read_text() == "newer"
+    assert os.listdir(tmp_path) == ["demo"]
+
+
+def test_removing_a_tree_never_follows_a_link(tmp_path):
+    outside = _folder(tmp_path / "outside", "keep")
+    tree = tmp_path / "tree"
+    tree.mkdir()
+    (tree / "link").symlink_to(outside)
+    swapdir.remove_tree(tmp_path / "missing")
+    (tmp_path / "top").symlink_to(outside)
+    swapdir.remove_tree(tmp_path / "top")  # a link is not a folder of ours: left alone
+    assert (tmp_path / "top").is_symlink()
+    swapdir.remove_tree(tree)
+    assert not tree.exists()
+    assert (outside / "file.txt").read_text() == "keep"
+
+
+def test_alive_and_fsync_of_a_folder(tmp_path):
+    assert swapdir.alive(os.getpid())
+    assert not swapdir.alive(_dead_pid())
+    swapdir.fsync_dir(tmp_path)
+    swapdir.fsync_dir(tmp_path / "missing")  # nothing to flush, no error
