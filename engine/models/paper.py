@@ -29,7 +29,8 @@ movable object the pair stage is skipped (`skip=False` turns both skips off; `br
 
 The tick loop is one numba kernel run without reference counting (it allocates nothing); when the
 event log or the candidate list needs more room it stops at a stage boundary, the buffer grows in
-Python, and the next call resumes the same tick where it stopped.
+Python, and the next call resumes the same tick where it stopped. `Model.profile` runs the same
+kernel one stage at a time (STAGES) to time each.
 """
 
 from __future__ import annotations

@@ -24,7 +24,9 @@ objects are never listed, and with no movable object (or fewer than two objects)
 skipped; the `skip=False` option turns both skips off, and `broadphase` ("sweep", "grid",
 "cells") forces a method instead of the scene's choice (for tests and `collide2d bench`).
 
-Events go to the one event log of events.py.
+Events go to the one event log of events.py. The step's stages are one kernel, `_step` (STAGES:
+move, broad, narrow, response): `_run` runs all of them every step, `Model.profile` the same
+kernel one stage at a time to time each.
 """
 
 from __future__ import annotations
