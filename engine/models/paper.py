@@ -29,7 +29,8 @@ movable object the pair stage is skipped (`skip=False` turns both skips off; `br
 
 The tick loop is one numba kernel run without reference counting (it allocates nothing); when the
 event log or the candidate list needs more room it stops at a stage boundary, the buffer grows in
-Python, and the next call resumes the same tick where it stopped.
+Python, and the next call resumes the same tick where it stopped. `Model.profile` runs the same
+kernel one stage at a time (STAGES) to time each.
 """
 
 from __future__ import annotations
@@ -80,11 +81,21 @@ _MARGIN_MAX_PX = 32
 # listed (-1: none yet), this tick's drift (px) and whether a box left the world, whether the list
 # is to be made anew this tick, event rows written in this `advance`, the candidates a too small
 # buffer needed, whether pairs can happen at all, wall events and pair events so far (logged or
-# not).
+# not), this tick's overlapping candidate pairs.
 _S_TICK, _S_STAGE, _S_KEYS, _S_DRIFT, _S_LEFT, _S_RELIST, _S_EVENTS, _S_NEEDED, _S_PAIRS = range(9)
-_S_WALLS, _S_PAIR_EVENTS = 9, 10
-_S_SIZE = 11
-_STAGE_MOVE, _STAGE_WALLS, _STAGE_PAIRS = range(3)
+_S_WALLS, _S_PAIR_EVENTS, _S_NEAR = 9, 10, 11
+_S_SIZE = 12
+# The stages of a tick, in the order `_run` runs them (it can stop after any of them).
+_STAGE_MOVE, _STAGE_WALLS, _STAGE_BROAD, _STAGE_NARROW, _STAGE_RESPONSE = range(5)
+_N_STAGES = 5
+# The stages `Model.profile` times, each by name with the stage it runs up to (_N_STAGES: the
+# tick's end): move and walls count as "move".
+STAGES = (
+    ("move", _STAGE_BROAD),
+    ("broad", _STAGE_NARROW),
+    ("narrow", _STAGE_RESPONSE),
+    ("response", _N_STAGES),
+)
 # What a call of the kernel ends with: done, or stopped for more room (grow, call again).
 _DONE, _LOG_FULL, _KEYS_FULL = range(3)
 
@@ -204,26 +215,27 @@ def _pairs(pos, size, step, disp, near, n_near, tick, log, ev, n_ev, st):
 
 
 @_kernel
-def _run(pos, size, room, step, period, count, movable, tick_to, log, st, bp, ev, ws):
-    """Run ticks until st[_S_TICK] = tick_to; returns _DONE, or _LOG_FULL / _KEYS_FULL when `ev`
-    or the candidate buffers need more room (grow them and call again: the tick resumes at the
-    stage it stopped). st: the scalar state (see _S_*); bp = (order, anchor, keys, near, disp,
-    lo, hi, params) with params = [margin px, method, grid cell px] (float64)."""
+def _run(pos, size, room, step, period, count, movable, stop, log, st, bp, ev, ws):
+    """Run stage after stage until st[_S_TICK] * _N_STAGES + st[_S_STAGE] = stop (advance: ticks
+    done x _N_STAGES, a tick's end); returns _DONE, or _LOG_FULL / _KEYS_FULL when `ev` or the
+    candidate buffers need more room (grow them and call again: the tick resumes at the stage it
+    stopped). st: the scalar state (see _S_*); bp = (order, anchor, keys, near, disp, lo, hi,
+    params) with params = [margin px, method, grid cell px] (float64)."""
     order, anchor, keys, near, disp, lo, hi, params = bp
     margin = int(params[0])
     method = int(params[1])
     cell = params[2]
     n = pos.shape[0]
     n_ev = st[_S_EVENTS]
-    while st[_S_TICK] < tick_to:
+    while st[_S_TICK] * _N_STAGES + st[_S_STAGE] < stop:
         tick = st[_S_TICK] + 1
-        if st[_S_STAGE] == _STAGE_MOVE:
+        stage = st[_S_STAGE]
+        if stage == _STAGE_MOVE:
             # move: counters fire, this tick's displacement is kept to be taken back
             drift, left = _move(pos, step, period, count, disp, anchor, room)
             st[_S_DRIFT] = drift
             st[_S_LEFT] = left
-            st[_S_STAGE] = _STAGE_WALLS
-        if st[_S_STAGE] == _STAGE_WALLS:
+        elif stage == _STAGE_WALLS:
             # walls: reverse and take back what left the world moving outward
             if st[_S_LEFT]:
                 if log and n_ev + 2 * n > ev.shape[0]:
@@ -233,9 +245,10 @@ def _run(pos, size, room, step, period, count, movable, tick_to, log, st, bp, ev
             # the list is made anew once anything drifted a margin from where it was made
             # (drift is measured before the walls take steps back, which only errs early)
             st[_S_RELIST] = st[_S_KEYS] < 0 or st[_S_DRIFT] >= margin
-            st[_S_STAGE] = _STAGE_PAIRS
-        if st[_S_STAGE] == _STAGE_PAIRS and st[_S_PAIRS]:
-            # pairs: the listed pairs whose reach boxes overlap, in (a, b) order, by the rule
+        elif not st[_S_PAIRS]:
+            pass  # no pair can happen: the pair stages do nothing
+        elif stage == _STAGE_BROAD:
+            # broad: the candidate list, when it is to be made anew
             if st[_S_RELIST]:
                 k = _relist(pos, size, disp, movable, margin, method, cell, order, lo, hi, keys, ws)
                 if k > keys.shape[0]:
@@ -247,13 +260,20 @@ def _run(pos, size, room, step, period, count, movable, tick_to, log, st, bp, ev
                 for i in range(n):
                     anchor[i, 0] = pos[i, 0]
                     anchor[i, 1] = pos[i, 1]
-            if log and n_ev + st[_S_KEYS] > ev.shape[0]:
+        elif stage == _STAGE_NARROW:
+            # narrow: the listed pairs whose reach boxes overlap, in (a, b) order
+            st[_S_NEAR] = _near(pos, size, disp, keys, st[_S_KEYS], near)
+        else:
+            # response: the rule on each of them
+            if log and n_ev + st[_S_NEAR] > ev.shape[0]:
                 st[_S_EVENTS] = n_ev
                 return _LOG_FULL
-            n_near = _near(pos, size, disp, keys, st[_S_KEYS], near)
-            n_ev = _pairs(pos, size, step, disp, near, n_near, tick, log, ev, n_ev, st)
-        st[_S_STAGE] = _STAGE_MOVE
-        st[_S_TICK] = tick
+            n_ev = _pairs(pos, size, step, disp, near, st[_S_NEAR], tick, log, ev, n_ev, st)
+        if stage == _STAGE_RESPONSE:
+            st[_S_STAGE] = _STAGE_MOVE
+            st[_S_TICK] = tick
+        else:
+            st[_S_STAGE] = stage + 1
     st[_S_EVENTS] = n_ev
     return _DONE
 
@@ -301,8 +321,35 @@ class Model:
 
     def advance(self, ticks: int, log: bool = True) -> np.ndarray:
         """Run `ticks` ticks; the events they made (EVENT_DTYPE, in order; empty if not log)."""
-        target = self.tick + int(ticks)
         self._st[_S_EVENTS] = 0
+        self._run_to((self.tick + int(ticks)) * _N_STAGES, bool(log))
+        n = int(self._st[_S_EVENTS])
+        return event_records(self._ev, self._ev[:n, ROW_TICK] / self.fps, n)
+
+    def event_counts(self) -> tuple[int, int]:
+        """(wall events, pair events) so far, logged or not."""
+        return int(self._st[_S_WALLS]), int(self._st[_S_PAIR_EVENTS])
+
+    def profile(self, ticks: int) -> dict[str, float]:
+        """Run `ticks` ticks with the event log off, one stage of `_run` at a time, and return the
+        seconds spent in each (STAGES): "move" (counters and walls), "broad" (making the candidate
+        list), "narrow" (keeping the listed pairs whose reach boxes overlap), "response" (the flip
+        rule). The state ends exactly as `advance(ticks, log=False)` would leave it. Each stage is
+        timed from Python, so each count includes a call's overhead (microseconds), which
+        dominates in small scenes."""
+        spent = {name: 0.0 for name, _ in STAGES}
+        clock = time.perf_counter
+        for _ in range(int(ticks)):
+            done = self.tick * _N_STAGES
+            for name, until in STAGES:
+                began = clock()
+                self._run_to(done + until, False)
+                spent[name] += clock() - began
+        return spent
+
+    def _run_to(self, stop: int, log: bool) -> None:
+        """Run `_run` to `stop` (ticks done x _N_STAGES + stage), growing the buffers it asks
+        to grow."""
         while True:
             status = _run(
                 self.pos,
@@ -312,8 +359,8 @@ class Model:
                 self.period,
                 self.count,
                 self.movable,
-                target,
-                bool(log),
+                stop,
+                log,
                 self._st,
                 self._bp,
                 self._ev,
@@ -331,68 +378,6 @@ class Model:
                     + self._bp[4:]
                 )
         self.tick = int(self._st[_S_TICK])
-        n = int(self._st[_S_EVENTS])
-        return event_records(self._ev, self._ev[:n, ROW_TICK] / self.fps, n)
-
-    def event_counts(self) -> tuple[int, int]:
-        """(wall events, pair events) so far, logged or not."""
-        return int(self._st[_S_WALLS]), int(self._st[_S_PAIR_EVENTS])
-
-    def profile(self, ticks: int) -> dict[str, float]:
-        """Run `ticks` ticks with the event log off, one stage at a time, and return the seconds
-        spent in each: "move" (counters and walls), "broad" (making the candidate list),
-        "narrow" (keeping the listed pairs whose reach boxes overlap), "response" (the flip
-        rule). The state ends exactly as `advance(ticks, log=False)` would leave it. Each stage is
-        timed from Python, so each count includes a call's overhead (microseconds), which
-        dominates in small scenes."""
-        order, anchor, keys, near, disp, lo, hi, params = self._bp
-        margin, method, cell = int(params[0]), int(params[1]), float(params[2])
-        st = self._st
-        spent = {"move": 0.0, "broad": 0.0, "narrow": 0.0, "response": 0.0}
-        clock = time.perf_counter
-        for _ in range(int(ticks)):
-            tick = int(st[_S_TICK]) + 1
-            t0 = clock()
-            drift, left = _move(
-                self.pos, self.step, self.period, self.count, disp, anchor, self._room
-            )
-            if left:
-                _walls(self.pos, self._room, self.step, disp, tick, False, self._ev, 0, self._st)
-            t1 = clock()
-            spent["move"] += t1 - t0
-            if st[_S_PAIRS]:
-                if st[_S_KEYS] < 0 or drift >= margin:
-                    args = (self.pos, self.size, disp, self.movable, margin, method, cell, order)
-                    k = _relist(*args, lo, hi, keys, self._ws)
-                    if k > keys.shape[0]:
-                        keys, near = np.empty(2 * k, np.int64), np.empty(2 * k, np.int64)
-                        k = _relist(*args, lo, hi, keys, self._ws)
-                    st[_S_KEYS] = k
-                    anchor[:] = self.pos
-                t2 = clock()
-                n_near = _near(self.pos, self.size, disp, keys, st[_S_KEYS], near)
-                t3 = clock()
-                _pairs(
-                    self.pos,
-                    self.size,
-                    self.step,
-                    disp,
-                    near,
-                    n_near,
-                    tick,
-                    False,
-                    self._ev,
-                    0,
-                    self._st,
-                )
-                t4 = clock()
-                spent["broad"] += t2 - t1
-                spent["narrow"] += t3 - t2
-                spent["response"] += t4 - t3
-            st[_S_TICK] = tick
-        self._bp = (order, anchor, keys, near, disp, lo, hi, params)
-        self.tick = int(st[_S_TICK])
-        return spent
 
     def positions(self) -> np.ndarray:
         return self.pos.astype(np.float64)

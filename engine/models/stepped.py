@@ -24,7 +24,9 @@ objects are never listed, and with no movable object (or fewer than two objects)
 skipped; the `skip=False` option turns both skips off, and `broadphase` ("sweep", "grid",
 "cells") forces a method instead of the scene's choice (for tests and `collide2d bench`).
 
-Events go to the one event log of events.py.
+Events go to the one event log of events.py. The step's stages are one kernel, `_step` (STAGES:
+move, broad, narrow, response): `_run` runs all of them every step, `Model.profile` the same
+kernel one stage at a time to time each.
 """
 
 from __future__ import annotations
@@ -72,8 +74,10 @@ MARGIN_MAX_SIDES = 1.5
 # world's side) of the margin: room for the rounding of the drift and of the grown boxes.
 DRIFT_SLACK_PX = 1e-6
 DRIFT_SLACK_REL = 1e-12
-# The wall and pair event counters in the broad phase's `state` array (see `_run`).
-ST_WALLS, ST_PAIRS = 3, 4
+# The wall and pair event counters and this step's overlapping pairs in the broad phase's `state`
+# array, this step's drift in its `params` (see `_run`).
+ST_WALLS, ST_PAIRS, ST_NEAR = 3, 4, 5
+P_DRIFT = 3
 # Candidate slots to start with per object (the buffers double when full).
 CANDIDATES_PER_OBJECT = 4
 # The objects inside are put back in the broad phase's order once they have strayed from it by
@@ -314,52 +318,96 @@ def _pairs(S, width, height, exact, cores, near, n_near, tick, t, log, rows, tim
     return rows, times, n_ev
 
 
+# The stages of one step, in the order `_step` runs them; `Model.profile` times each by name
+# through the same kernel.
+STAGES = ("move", "broad", "narrow", "response")
+_MOVE, _BROAD, _NARROW, _RESPONSE = range(len(STAGES))
+
+
+@njit(cache=True)
+def _step(first, last, S, dt, width, height, exact, cores, tick, t, log, rows, times, n_ev, bp):
+    """Run the stages first ... last-1 (of STAGES) of one step; returns (event buffers, how many
+    events, bp): the buffers that grew replace the caller's. What a stage hands the next waits
+    in bp between calls: the drift in params[P_DRIFT], the overlapping pairs in state[ST_NEAR]."""
+    keys, near, order, lo, hi, folds, state, params, ws = bp
+    if first <= _MOVE < last:
+        # move, walls: every object; the walls' events in id order; how far anything drifted
+        # from where the candidate list was made
+        n_folds, params[P_DRIFT] = _move_walls(S, dt, folds)
+        if n_folds:
+            for r in range(n_folds):  # one wall event per fold
+                state[ST_WALLS] += folds[r, 1] + folds[r, 2]
+            if log:
+                rows, times, n_ev = _log_walls(folds, n_folds, tick, t, rows, times, n_ev)
+    if state[2] == 0:  # no pair can happen
+        return rows, times, n_ev, bp
+    if first <= _BROAD < last:
+        # the candidate list made anew once an object drifted its margin
+        if state[0] < 0 or params[P_DRIFT] >= params[0] - params[2]:
+            keys, state[0] = _relist(S, params[0], state[1], params[1], bp)
+            bp = (keys, near, order, lo, hi, folds, state, params, ws)
+    if first <= _NARROW < last:
+        # the listed pairs that overlap, in (a, b) order
+        state[ST_NEAR] = _overlapping(S.pos, S.size, S.ext, keys, state[0], near)
+        if state[ST_NEAR] > near.shape[0]:
+            near = np.empty(2 * state[ST_NEAR], np.int64)
+            bp = (keys, near, order, lo, hi, folds, state, params, ws)
+            state[ST_NEAR] = _overlapping(S.pos, S.size, S.ext, keys, state[0], near)
+    if first <= _RESPONSE < last:
+        rows, times, n_ev = _pairs(
+            S,
+            width,
+            height,
+            exact,
+            cores,
+            near,
+            state[ST_NEAR],
+            tick,
+            t,
+            log,
+            rows,
+            times,
+            n_ev,
+            state,
+        )
+    return rows, times, n_ev, bp
+
+
 @njit(cache=True)
 def _run(world, substeps, tick0, ticks, log, S, exact, cores, rows, times, bp):
-    """Run ticks tick0+1 ... tick0+ticks; returns (event buffers, how many events, candidate
-    keys, overlap buffer): the buffers that grew replace the caller's.
+    """Run ticks tick0+1 ... tick0+ticks, every step all of `_step`; returns (event buffers, how
+    many events, bp): the buffers that grew replace the caller's.
 
     S: the state arrays (a `State`). bp = (keys, near, order, lo, hi, folds, state, params, ws):
     the candidate list kept between calls (see the module docstring) and scratch; state = [keys
     listed (-1: no list yet), method, whether pairs can happen at all, wall events and pair events
-    so far, logged or not (ST_WALLS, ST_PAIRS)]; params = [margin px, grid cell px, drift slack
-    px].
+    so far, logged or not (ST_WALLS, ST_PAIRS), overlapping pairs of this step (ST_NEAR)]; params
+    = [margin px, grid cell px, drift slack px, this step's drift px (P_DRIFT)].
     """
-    keys, near, order, lo, hi, folds, state, params, ws = bp
-    pos, size, ext = S.pos, S.size, S.ext
     width, height, fps = world
-    margin, cell, slack = params[0], params[1], params[2]
-    method = state[1]
-    pairs_possible = state[2] != 0
     dt = 1.0 / (fps * substeps)
     n_ev = 0
     for tick in range(tick0 + 1, tick0 + ticks + 1):
         t = tick / fps
         for _ in range(substeps):
-            # move, walls: every object; the walls' events in id order; how far anything
-            # drifted from where the candidate list was made
-            n_folds, drift = _move_walls(S, dt, folds)
-            if n_folds:
-                for r in range(n_folds):  # one wall event per fold
-                    state[ST_WALLS] += folds[r, 1] + folds[r, 2]
-                if log:
-                    rows, times, n_ev = _log_walls(folds, n_folds, tick, t, rows, times, n_ev)
-            if not pairs_possible:
-                continue
-            # pairs: the list made anew once an object drifted its margin, then the listed
-            # pairs that overlap, in (a, b) order
-            if state[0] < 0 or drift >= margin - slack:
-                keys, state[0] = _relist(S, margin, method, cell, bp)
-                bp = (keys, near, order, lo, hi, folds, state, params, ws)
-            n_near = _overlapping(pos, size, ext, keys, state[0], near)
-            if n_near > near.shape[0]:
-                near = np.empty(2 * n_near, np.int64)
-                bp = (keys, near, order, lo, hi, folds, state, params, ws)
-                n_near = _overlapping(pos, size, ext, keys, state[0], near)
-            rows, times, n_ev = _pairs(
-                S, width, height, exact, cores, near, n_near, tick, t, log, rows, times, n_ev, state
+            rows, times, n_ev, bp = _step(
+                0,
+                len(STAGES),
+                S,
+                dt,
+                width,
+                height,
+                exact,
+                cores,
+                tick,
+                t,
+                log,
+                rows,
+                times,
+                n_ev,
+                bp,
             )
-    return rows, times, n_ev, keys, near
+    return rows, times, n_ev, bp
 
 
 class State(NamedTuple):
@@ -428,7 +476,7 @@ class Model:
         """Run `ticks` ticks; the events in the order they happened (empty when log is False)."""
         world = (float(self.world.width), float(self.world.height), float(self.world.fps))
         rows, times = new_log(log)
-        rows, times, n, keys, near = _run(
+        rows, times, n, self._bp = _run(
             world,
             self.substeps,
             self.tick,
@@ -441,7 +489,6 @@ class Model:
             times,
             self._bp,
         )
-        self._bp = (keys, near) + self._bp[2:]
         self.tick += int(ticks)
         return event_records(rows, times, n)
 
@@ -451,61 +498,42 @@ class Model:
         return int(state[ST_WALLS]), int(state[ST_PAIRS])
 
     def profile(self, ticks: int) -> dict[str, float]:
-        """Run `ticks` ticks with the event log off, one stage at a time, and return the seconds
-        spent in each: "move" (motion and walls), "broad" (making the candidate list), "narrow"
-        (testing the listed pairs), "response" (exchange and separation). The state ends exactly
-        as `advance(ticks, log=False)` would leave it. Each stage is timed from Python, so each
-        count includes a call's overhead (microseconds), which dominates in small scenes."""
-        width, height, fps = float(self.world.width), float(self.world.height), self.world.fps
-        keys, near, order, lo, hi, folds, state, params, ws = self._bp
-        margin, cell, slack = float(params[0]), float(params[1]), float(params[2])
+        """Run `ticks` ticks with the event log off, one stage of `_step` at a time, and return
+        the seconds spent in each (STAGES): "move" (motion and walls), "broad" (making the
+        candidate list), "narrow" (testing the listed pairs), "response" (exchange and
+        separation). The state ends exactly as `advance(ticks, log=False)` would leave it. Each
+        stage is timed from Python, so each count includes a call's overhead (microseconds),
+        which dominates in small scenes."""
+        fps = float(self.world.fps)
+        width, height = float(self.world.width), float(self.world.height)
         dt = 1.0 / (fps * self.substeps)
         exact = self.geometry == "exact"
         rows, times = new_log(False)
-        spent = {"move": 0.0, "broad": 0.0, "narrow": 0.0, "response": 0.0}
+        spent = dict.fromkeys(STAGES, 0.0)
         clock = time.perf_counter
         for tick in range(self.tick + 1, self.tick + int(ticks) + 1):
             t = tick / fps
             for _ in range(self.substeps):
-                t0 = clock()
-                n_folds, drift = _move_walls(self._S, dt, folds)
-                state[ST_WALLS] += folds[:n_folds, 1:3].sum()
-                t1 = clock()
-                spent["move"] += t1 - t0
-                if not state[2]:
-                    continue
-                if state[0] < 0 or drift >= margin - slack:
-                    bp = (keys, near, order, lo, hi, folds, state, params, ws)
-                    keys, state[0] = _relist(self._S, margin, state[1], cell, bp)
-                t2 = clock()
-                n_near = _overlapping(self._S.pos, self._S.size, self._S.ext, keys, state[0], near)
-                if n_near > near.shape[0]:
-                    near = np.empty(2 * n_near, np.int64)
-                    n_near = _overlapping(
-                        self._S.pos, self._S.size, self._S.ext, keys, state[0], near
+                for stage, name in enumerate(STAGES):
+                    began = clock()
+                    rows, times, _, self._bp = _step(
+                        stage,
+                        stage + 1,
+                        self._S,
+                        dt,
+                        width,
+                        height,
+                        exact,
+                        self._cores,
+                        tick,
+                        t,
+                        False,
+                        rows,
+                        times,
+                        0,
+                        self._bp,
                     )
-                t3 = clock()
-                _pairs(
-                    self._S,
-                    width,
-                    height,
-                    exact,
-                    self._cores,
-                    near,
-                    n_near,
-                    tick,
-                    t,
-                    False,
-                    rows,
-                    times,
-                    0,
-                    state,
-                )
-                t4 = clock()
-                spent["broad"] += t2 - t1
-                spent["narrow"] += t3 - t2
-                spent["response"] += t4 - t3
-        self._bp = (keys, near, order, lo, hi, folds, state, params, ws)
+                    spent[name] += clock() - began
         self.tick += int(ticks)
         return spent
 
@@ -544,7 +572,7 @@ def _broad_phase(world, pos, vel, size, movable, substeps, skip, broadphase):
         np.empty_like(pos),  # lo
         np.empty_like(pos),  # hi
         np.empty((2 * n, 4), np.int64),  # folds
-        np.array([-1, method, int(possible), 0, 0], np.int64),  # state (see _run)
-        np.array([margin, cell, slack]),
+        np.array([-1, method, int(possible), 0, 0, 0], np.int64),  # state (see _run)
+        np.array([margin, cell, slack, 0.0]),
         workspace(n),
     )

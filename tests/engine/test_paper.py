@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from collide2d.engine.events import AXIS_NAMES, EV_PAIR, EV_WALL, SIDE_NAMES
-from collide2d.engine.models.paper import Model
+from collide2d.engine.models.paper import STAGES, Model
 from collide2d.engine.world import Bodies, WorldSpec
 
 
@@ -380,6 +380,11 @@ def test_profile_runs_the_same_ticks_as_advance():
     a, b = Model(WorldSpec(300, 200, 10), bodies), Model(WorldSpec(300, 200, 10), bodies)
     a.advance(80, log=False)
     spent = b.profile(80)
-    assert set(spent) == {"move", "broad", "narrow", "response"} and b.tick == 80
+    # each stage of the one stage list of `_run`, by name, in the order the tick runs them
+    assert tuple(spent) == tuple(name for name, _ in STAGES)
+    assert tuple(spent) == ("move", "broad", "narrow", "response") and b.tick == 80
+    assert all(v >= 0.0 for v in spent.values())
     assert a.pos.tolist() == b.pos.tolist() and a.step.tolist() == b.step.tolist()
+    assert a.count.tolist() == b.count.tolist()
+    assert a.event_counts() == b.event_counts() and min(a.event_counts()) > 0
     assert logged(a.advance(30)) == logged(b.advance(30))
