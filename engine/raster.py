@@ -3,7 +3,7 @@
 This is the picture stage (SPEC section 4). Input: the world (`WorldSpec`), the objects' drawing
 data (`Bodies`: kind, size, colour index, fill flag, polygon vertices) and, per frame, the float
 top-left corners `pos (n, 2)` in pixels. Output: a palette-index frame `(H, W) uint8`, index 0 the
-background and `Bodies.color[i]` the colour of object i; the RGB picture is `palette[frame]`
+background and `Bodies.looks.color[i]` the colour of object i; the RGB picture is `palette[frame]`
 (`to_rgb`). Positions are rounded as `floor(x + 0.5)`; each object is drawn by the primitives of
 `engine.draw` (DDA outlines, midpoint circles, fills), later ids on top, pixels outside the world
 dropped.
@@ -198,8 +198,8 @@ class Renderer:
         self.height = int(world.height)
         self._kind = np.ascontiguousarray(bodies.kind, dtype=np.int8)
         self._wh = round_positions(bodies.size)
-        self._color = np.ascontiguousarray(bodies.color, dtype=np.uint8)
-        self._fill = np.ascontiguousarray(bodies.fill, dtype=np.bool_)
+        self._color = np.ascontiguousarray(bodies.looks.color, dtype=np.uint8)
+        self._fill = np.ascontiguousarray(bodies.looks.fill, dtype=np.bool_)
         self._vert_start = np.ascontiguousarray(bodies.vert_start, dtype=np.int64)
         self._verts = np.ascontiguousarray(bodies.verts, dtype=np.int64).reshape(-1, 2)
         self._ext = _extents(self._kind, self._wh, self._vert_start, self._verts)

@@ -1,10 +1,11 @@
 """The world's state as parallel arrays: what every model, the rasteriser and the writers share.
 
 `WorldSpec` is the fixed frame (size in pixels, ticks per second). `Bodies` is the per-object table
-in id order: hot arrays (`pos`, `vel`, `size`, `inv_mass`, `kind`) that the kernels read, and the
-drawing data (`color`, `fill`, polygon vertices) that only the rasteriser reads. Names and YAML
-lines are cold data and live with the scenario, not here. A box's position is its top-left corner;
-its box covers `[x, x+w) x [y, y+h)`.
+in id order: the hot arrays the models read (`kind`, `pos`, `size`, `vel`, `mass`, `static`, and
+the polygon vertices, which give exact shapes their outline), and apart from them, in
+`Bodies.looks`, the drawing data only the rasteriser reads (`Looks`: colour and fill). Names and
+YAML lines are cold data and live with the scenario, not here. A box's position is its top-left
+corner; its box covers `[x, x+w) x [y, y+h)`.
 """
 
 from __future__ import annotations
@@ -29,6 +30,18 @@ class WorldSpec:
 
 
 @dataclass(frozen=True)
+class Looks:
+    """How objects are drawn, apart from the arrays the models read; n objects.
+
+    color      (n,)   uint8    index into the scenario's palette (0 is the background)
+    fill       (n,)   bool     paint the inside as well as the outline
+    """
+
+    color: np.ndarray
+    fill: np.ndarray
+
+
+@dataclass(frozen=True)
 class Bodies:
     """Per-object arrays in id order; n objects, m polygon vertices in all.
 
@@ -38,10 +51,9 @@ class Bodies:
     vel        (n, 2) float64  px per second
     mass       (n,)   float64  inf for static objects
     static     (n,)   bool     static objects never move
-    color      (n,)   uint8    index into the scenario's palette (0 is the background)
-    fill       (n,)   bool     paint the inside as well as the outline
     vert_start (n+1,) int64    polygon i's vertices are verts[vert_start[i]:vert_start[i+1]]
     verts      (m, 2) int64    polygon vertices relative to the box's top-left corner
+    looks      Looks           colour and fill, for drawing only
     """
 
     kind: np.ndarray
@@ -50,10 +62,9 @@ class Bodies:
     vel: np.ndarray
     mass: np.ndarray
     static: np.ndarray
-    color: np.ndarray
-    fill: np.ndarray
     vert_start: np.ndarray
     verts: np.ndarray
+    looks: Looks
 
     @property
     def n(self) -> int:
@@ -85,8 +96,10 @@ class Bodies:
             vel=vel,
             mass=mass,
             static=static,
-            color=np.ones(n, np.uint8) if color is None else np.asarray(color, np.uint8),
-            fill=np.zeros(n, bool) if fill is None else np.asarray(fill, bool),
             vert_start=np.zeros(n + 1, np.int64),
             verts=np.zeros((0, 2), np.int64),
+            looks=Looks(
+                color=np.ones(n, np.uint8) if color is None else np.asarray(color, np.uint8),
+                fill=np.zeros(n, bool) if fill is None else np.asarray(fill, bool),
+            ),
         )

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from collide2d.engine.world import Bodies, WorldSpec
+from collide2d.engine.world import Bodies, Looks, WorldSpec
 from collide2d.runner import generate as gen
 from collide2d.runner.nodes import Nodes, fmt
 from collide2d.runner.objects import Block, Listed
@@ -84,10 +84,9 @@ def bodies(reader: Nodes, listed: list[Listed], blocks: list[Block], world: Worl
         vel=all_vel,
         mass=mass,
         static=static,
-        color=color,
-        fill=fill,
         vert_start=vert_start,
         verts=verts,
+        looks=Looks(color=color, fill=fill),
     )
 
     names: list = [o.name for o in listed]

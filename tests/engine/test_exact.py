@@ -20,7 +20,7 @@ from collide2d.engine.invariants import kinetic_energy
 from collide2d.engine.models import exact as exact_model
 from collide2d.engine.models import make
 from collide2d.engine.models.exact import MAX_EVENTS_PER_TICK, EventCapExceeded
-from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies, WorldSpec
+from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies, Looks, WorldSpec
 
 # --- helpers --------------------------------------------------------------------------------------
 
@@ -44,8 +44,7 @@ def shapes(kind, pos, size, vel, mass=None, polys=None, static=None):
         vel=vel,
         mass=np.where(static, np.inf, mass),
         static=static,
-        color=np.ones(n, np.uint8),
-        fill=np.zeros(n, bool),
+        looks=Looks(color=np.ones(n, np.uint8), fill=np.zeros(n, bool)),
         vert_start=np.array(starts, np.int64),
         verts=np.array(verts, np.int64).reshape(-1, 2),
     )
@@ -592,13 +591,15 @@ def test_same_input_same_bytes_in_chunks_and_in_another_process(tmp_path):
     assert ev_a.tobytes() == ev_b.tobytes()
     assert a.positions().tobytes() == b.positions().tobytes()
     digest = hashlib.sha256(ev_a.tobytes() + a.positions().tobytes()).hexdigest()
-    np.savez(tmp_path / "bodies.npz", **bodies.__dict__)
+    hot = {k: v for k, v in bodies.__dict__.items() if k != "looks"}
+    np.savez(tmp_path / "bodies.npz", **hot, color=bodies.looks.color, fill=bodies.looks.fill)
     script = (
         "import hashlib, sys, numpy as np\n"
-        "from engine.models import make\n"
-        "from engine.world import Bodies, WorldSpec\n"
+        "from collide2d.engine.models import make\n"
+        "from collide2d.engine.world import Bodies, Looks, WorldSpec\n"
         "arrays = np.load(sys.argv[1])\n"
-        "bodies = Bodies(**{k: arrays[k] for k in arrays.files})\n"
+        "hot = {k: arrays[k] for k in arrays.files if k not in ('color', 'fill')}\n"
+        "bodies = Bodies(**hot, looks=Looks(arrays['color'], arrays['fill']))\n"
         "m = make('exact', WorldSpec(160, 120, 10), bodies)\n"
         "e = m.advance(120)\n"
         "print(hashlib.sha256(e.tobytes() + m.positions().tobytes()).hexdigest())\n"

@@ -14,7 +14,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from collide2d.engine import draw, raster
-from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies, WorldSpec
+from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies, Looks, WorldSpec
 
 FAST = settings(max_examples=30, deadline=None)
 
@@ -38,8 +38,7 @@ def make_bodies(kind, pos, size, color, fill, polys=None) -> Bodies:
         vel=np.zeros((n, 2)),
         mass=np.ones(n),
         static=np.zeros(n, bool),
-        color=np.asarray(color, np.uint8),
-        fill=np.asarray(fill, bool),
+        looks=Looks(color=np.asarray(color, np.uint8), fill=np.asarray(fill, bool)),
         vert_start=np.asarray(starts, np.int64),
         verts=np.asarray(verts, np.int64).reshape(-1, 2),
     )

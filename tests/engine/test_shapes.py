@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from collide2d.engine.shapes import build_cores, edge_normals, pixel_hull
-from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies
+from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies, Looks
 
 
 def shoelace(v):
@@ -30,8 +30,7 @@ def bodies_of(kinds, sizes, polys):
         vel=np.zeros((n, 2)),
         mass=np.ones(n),
         static=np.zeros(n, bool),
-        color=np.ones(n, np.uint8),
-        fill=np.zeros(n, bool),
+        looks=Looks(color=np.ones(n, np.uint8), fill=np.zeros(n, bool)),
         vert_start=np.array(starts, np.int64),
         verts=np.array(verts, np.int64).reshape(-1, 2),
     )

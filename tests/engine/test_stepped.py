@@ -13,7 +13,7 @@ from collide2d.engine.invariants import kinetic_energy, momentum
 from collide2d.engine.models import make
 from collide2d.engine.models.stepped import STAGES
 from collide2d.engine.response import exchange, fold, separate
-from collide2d.engine.world import KIND_CIRCLE, Bodies, WorldSpec
+from collide2d.engine.world import KIND_CIRCLE, Bodies, Looks, WorldSpec
 
 
 def boxes_overlap(pos, size):
@@ -213,8 +213,7 @@ def circles(pos, d, vel):
         vel=np.array(vel, float),
         mass=np.ones(n),
         static=np.zeros(n, bool),
-        color=np.ones(n, np.uint8),
-        fill=np.zeros(n, bool),
+        looks=Looks(color=np.ones(n, np.uint8), fill=np.zeros(n, bool)),
         vert_start=np.zeros(n + 1, np.int64),
         verts=np.zeros((0, 2), np.int64),
     )

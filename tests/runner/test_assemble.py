@@ -88,7 +88,7 @@ def test_palette_in_order_of_first_appearance():
     sc = loads(text)
     assert sc.palette.tolist() == [[16, 16, 16], [0, 0, 255], [255, 0, 0], [0, 0, 0], [0, 255, 0]]
     # an object drawn in the background's colour still has its own row: row 0 is the background
-    assert sc.bodies.color.tolist() == [1, 2, 1, 3, 2, 2, 4]
+    assert sc.bodies.looks.color.tolist() == [1, 2, 1, 3, 2, 2, 4]
 
 
 def test_palette_holds_256_rows():

@@ -99,7 +99,7 @@ def test_generated_objects_fill_the_arrays():
     b = sc.bodies
     assert b.n == 31
     assert np.all(b.kind[1:] == KIND_CIRCLE) and np.all(b.size[1:] == 6)
-    assert np.all(b.mass[1:] == 2) and np.all(b.fill[1:]) and not b.fill[0]
+    assert np.all(b.mass[1:] == 2) and np.all(b.looks.fill[1:]) and not b.looks.fill[0]
     assert np.all(np.abs(b.vel[1:]) == 10)
     assert np.all(b.pos == np.floor(b.pos))  # whole pixels
     assert np.all(b.pos >= 0) and np.all(b.pos + b.size <= [320, 240])

@@ -51,7 +51,7 @@ def test_spec_example_loads_as_written():
     # palette: background black, then red, #00ff00, white (the circle's default, then generated)
     assert sc.palette.tolist() == [[0, 0, 0], [255, 0, 0], [0, 255, 0], [255, 255, 255]]
     assert sc.palette.dtype == np.uint8
-    assert b.color.tolist() == [1, 2, 3, 3] + [3] * 50
+    assert b.looks.color.tolist() == [1, 2, 3, 3] + [3] * 50
     assert b.vert_start.tolist()[:6] == [0, 0, 0, 0, 3, 3]
     assert b.vert_start[-1] == 3
     assert b.verts.tolist() == [[0, 9], [5, 0], [10, 9]]
@@ -90,8 +90,8 @@ def test_object_defaults():
     sc = loads(objects("{shape: box, size: 10, position: [1, 2]}"))
     b = sc.bodies
     assert b.vel.tolist() == [[0, 0]] and b.mass.tolist() == [1.0]
-    assert b.static.tolist() == [False] and b.fill.tolist() == [False]
-    assert sc.palette[b.color[0]].tolist() == [255, 255, 255]
+    assert b.static.tolist() == [False] and b.looks.fill.tolist() == [False]
+    assert sc.palette[b.looks.color[0]].tolist() == [255, 255, 255]
     assert sc.names == (None,)
 
 
@@ -104,14 +104,16 @@ def test_object_fields():
     )
     b = sc.bodies
     assert b.kind.tolist() == [KIND_CIRCLE] and b.size.tolist() == [[7, 7]]
-    assert b.vel.tolist() == [[3, -4]] and b.mass.tolist() == [2.5] and b.fill.tolist() == [True]
-    assert sc.names == ("ball",) and sc.palette[b.color[0]].tolist() == [1, 2, 3]
+    assert (
+        b.vel.tolist() == [[3, -4]] and b.mass.tolist() == [2.5] and b.looks.fill.tolist() == [True]
+    )
+    assert sc.names == ("ball",) and sc.palette[b.looks.color[0]].tolist() == [1, 2, 3]
     for arr, dtype in (
         (b.pos, np.float64),
         (b.vel, np.float64),
         (b.size, np.float64),
         (b.kind, np.int8),
-        (b.color, np.uint8),
+        (b.looks.color, np.uint8),
         (b.verts, np.int64),
     ):
         assert arr.dtype == dtype
@@ -510,7 +512,7 @@ def test_bad_objects_at_their_place(obj, bad, message):
 )
 def test_colours(color, rgb):
     sc = loads(objects(f"{{shape: box, size: 3, position: [0, 0], color: {color}}}"))
-    assert tuple(sc.palette[sc.bodies.color[0]]) == rgb
+    assert tuple(sc.palette[sc.bodies.looks.color[0]]) == rgb
 
 
 @pytest.mark.parametrize(

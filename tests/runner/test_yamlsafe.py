@@ -152,7 +152,7 @@ def test_merge_keys_and_explicit_keys_win():
     sc = loads(text)
     assert sc.bodies.size.tolist() == [[10, 10], [10, 10]]
     assert sc.bodies.pos.tolist() == [[0, 0], [20, 0]]
-    assert sc.palette[sc.bodies.color].tolist() == [[255, 0, 0], [0, 0, 255]]
+    assert sc.palette[sc.bodies.looks.color].tolist() == [[255, 0, 0], [0, 0, 255]]
 
 
 def test_duplicate_key_refused():
