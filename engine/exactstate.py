@@ -8,8 +8,29 @@ The `hot` and `kernel` decorators the exact model's kernels are compiled with li
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
+
+
+class State(NamedTuple):
+    """The arrays the exact model's kernels share, handed to them as one argument (numba takes a
+    named tuple as it takes a tuple; the kernels unpack it by position)."""
+
+    F: np.ndarray  # (n, 8) float64, columns below
+    N: np.ndarray  # (n, 8) int64, columns below
+    C: tuple  # exact shapes: radius, vertex start, vertices, edge normals
+    cells: np.ndarray  # the grid's per-cell lists of movers (cells.py)
+    s_start: np.ndarray  # each cell's first entry in s_items (static objects)
+    s_items: np.ndarray  # the static objects filed in each cell
+    HT: np.ndarray  # heap: event times
+    HI: np.ndarray  # heap: event ids and counters
+    HN: np.ndarray  # heap: tie-breaking keys
+    st: np.ndarray  # int64 scalar state, indices S_* below
+    stf: np.ndarray  # float64 scalar state, indices SF_* below
+    world: tuple  # the world's sides and grid, floats
+
 
 # Columns of F (n, 8) float64: position (top-left, px) valid at the object's own clock TLOC (s),
 # velocity (px/s), box size (px), inverse mass (0 for static objects).

@@ -124,6 +124,7 @@ from collide2d.engine.exactstate import (
     TLOC,
     VX,
     VY,
+    State,
     X,
     Y,
     hot,
@@ -217,28 +218,7 @@ def _on_pair(a, b, code, nx, ny, t, F, N, jobs):
 
 
 @kernel
-def _run(
-    jobs,
-    stack,
-    tick_to,
-    log,
-    cap,
-    everyone,
-    F,
-    N,
-    C,
-    cells,
-    s_start,
-    s_items,
-    HT,
-    HI,
-    HN,
-    st,
-    stf,
-    world,
-    rows,
-    times,
-):
+def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
     """Run ticks until tick_to: first (once) predict every object's first events; then take due
     events in order, apply each, predict again for the objects it touched. (Objects not touched
     keep their clocks; positions() moves them to the tick's end.)
@@ -254,6 +234,7 @@ def _run(
     with a higher cap would resume). st[S_LOGGED] counts the rows written, st[S_WALLS] and
     st[S_PAIRS] every event, logged or not.
     """
+    F, N, C, cells, s_start, s_items, HT, HI, HN, st, stf, world = S
     extra_room = F.shape[0] * F.shape[0] if everyone else 0
     # (The loop's steps are written out here, not as inlined helpers: helpers cost ~15 % of the
     # events per second of a two-body chain, measured with numba 0.68.)
@@ -413,9 +394,11 @@ class Model:
         self._jobs = np.zeros((JOB_ROWS, 3), np.int64)  # scratch: the prediction jobs of one event
         self._stack = np.zeros(INSTANT_STACK, np.int64)  # scratch: walking one instant's entries
 
-    def _state(self):
-        """The arrays the kernels share: F, N, cores, grid (3), heap (3), st, world."""
-        return (self._F, self._N, self._C, *self._G, *self._heap, self._st, self._world)
+    def _state(self) -> State:
+        """The arrays the kernels share."""
+        return State(
+            self._F, self._N, self._C, *self._G, *self._heap, self._st, self._stf, self._world
+        )
 
     def advance(self, ticks: int, log: bool = True) -> np.ndarray:
         """Run `ticks` ticks; the events in the order they happened (empty when log is False)."""
@@ -440,29 +423,8 @@ class Model:
 
     def _call(self, target, log, cap, rows, times) -> int:
         """One call of the kernel `_run` on the model's state; its status."""
-        F, N, C, cells, s_start, s_items, HT, HI, HN, st, world = self._state()
-        return _run(
-            self._jobs,
-            self._stack,
-            target,
-            log,
-            cap,
-            self.repredict == "all",
-            F,
-            N,
-            C,
-            cells,
-            s_start,
-            s_items,
-            HT,
-            HI,
-            HN,
-            st,
-            self._stf,
-            world,
-            rows,
-            times,
-        )
+        everyone = self.repredict == "all"
+        return _run(self._state(), self._jobs, self._stack, target, log, cap, everyone, rows, times)
 
     def event_counts(self) -> tuple[int, int]:
         """(wall events, pair events) so far, logged or not."""

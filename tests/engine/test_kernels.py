@@ -64,7 +64,7 @@ def _tiny_runs() -> None:
         events = model.advance(10)
         assert len(events) > 0
         assert np.isfinite(model.positions()).all()
-    F, N, C, cells, s_start, s_items, HT, HI, HN, st, world_ = model._state()
+    F, N, C, cells, s_start, s_items, HT, HI, HN, st, _stf, world_ = model._state()
     heap_before = int(st[S_HEAP_N])
     set_job(model._jobs, 0, 0, -1, JOB_EVENT)
     predict(model._jobs, 0, 1.0, F, N, C, cells, s_start, s_items, HT, HI, HN, st, world_)
