@@ -26,6 +26,8 @@ from pathlib import Path
 
 from collide2d.runner.exitcodes import EXIT_BAD_INPUT, EXIT_DIFFERENCE, EXIT_OK, EXIT_UNEXPECTED
 from collide2d.runner.golden import bless_run, check_run, golden_frames, report, shown_path
+from collide2d.runner.golden.formats import Output, add_check_formats
+from collide2d.runner.golden.fromreport import add_from_report, bless_from_report
 from collide2d.runner.golden.store import (
     GOLDENS_DIR,
     SCENARIO_SUFFIXES,
@@ -99,8 +101,10 @@ def register(subparsers, *, load=None, simulate=None) -> None:
             p.add_argument(
                 "--report", metavar="DIR", help="write expected/actual/diff images and HTML"
             )
+            add_check_formats(p)
         else:
             p.add_argument("--prune", action="store_true", help="remove goldens no scenario uses")
+            add_from_report(p)
         _common(p)
         p.set_defaults(func=partial(command, load=load, simulate=simulate))
 
@@ -145,9 +149,13 @@ def check_command(args, *, load=default_load, simulate=default_simulate) -> int:
                 raise _Usage(str(exc)) from None
         # Unused goldens are only known when every scenario is checked.
         used = None if args.scenarios else [scn.name for _p, scn in scenarios]
+        try:
+            out = Output(args)
+        except GoldenError as exc:
+            raise _Usage(str(exc)) from None
     except _Usage as exc:
         return exc.exit()
-    outcomes, status, errors = [], EXIT_OK, 0
+    outcomes, status, errors = [], EXIT_OK, []
     for i, (path, scn) in enumerate(scenarios, start=1):
         _progress(args, f"[{i}/{len(scenarios)}] checking {scn.name}")
         try:
@@ -155,21 +163,22 @@ def check_command(args, *, load=default_load, simulate=default_simulate) -> int:
             outcome = check_run(scn, result, store, path=path, report_dir=report_dir)
         except Exception as exc:  # one scenario never stops the others
             status = max(status, _scenario_failed(args, "checking", path, scn, exc))
-            errors += 1
+            errors.append((scn.name, f"{type(exc).__name__}: {exc}"))
             continue
         outcomes.append(outcome)
-        print(outcome.message(), flush=True)
+        out.say(outcome.message())
     unused = store.unused(used) if used is not None else []
     if unused:
-        print(
+        out.say(
             f"unused goldens (no scenario uses them): {', '.join(unused)}; "
             "remove them with: collide2d bless --prune"
         )
     if report_dir is not None:
-        print(f"report: {shown_path(report.write_index(report_dir, outcomes, unused))}")
+        out.say(f"report: {shown_path(report.write_index(report_dir, outcomes, unused))}")
     failed = [o for o in outcomes if not o.ok]
-    said = f", {errors} not checked (errors above)" if errors else ""
-    print(f"{len(outcomes) - len(failed)} passed, {len(failed)} failed{said}")
+    said = f", {len(errors)} not checked (errors above)" if errors else ""
+    out.say(f"{len(outcomes) - len(failed)} passed, {len(failed)} failed{said}")
+    out.finish(outcomes, unused, errors)
     return max(status, EXIT_DIFFERENCE if failed else EXIT_OK)
 
 
@@ -212,6 +221,8 @@ def bless_command(args, *, load=default_load, simulate=default_simulate) -> int:
             raise _Usage(
                 "CI is set: goldens are never written in CI; bless locally and commit goldens/"
             )
+        if getattr(args, "from_report", None):
+            return bless_from_report(args, partial(_prepare, load=load))
         root, scenarios = _prepare(args, load)
         store = GoldenStore(root)
         used = _all_names(root, scenarios, load) if args.prune else []

@@ -9,18 +9,18 @@ texts of events and final state when those differ. Outputs:
 - `write_scenario(DIR, outcome)`: `DIR/NAME/` with `frame_000006_expected.png`, `_actual.png` and
   `_diff.png` per differing frame (the diff: differing pixels in magenta, pixels changed within the
   colour threshold in amber, over the run's frame dimmed to grey), the golden and run event logs or
-  final states when they differ, `summary.json` and a self-contained `index.html`;
+  final states when they differ, `summary.json`, a self-contained `index.html` (see
+  `reportpage`) and `run/`, the golden files this run would bless (`bless --from-report`);
 - `write_index(DIR, outcomes, unused)`: `DIR/summary.json` and `DIR/index.html` over all scenarios.
 
-Pages reference their images by relative paths and load nothing from the network, so a report
-folder can be zipped, kept as a CI artifact and opened anywhere. A report is written only into real
+Pages hold their images inline and load nothing from the network, so a page can be mailed, a report
+folder zipped, kept as a CI artifact and opened anywhere. A report is written only into real
 folders: a report folder, scenario folder or file that is a symbolic link is refused
 (`ReportRefused`, naming it), never followed or replaced, and nothing in a report folder is deleted.
 """
 
 from __future__ import annotations
 
-import html
 import os
 import stat
 from dataclasses import dataclass, field
@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from collide2d.runner.golden import reportpage
 from collide2d.runner.golden.compare import FrameDiff
 from collide2d.runner.golden.store import GoldenError, link_message, shown_path
 from collide2d.runner.outputs import atomic_write_bytes, encode_png, write_json
@@ -37,8 +38,9 @@ REPORT_FORMAT = 1
 DIFF_COLOR = (255, 0, 255)
 WITHIN_THRESHOLD_COLOR = (255, 176, 0)
 DIM_LEVEL = 0.35
-# On the pages, frames narrower than this many pixels are shown at twice their size.
-ZOOM_BELOW_PX = 480
+# In a scenario's report folder: the golden files of the run checked (what a bless would write).
+RUN_DIR = "run"
+MANIFEST_FILE = "manifest.json"
 
 STATUS_PASSED = "passed"
 STATUS_FAILED = "failed"
@@ -114,6 +116,9 @@ class Outcome:
     problems: list = field(default_factory=list)
     texts: dict = field(default_factory=dict)
     report: Path | None = None
+    cause: object = None  # why.Cause of a failure: scenario edited or engine changed
+    first_event: int | None = None  # index of the first differing event
+    run_files: dict = field(default_factory=dict)  # the golden files of this run, for bless
 
     @property
     def ok(self) -> bool:
@@ -129,6 +134,8 @@ class Outcome:
         if self.ok:
             return f"ok      {self.name}"
         lines = [f"{self.status.upper():<7} {self.name} ({self.scenario})"]
+        if self.cause is not None:
+            lines.append(f"  why: {self.cause.text}")
         for problem in self.problems:
             text = problem.message if isinstance(problem, FrameReport) else problem
             lines.extend("  " + line for line in text.splitlines())
@@ -151,6 +158,8 @@ class Outcome:
             "name": self.name,
             "scenario": self.scenario,
             "status": self.status,
+            "cause": self.cause.as_dict() if self.cause is not None else None,
+            "first_event": self.first_event,
             "problems": [p.message if isinstance(p, FrameReport) else p for p in self.problems],
             "frames": [_frame_summary(f, base) for f in self.frames],
             "files": [_rel(folder / k, base) for k in sorted(self.texts)] if folder else [],
@@ -204,9 +213,47 @@ def write_scenario(report_dir, outcome: Outcome) -> Path:
     outcome.report = folder / INDEX_FILE
     _refuse_link(folder / SUMMARY_FILE)
     write_json(folder / SUMMARY_FILE, outcome.summary(folder))
-    page = _page(f"collide2d golden: {outcome.name}", [outcome], folder, [])
+    if outcome.run_files:
+        _write_run_files(folder / RUN_DIR, outcome.run_files)
+    page = reportpage.page(f"collide2d golden: {outcome.name}", [outcome])
     _write(outcome.report, page)
     return outcome.report
+
+
+def _write_run_files(folder: Path, files: dict) -> None:
+    """The golden this run would bless, under the report's NAME/run/ (manifest last)."""
+    _real_folder(folder)
+    for rel in sorted(files, key=lambda r: (r == MANIFEST_FILE, r)):
+        path = folder / rel
+        _real_folder(path.parent)
+        _write(path, files[rel])
+
+
+def summary_dict(outcomes, unused=(), base: Path | None = None, errors=()) -> dict:
+    """The summary of a check for tools (summary.json, `check --format json`): the counts, the
+    summary line, one record per scenario (by name) and the unused goldens; `errors` names the
+    scenarios an unexpected error or a refusal kept from being checked."""
+    outcomes = sorted(outcomes, key=lambda o: o.name)
+    out = {
+        "format": REPORT_FORMAT,
+        "summary": reportpage.summary_line(outcomes),
+        "passed": sum(o.ok for o in outcomes),
+        "failed": sum(not o.ok for o in outcomes),
+        "scenarios": [o.summary(base) for o in outcomes],
+        "unused_goldens": list(unused),
+    }
+    if errors:
+        out["not_checked"] = list(errors)
+    return out
+
+
+def first_divergence(outcome) -> str:
+    """The first line of the first problem that is not a note on the scenario's settings."""
+    for problem in outcome.problems:
+        text = problem.message if isinstance(problem, FrameReport) else problem
+        if not text.startswith("note:"):
+            return text.splitlines()[0] if text else text
+    return outcome.status
 
 
 def write_index(report_dir, outcomes, unused=()) -> Path:
@@ -214,17 +261,11 @@ def write_index(report_dir, outcomes, unused=()) -> Path:
     name) and the unused goldens; returns the index.html path."""
     folder = _real_folder(Path(report_dir))
     outcomes = sorted(outcomes, key=lambda o: o.name)
-    summary = {
-        "format": REPORT_FORMAT,
-        "passed": sum(o.ok for o in outcomes),
-        "failed": sum(not o.ok for o in outcomes),
-        "scenarios": [o.summary(folder) for o in outcomes],
-        "unused_goldens": list(unused),
-    }
+    summary = summary_dict(outcomes, unused, folder)
     _refuse_link(folder / SUMMARY_FILE)
     write_json(folder / SUMMARY_FILE, summary)
     index = folder / INDEX_FILE
-    _write(index, _page("collide2d golden check", outcomes, folder, list(unused)))
+    _write(index, reportpage.page("collide2d golden check", outcomes, list(unused)))
     return index
 
 
@@ -232,103 +273,3 @@ def _rel(path, base: Path | None) -> str:
     if base is None:
         return Path(path).as_posix()
     return Path(os.path.relpath(path, base)).as_posix()
-
-
-_CSS = """
-body { font: 14px/1.4 system-ui, sans-serif; margin: 1.5em; background: #fafafa; color: #222; }
-h1 { font-size: 1.4em; } h2 { font-size: 1.15em; margin-top: 2em; }
-.passed { color: #1a7f37; } .failed, .missing, .unreadable { color: #cf222e; }
-pre { background: #fff; border: 1px solid #ddd; padding: .6em; overflow-x: auto; }
-.frame { background: #fff; border: 1px solid #ddd; padding: .8em; margin: 1em 0; }
-.views input { display: none; }
-.views label { border: 1px solid #bbb; padding: .2em .7em; cursor: pointer; margin-right: .3em; }
-.views input:checked + label { background: #222; color: #fff; }
-.panel { display: none; margin-top: .8em; }
-.views input.side:checked ~ .side-panel, .views input.diff:checked ~ .diff-panel {
-  display: flex; flex-wrap: wrap; gap: .8em; }
-figure { margin: 0; } figcaption { font-size: .85em; color: #555; }
-img { image-rendering: pixelated; border: 1px solid #999; background: #000; }
-"""
-
-
-def _page(title: str, outcomes, folder: Path, unused: list) -> bytes:
-    parts = [
-        "<!DOCTYPE html>",
-        '<html lang="en"><head><meta charset="utf-8">',
-        f"<title>{html.escape(title)}</title><style>{_CSS}</style></head><body>",
-        f"<h1>{html.escape(title)}</h1>",
-    ]
-    if len(outcomes) > 1 or unused:
-        parts.append("<ul>")
-        for o in outcomes:
-            parts.append(
-                f'<li><a href="#{html.escape(o.name)}">{html.escape(o.name)}</a> '
-                f'<span class="{o.status}">{o.status}</span></li>'
-            )
-        parts.append("</ul>")
-    if unused:
-        names = ", ".join(html.escape(n) for n in unused)
-        parts.append(
-            f"<p>Goldens no scenario uses: {names} "
-            "(remove them with <code>collide2d bless --prune</code>).</p>"
-        )
-    for o in outcomes:
-        parts.append(_section(o, folder))
-    parts.append("</body></html>\n")
-    return "\n".join(parts).encode("utf-8")
-
-
-def _section(o: Outcome, folder: Path) -> str:
-    name = html.escape(o.name)
-    out = [
-        f'<h2 id="{name}">{name} <span class="{o.status}">{o.status}</span></h2>',
-        f"<p>Scenario <code>{html.escape(o.scenario)}</code>.</p>",
-    ]
-    if o.ok:
-        return "\n".join(out)
-    texts = [p for p in o.problems if not isinstance(p, FrameReport)]
-    if texts:
-        out.append("<pre>" + html.escape("\n".join(texts)) + "</pre>")
-    if o.report is not None and o.texts:
-        links = ", ".join(
-            f'<a href="{html.escape(_rel(Path(o.report).parent / k, folder))}">{html.escape(k)}</a>'
-            for k in sorted(o.texts)
-        )
-        out.append(f"<p>Golden and run side by side as text: {links}</p>")
-    for fr in o.frames:
-        out.append(_frame_block(o.name, fr, folder))
-    out.append(f"<p>To accept this run: <code>{html.escape(o.bless)}</code></p>")
-    return "\n".join(out)
-
-
-def _frame_block(name: str, fr: FrameReport, folder: Path) -> str:
-    key = html.escape(f"{name}-{fr.frame}")
-    figures = []
-    for kind in ("expected", "actual", "diff"):
-        if kind in fr.paths:
-            figures.append(_figure(kind, fr, folder))
-    side = "".join(figures)
-    diff = _figure("diff", fr, folder) if "diff" in fr.paths else "<p>No diff image.</p>"
-    return (
-        f'<div class="frame"><p>{html.escape(fr.message)}</p><div class="views">'
-        f'<input type="radio" class="side" name="v-{key}" id="s-{key}" checked>'
-        f'<label for="s-{key}">side by side</label>'
-        f'<input type="radio" class="diff" name="v-{key}" id="d-{key}">'
-        f'<label for="d-{key}">diff</label>'
-        f'<div class="panel side-panel">{side}</div>'
-        f'<div class="panel diff-panel">{diff}</div></div></div>'
-    )
-
-
-def _figure(kind: str, fr: FrameReport, folder: Path) -> str:
-    rgb = {"expected": fr.expected, "actual": fr.actual}.get(kind)
-    if rgb is None:
-        rgb = fr.actual if fr.actual is not None else fr.expected
-    h, w = rgb.shape[:2]
-    zoom = 2 if w < ZOOM_BELOW_PX else 1
-    src = html.escape(_rel(fr.paths[kind], folder))
-    caption = {"expected": "golden", "actual": "this run", "diff": "diff"}[kind]
-    return (
-        f'<figure><img src="{src}" width="{w * zoom}" height="{h * zoom}" alt="{kind}">'
-        f"<figcaption>{caption} ({w}x{h})</figcaption></figure>"
-    )

@@ -35,6 +35,7 @@ import zlib
 import numpy as np
 from PIL import Image, UnidentifiedImageError
 
+from collide2d import __version__
 from collide2d.engine.events import event_dict, format_event
 from collide2d.runner.outputs import encode_png, final_csv_text
 
@@ -238,6 +239,11 @@ def check_manifest(obj) -> dict:
         if entry["file"] != rel:
             raise ValueError(f"{key}.file is {json.dumps(entry['file'])[:80]}, not {rel!r}")
         _hex64(entry.get("sha256"), f"{key}.sha256")
+    if obj.get("scenario_sha256") is not None:  # goldens blessed before it was kept lack it
+        _hex64(obj["scenario_sha256"], "scenario_sha256")
+    version = obj.get("collide2d_version")
+    if version is not None and not (isinstance(version, str) and 0 < len(version) <= 64):
+        raise ValueError("collide2d_version must be a version text of at most 64 characters")
     frames = obj.get("frames")
     if not isinstance(frames, list):
         raise ValueError("'frames' must be a list")
@@ -332,7 +338,9 @@ def parse_final(data: bytes) -> np.ndarray:
 def manifest(scenario, events: bytes, final: bytes, frames: dict[int, np.ndarray]) -> dict:
     """The manifest of a golden: format version, what was run, and the hash of every file.
 
-    scenario: the Scenario that was run (name, model, ticks, world); events / final: the bytes of
+    scenario: the Scenario that was run (name, model, ticks, world, the SHA-256 of its text, kept
+    with the collide2d version that blesses it so a failed check can say whether the scenario or
+    the engine changed); events / final: the bytes of
     events.jsonl and final.csv; frames: frame number -> (H, W, 3) uint8. Keys are in a fixed order
     and no value depends on the time or the machine.
     """
@@ -346,6 +354,9 @@ def manifest(scenario, events: bytes, final: bytes, frames: dict[int, np.ndarray
             "fps": int(scenario.world.fps),
         },
         "ticks": int(scenario.ticks),
+        # why a check fails: was the scenario edited, or did another collide2d bless it
+        "scenario_sha256": getattr(scenario, "text_sha256", None),
+        "collide2d_version": __version__,
         "events": {
             "file": EVENTS_FILE,
             "count": events.count(b"\n"),

@@ -16,7 +16,7 @@ import json
 import shlex
 from dataclasses import dataclass
 
-from collide2d.runner.golden import compare, report
+from collide2d.runner.golden import compare, report, why
 from collide2d.runner.golden import serialize as ser
 from collide2d.runner.golden.store import (
     DEFAULT_MAX_FRAME_PIXELS,
@@ -76,9 +76,21 @@ def check_run(scenario, result, store: GoldenStore, *, path=None, report_dir=Non
         if outcome.problems:
             outcome.status = report.STATUS_FAILED
             outcome.problems[:0] = _setting_notes(scenario, golden.manifest)
+            outcome.cause = why.cause(scenario, golden.manifest)
     if report_dir is not None and not outcome.ok:
+        if outcome.status != report.STATUS_UNREADABLE or run_frames:
+            outcome.run_files = _run_files(scenario, result)
         report.write_scenario(report_dir, outcome)
     return outcome
+
+
+def _run_files(scenario, result) -> dict:
+    """The golden files this run would bless (kept in a report for `bless --from-report`); empty
+    when the run lacks a golden frame."""
+    try:
+        return golden_files(scenario, result)
+    except ValueError:
+        return {}
 
 
 def _setting_notes(scenario, manifest) -> list[str]:
@@ -99,6 +111,7 @@ def _compare(scenario, result, golden, run_frames, outcome) -> None:
     mismatch = compare.compare_events(golden.events, events, tol)
     if mismatch is not None:
         outcome.problems.append(mismatch.message())
+        outcome.first_event = mismatch.index
         outcome.texts["events_expected.jsonl"] = golden.files[ser.EVENTS_FILE]
         outcome.texts["events_actual.jsonl"] = ser.events_jsonl(result.events)
     hashes = {int(e["frame"]): e["pixels_sha256"] for e in golden.manifest["frames"]}

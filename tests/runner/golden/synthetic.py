@@ -20,6 +20,7 @@ and watches the check react, independent of the physics:
 from __future__ import annotations
 
 import copy
+import hashlib
 import json
 from pathlib import Path
 from types import SimpleNamespace
@@ -80,6 +81,7 @@ def load(path, *, overrides=None, limits=None):
             color_threshold=g["color_threshold"],
         ),
         data=data,
+        text_sha256=hashlib.sha256(text.encode()).hexdigest(),
     )
 
 

@@ -47,6 +47,8 @@ def project(pytester):
     )
     for name in ("a", "b"):
         synthetic.write(pytester.path / "scenarios" / f"{name}.yaml", synthetic.spec(name=name))
+    # pytest-playwright's per-test hook keeps global state that a nested in-process run trips on
+    pytester.makeini("[pytest]\naddopts = -p no:playwright\n")
     return pytester
 
 

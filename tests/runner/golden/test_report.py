@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+import base64
 import json
 import re
 
 import numpy as np
 
-from collide2d.runner.golden import report
+from collide2d.runner.golden import report, reportpage
 from collide2d.runner.golden.compare import compare_frame
 from collide2d.runner.golden.serialize import decode_png
 
@@ -68,35 +69,93 @@ def test_scenario_report_folder(tmp_path):
     assert summary["bless"] == "collide2d bless scenarios/demo.yaml"
 
 
-def _assert_self_contained(page, folder):
-    assert "http://" not in page and "https://" not in page and "<script" not in page
-    srcs = re.findall(r'(?:src|href)="([^"#]+)"', page)
+def _assert_self_contained(page):
+    """Nothing is loaded from anywhere: every src is an inline image, every href an anchor."""
+    assert "http://" not in page and "https://" not in page and "<link" not in page
+    srcs = re.findall(r'src="([^"]+)"', page)
     assert srcs, "the page shows no images"
-    for src in srcs:
-        assert not src.startswith("/") and ":" not in src
-        assert (folder / src).is_file(), src
+    assert all(src.startswith("data:image/png;base64,") for src in srcs)
+    assert all(h.startswith("#") for h in re.findall(r'href="([^"]+)"', page))
 
 
-def test_pages_are_self_contained_with_side_by_side_and_diff_views(tmp_path):
+def _images(page) -> list[np.ndarray]:
+    return [
+        decode_png(base64.b64decode(src))
+        for src in re.findall(r'src="data:image/png;base64,([^"]+)"', page)
+    ]
+
+
+def test_pages_are_self_contained_with_crops_views_and_full_frames(tmp_path):
     out = _failed_outcome(texts={"final_expected.csv": b"id,x,y,vx,vy\n"})
     page_path = report.write_scenario(tmp_path, out)
     page = page_path.read_text()
-    _assert_self_contained(page, page_path.parent)
-    assert "side by side" in page and ">diff<" in page
-    # frame 6: expected, actual, diff side by side and the diff alone; frame 9: its run frame
-    assert page.count("<img") == 5
-    assert "No diff image" in page
-    ok = report.Outcome("zeta", "scenarios/zeta.yaml", "collide2d bless scenarios/zeta.yaml")
+    _assert_self_contained(page)
+    for view in ("side by side", "blink", "slider", "diff"):
+        assert f">{view}</button>" in page
+    e, a = _pair()
+    images = _images(page)
+    # frame 6: the crop (the whole 6x4 frame: smaller than the least crop) enlarged 40x as
+    # golden, run and diff side by side, golden and run stacked for blink and slider, the diff
+    # alone, then the full run frame; frame 9: its run frame only
+    zoom = reportpage.crop_zoom((0, 0, 6, 4))
+    assert zoom == 16  # CROP_TARGET // 6 = 40, at most CROP_MAX_ZOOM
+    big = lambda rgb: rgb.repeat(zoom, axis=0).repeat(zoom, axis=1)  # noqa: E731
+    diff = report.diff_image(out.frames[0])
+    expected = [big(e), big(a), big(diff), big(e), big(a), big(diff), a, a]
+    assert len(images) == len(expected)
+    for got, want in zip(images, expected, strict=True):
+        assert np.array_equal(got, want)
+    ok = report.Outcome("alpha", "scenarios/alpha.yaml", "collide2d bless scenarios/alpha.yaml")
     index = report.write_index(tmp_path, [ok, out], unused=["old"])
     top = index.read_text()
-    _assert_self_contained(top, tmp_path)
-    assert 'src="demo/frame_000006_diff.png"' in top
+    _assert_self_contained(top)
+    assert '<p id="summary" class="summary bad">1 failed, 1 passed</p>' in top
+    assert top.index('id="sc-demo"') < top.index('id="sc-alpha"')  # failures first
     assert "old" in top and "collide2d bless --prune" in top
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert (summary["passed"], summary["failed"]) == (1, 1)
-    assert [s["name"] for s in summary["scenarios"]] == ["demo", "zeta"]
+    assert summary["summary"] == "1 failed, 1 passed"
+    assert [s["name"] for s in summary["scenarios"]] == ["alpha", "demo"]
     assert summary["unused_goldens"] == ["old"]
-    assert summary["scenarios"][0]["frames"][0]["diff"] == "demo/frame_000006_diff.png"
+    assert summary["scenarios"][1]["frames"][0]["diff"] == "demo/frame_000006_diff.png"
+
+
+def test_crop_surrounds_the_change_within_the_frame():
+    # a 3x2 change near the right edge of a 320x240 frame
+    box = reportpage.crop_box((315, 100, 317, 101), 320, 240)
+    x0, y0, x1, y1 = box
+    assert x1 == 320 and x1 - x0 == reportpage.CROP_MIN  # pushed back inside, at least CROP_MIN
+    assert y0 <= 100 - reportpage.CROP_MARGIN and y1 >= 102 + reportpage.CROP_MARGIN
+    assert y1 - y0 == reportpage.CROP_MIN
+    # a large change keeps its margin
+    assert reportpage.crop_box((10, 20, 109, 59), 320, 240) == (4, 14, 116, 66)
+    assert reportpage.crop_zoom((4, 14, 116, 66)) == 2
+
+
+def test_event_table_marks_the_first_divergence_with_context():
+    from collide2d.runner.golden import serialize as ser
+
+    def line(tick, i):
+        return json.dumps({"tick": tick, "t": tick / 10, "type": "wall", "id": i, "side": "left"})
+
+    golden = [line(k, 0) for k in range(10)]
+    run = golden[:6] + [line(6, 1)] + golden[7:]
+    out = _failed_outcome(
+        texts={
+            "events_expected.jsonl": ("\n".join(golden) + "\n").encode(),
+            "events_actual.jsonl": ("\n".join(run) + "\n").encode(),
+        }
+    )
+    out.first_event = 6
+    assert len(ser.parse_events(out.texts["events_actual.jsonl"])) == 10
+    page = reportpage.page("t", [out]).decode()
+    table = page[page.index('<table class="events">') : page.index("</table>")]
+    rows = re.findall(r'<tr class="(\w+)"><td>(\d+)</td>', table)
+    assert rows == [("same", "4"), ("same", "5"), ("same", "6"), ("first", "7"),
+                    ("same", "8"), ("same", "9"), ("same", "10")]
+    assert "3 matching events before" in table and "first divergence at #7" in table
+    first = re.search(r'<tr class="first">.*?</tr>', table).group(0)
+    assert "tick 6, wall, 0" in first and "tick 6, wall, 1" in first
 
 
 def test_html_escapes_what_it_shows(tmp_path):

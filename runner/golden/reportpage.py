@@ -1,0 +1,391 @@
+"""The report page: one self-contained HTML file a reviewer opens to see what changed and why.
+
+Input: `report.Outcome`s (with their frames and texts) and the report folder. Output: the bytes of
+`index.html`. Every image is inline (PNG data URIs) and the script and styles are inline, so the
+file opens anywhere with no network and no other file.
+
+What the page shows, top to bottom: a summary line (`1 failed, 18 passed`), a "failures only"
+filter and the keys; then one section per scenario, failures first (each group by name). A failed
+section says why it changed (`why.Cause`: the scenario edited since bless, or the same scenario
+under another collide2d), lists the problems, shows the event log diff as a table (golden and run
+side by side, the first divergence highlighted, `EVENT_CONTEXT` rows around it), and per differing
+frame a crop around the changed pixels enlarged with nearest-neighbour pixels next to the full
+frame (the crop's place outlined), in four views: side by side, blink (golden and run toggled in
+place), a slider (golden left of the handle, run right of it) and the diff.
+
+Keys: j / k next / previous frame, n / p next / previous failing scenario, 1-4 or s / b / l / d the
+view of the current frame (b again toggles blink), arrow keys move its slider, f the filter.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import json
+
+import numpy as np
+
+from collide2d.runner.golden import compare
+from collide2d.runner.golden import serialize as ser
+from collide2d.runner.outputs import encode_png
+
+# Crops: the changed pixels' box grown by CROP_MARGIN px on each side and to at least CROP_MIN px,
+# enlarged by a whole factor to about CROP_TARGET px on its longer side (at most CROP_MAX_ZOOM).
+CROP_MARGIN = 6
+CROP_MIN = 24
+CROP_TARGET = 240
+CROP_MAX_ZOOM = 16
+# Full frames narrower than this are shown at twice their size.
+ZOOM_BELOW_PX = 480
+# Event rows shown before and after the first divergence.
+EVENT_CONTEXT = 3
+VIEWS = ("side", "blink", "slider", "diff")
+
+
+def summary_line(outcomes) -> str:
+    """`1 failed, 18 passed` (missing and unreadable goldens count as failed)."""
+    failed = sum(not o.ok for o in outcomes)
+    return f"{failed} failed, {len(outcomes) - failed} passed"
+
+
+def ordered(outcomes) -> list:
+    """Failures first, each group by name."""
+    return sorted(outcomes, key=lambda o: (o.ok, o.name))
+
+
+def crop_box(bbox, width: int, height: int) -> tuple[int, int, int, int]:
+    """(x0, y0, x1, y1) exclusive-end crop around the inclusive box `bbox` of changed pixels."""
+    x0, y0, x1, y1 = bbox
+    x0, y0, x1, y1 = x0 - CROP_MARGIN, y0 - CROP_MARGIN, x1 + 1 + CROP_MARGIN, y1 + 1 + CROP_MARGIN
+    for lo, hi, size, axis in ((x0, x1, width, 0), (y0, y1, height, 1)):
+        grow = max(0, min(CROP_MIN, size) - (hi - lo))
+        lo, hi = lo - grow // 2, hi + grow - grow // 2
+        shift = max(0, -lo) - max(0, hi - size)
+        lo, hi = max(0, lo + shift), min(size, hi + shift)
+        if axis == 0:
+            x0, x1 = lo, hi
+        else:
+            y0, y1 = lo, hi
+    return x0, y0, x1, y1
+
+
+def crop_zoom(box) -> int:
+    """The whole enlargement factor of a crop."""
+    side = max(box[2] - box[0], box[3] - box[1])
+    return max(1, min(CROP_MAX_ZOOM, CROP_TARGET // max(side, 1)))
+
+
+def _uri(rgb: np.ndarray, zoom: int = 1) -> str:
+    data = encode_png(np.ascontiguousarray(rgb), scale=zoom)
+    return "data:image/png;base64," + base64.b64encode(data).decode("ascii")
+
+
+def page(title: str, outcomes, unused=()) -> bytes:
+    """index.html bytes over `outcomes` (any order; shown failures first)."""
+    outcomes = ordered(outcomes)
+    parts = [
+        "<!DOCTYPE html>",
+        '<html lang="en"><head><meta charset="utf-8">',
+        '<meta name="viewport" content="width=device-width">',
+        f"<title>{html.escape(title)}</title><style>{_CSS}</style></head><body>",
+        f"<h1>{html.escape(title)}</h1>",
+        f'<p id="summary" class="summary {"bad" if any(not o.ok for o in outcomes) else "good"}">'
+        f"{html.escape(summary_line(outcomes))}</p>",
+        '<p class="bar"><label><input type="checkbox" id="only-failures"> failures only '
+        "(f)</label> <span class=keys>keys: <kbd>j</kbd>/<kbd>k</kbd> next/previous frame, "
+        "<kbd>n</kbd>/<kbd>p</kbd> next/previous failure, <kbd>1</kbd>-<kbd>4</kbd> side by "
+        "side / blink / slider / diff, <kbd>b</kbd> blink, <kbd>←</kbd>/<kbd>→</kbd> slider"
+        "</span></p>",
+        '<ul id="toc">',
+    ]
+    for o in outcomes:
+        name = html.escape(o.name)
+        parts.append(
+            f'<li class="entry" data-status="{o.status}"><a href="#sc-{name}">{name}</a> '
+            f'<span class="{o.status}">{o.status}</span></li>'
+        )
+    parts.append("</ul>")
+    if unused:
+        names = ", ".join(html.escape(n) for n in unused)
+        parts.append(
+            f"<p>Goldens no scenario uses: {names} "
+            "(remove them with <code>collide2d bless --prune</code>).</p>"
+        )
+    parts.extend(_section(o) for o in outcomes)
+    parts.append(f"<script>{_JS}</script></body></html>\n")
+    return "\n".join(parts).encode("utf-8")
+
+
+def _section(o) -> str:
+    name = html.escape(o.name)
+    out = [
+        f'<section class="scenario" id="sc-{name}" data-status="{o.status}">',
+        f'<h2>{name} <span class="{o.status}">{o.status}</span></h2>',
+        f"<p>Scenario <code>{html.escape(o.scenario)}</code>.</p>",
+    ]
+    if o.ok:
+        return "\n".join([*out, "</section>"])
+    if o.cause is not None:
+        out.append(
+            f'<p class="why" data-kind="{html.escape(o.cause.kind)}"><b>Why it changed:</b> '
+            f"{html.escape(o.cause.text)}</p>"
+        )
+    texts = [p for p in o.problems if isinstance(p, str)]
+    if texts:
+        out.append('<pre class="problems">' + html.escape("\n".join(texts)) + "</pre>")
+    table = _event_table(o)
+    if table:
+        out.append(table)
+    for fr in o.frames:
+        out.append(_frame_block(o.name, fr))
+    out.append(f"<p>To accept this run: <code>{html.escape(o.bless)}</code></p>")
+    out.append("</section>")
+    return "\n".join(out)
+
+
+def _event_table(o) -> str:
+    """Golden and run events side by side around the first divergence."""
+    exp_bytes = o.texts.get("events_expected.jsonl")
+    act_bytes = o.texts.get("events_actual.jsonl")
+    if exp_bytes is None or act_bytes is None or o.first_event is None:
+        return ""
+    try:
+        exp, act = ser.parse_events(exp_bytes), ser.parse_events(act_bytes)
+    except ValueError:
+        return ""
+    k = o.first_event
+    lo, hi = max(0, k - EVENT_CONTEXT), min(max(len(exp), len(act)), k + EVENT_CONTEXT + 1)
+    rows = [
+        '<table class="events"><caption>Event log: golden vs this run '
+        f"({len(exp)} vs {len(act)} events; first divergence at #{k + 1})</caption>",
+        "<tr><th>#</th><th>golden</th><th>this run</th></tr>",
+    ]
+    if lo > 0:
+        rows.append(f'<tr class="gap"><td colspan="3">… {lo} matching events before</td></tr>')
+    for i in range(lo, hi):
+        e = exp[i] if i < len(exp) else None
+        a = act[i] if i < len(act) else None
+        cls = "first" if i == k else ("differs" if e != a else "same")
+        rows.append(
+            f'<tr class="{cls}"><td>{i + 1}</td><td>{_event_cell(e)}</td>'
+            f"<td>{_event_cell(a)}</td></tr>"
+        )
+    rest = max(len(exp), len(act)) - hi
+    if rest > 0:
+        rows.append(f'<tr class="gap"><td colspan="3">… {rest} more events</td></tr>')
+    rows.append("</table>")
+    return "\n".join(rows)
+
+
+def _event_cell(ev) -> str:
+    if ev is None:
+        return "<i>(none)</i>"
+    extra = {k: v for k, v in ev.items() if k not in ("tick", "type", "a", "b", "id")}
+    tail = " ".join(f"{k}={json.dumps(v)}" for k, v in extra.items())
+    return f"{html.escape(compare.event_label(ev))} <small>{html.escape(tail)}</small>"
+
+
+def _frame_block(name: str, fr) -> str:
+    key = html.escape(f"{name}-{fr.frame}")
+    head = f'<div class="frame" id="f-{key}" data-view="side" tabindex="-1">'
+    msg = f"<p class=msg>{html.escape(fr.message)}</p>"
+    exp, act, d = fr.expected, fr.actual, fr.diff
+    if d is None or d.size_mismatch or d.bbox is None:
+        figures = [
+            _figure(rgb, caption)
+            for rgb, caption in ((exp, "golden"), (act, "this run"))
+            if rgb is not None
+        ]
+        return head + msg + '<div class="fulls">' + "".join(figures) + "</div></div>"
+    from collide2d.runner.golden.report import diff_image
+
+    h, w = act.shape[:2]
+    box = crop_box(d.bbox, w, h)
+    zoom = crop_zoom(box)
+    x0, y0, x1, y1 = box
+    crops = {
+        kind: _uri(rgb[y0:y1, x0:x1], zoom)
+        for kind, rgb in (("expected", exp), ("actual", act), ("diff", diff_image(fr)))
+    }
+    cw, ch = (x1 - x0) * zoom, (y1 - y0) * zoom
+    size = f'width="{cw}" height="{ch}"'
+    views = "".join(
+        f'<button type="button" data-view="{v}">{label}</button>'
+        for v, label in zip(VIEWS, ("side by side", "blink", "slider", "diff"), strict=True)
+    )
+    crop_caption = (
+        f"crop x {x0}..{x1 - 1}, y {y0}..{y1 - 1}, {zoom}x; changed pixels x {d.bbox[0]}.."
+        f"{d.bbox[2]}, y {d.bbox[1]}..{d.bbox[3]}"
+    )
+    return (
+        head
+        + msg
+        + f'<div class="views">{views} <span class="showing"></span></div>'
+        + '<div class="crops">'
+        + f'<div class="panel side"><figure><img {size} src="{crops["expected"]}" alt="golden">'
+        + "<figcaption>golden</figcaption></figure>"
+        + f'<figure><img {size} src="{crops["actual"]}" alt="this run">'
+        + "<figcaption>this run</figcaption></figure>"
+        + f'<figure><img {size} src="{crops["diff"]}" alt="diff">'
+        + "<figcaption>diff</figcaption></figure></div>"
+        + f'<div class="panel stack" style="width:{cw}px;height:{ch}px">'
+        + f'<img class="under" {size} src="{crops["expected"]}" alt="golden">'
+        + f'<img class="over" {size} src="{crops["actual"]}" alt="this run"></div>'
+        + '<div class="panel slider"><input type="range" min="0" max="100" value="50" '
+        + f'style="width:{cw}px" aria-label="slider"></div>'
+        + f'<div class="panel diff"><img {size} src="{crops["diff"]}" alt="diff"></div>'
+        + f"<p class=caption>{html.escape(crop_caption)}</p></div>"
+        + '<div class="fulls">'
+        + _figure(act, "this run, full frame", box)
+        + "</div></div>"
+    )
+
+
+def _figure(rgb, caption: str, box=None) -> str:
+    h, w = rgb.shape[:2]
+    zoom = 2 if w < ZOOM_BELOW_PX else 1
+    mark = ""
+    if box is not None:
+        x0, y0, x1, y1 = (v * zoom for v in box)
+        mark = (
+            f'<span class="mark" style="left:{x0}px;top:{y0}px;width:{x1 - x0}px;'
+            f'height:{y1 - y0}px"></span>'
+        )
+    return (
+        f'<figure><div class="full" style="width:{w * zoom}px;height:{h * zoom}px">'
+        f'<img src="{_uri(rgb)}" width="{w * zoom}" height="{h * zoom}" alt="{caption}">'
+        f"{mark}</div><figcaption>{html.escape(caption)} ({w}x{h})</figcaption></figure>"
+    )
+
+
+_CSS = """
+body { font: 14px/1.4 system-ui, sans-serif; margin: 1.5em; background: #fafafa; color: #222; }
+h1 { font-size: 1.4em; } h2 { font-size: 1.15em; margin-top: 1.5em; }
+.summary { font-size: 1.2em; font-weight: bold; } .summary.bad { color: #cf222e; }
+.summary.good { color: #1a7f37; }
+.passed { color: #1a7f37; } .failed, .missing, .unreadable { color: #cf222e; }
+body.only-failures [data-status="passed"] { display: none; }
+.why { background: #fff8c5; border: 1px solid #d4a72c; padding: .4em .6em; }
+pre { background: #fff; border: 1px solid #ddd; padding: .6em; overflow-x: auto; }
+.frame { background: #fff; border: 1px solid #ddd; padding: .8em; margin: 1em 0;
+  display: flex; flex-wrap: wrap; gap: 1em; }
+.frame.current { outline: 3px solid #0969da; }
+.frame .msg { flex-basis: 100%; margin: 0; }
+.views button { border: 1px solid #bbb; background: #fff; padding: .2em .7em; cursor: pointer; }
+.frame[data-view="side"] button[data-view="side"], .frame[data-view="blink"]
+  button[data-view="blink"], .frame[data-view="slider"] button[data-view="slider"],
+  .frame[data-view="diff"] button[data-view="diff"] { background: #222; color: #fff; }
+.panel { display: none; margin-top: .6em; }
+.frame[data-view="side"] .panel.side { display: flex; gap: .8em; }
+.frame[data-view="blink"] .panel.stack, .frame[data-view="slider"] .panel.stack,
+  .frame[data-view="slider"] .panel.slider, .frame[data-view="diff"] .panel.diff {
+  display: block; }
+.stack { position: relative; }
+.stack img { position: absolute; left: 0; top: 0; }
+.frame[data-view="blink"] .stack img.over { visibility: hidden; }
+.frame[data-view="blink"].show-run .stack img.over { visibility: visible; }
+.frame:not([data-view="slider"]) .stack img.over { clip-path: none !important; }
+figure { margin: 0; } figcaption, .caption { font-size: .85em; color: #555; }
+img { image-rendering: pixelated; display: block; }
+.full { position: relative; border: 1px solid #999; }
+.mark { position: absolute; outline: 2px solid #0969da; pointer-events: none; }
+table.events { border-collapse: collapse; background: #fff; margin: .6em 0; }
+table.events td, table.events th { border: 1px solid #ddd; padding: .15em .6em;
+  font-family: ui-monospace, monospace; font-size: .9em; text-align: left; }
+table.events tr.first { background: #ffd8d3; font-weight: bold; }
+table.events tr.differs { background: #fff0ee; }
+table.events tr.gap td { color: #777; font-style: italic; }
+kbd { border: 1px solid #bbb; border-radius: 3px; padding: 0 .3em; background: #fff; }
+"""
+
+_JS = r"""
+(function () {
+  "use strict";
+  var frames = Array.prototype.slice.call(document.querySelectorAll(".frame"));
+  var current = -1;
+  function visible(el) { return el.offsetParent !== null; }
+  function showing(f) {
+    var s = f.querySelector(".showing");
+    if (!s) return;
+    var v = f.dataset.view;
+    s.textContent = v === "blink" ? (f.classList.contains("show-run") ? "showing: this run"
+      : "showing: golden") : "";
+  }
+  function setView(f, v) {
+    if (!f.querySelector(".panel")) return;
+    if (v === "blink" && f.dataset.view === "blink") f.classList.toggle("show-run");
+    f.dataset.view = v;
+    showing(f);
+  }
+  function slide(f, value) {
+    var r = f.querySelector('input[type="range"]');
+    if (!r) return;
+    r.value = String(value);
+    var over = f.querySelector(".stack img.over");
+    over.style.clipPath = "inset(0 0 0 " + r.value + "%)";
+  }
+  frames.forEach(function (f) {
+    f.querySelectorAll("button[data-view]").forEach(function (b) {
+      b.addEventListener("click", function () { setView(f, b.dataset.view); });
+    });
+    var r = f.querySelector('input[type="range"]');
+    if (r) {
+      r.addEventListener("input", function () { slide(f, r.value); });
+      slide(f, r.value);
+    }
+  });
+  function focusFrame(i) {
+    var shown = frames.filter(visible);
+    if (!shown.length) return;
+    if (frames[current]) frames[current].classList.remove("current");
+    var pos = shown.indexOf(frames[current]);
+    pos = Math.max(0, Math.min(shown.length - 1, pos + i));
+    current = frames.indexOf(shown[pos]);
+    var f = frames[current];
+    f.classList.add("current");
+    f.scrollIntoView({block: "nearest"});
+  }
+  function jumpFailure(step) {
+    var bad = Array.prototype.slice.call(
+      document.querySelectorAll('section.scenario:not([data-status="passed"])'));
+    if (!bad.length) return;
+    var here = frames[current] ? bad.indexOf(frames[current].closest("section")) : -1;
+    var next = bad[Math.max(0, Math.min(bad.length - 1, here + step))];
+    if (here < 0 && step < 0) next = bad[0];
+    var f = next.querySelector(".frame");
+    if (frames[current]) frames[current].classList.remove("current");
+    if (f) {
+      current = frames.indexOf(f);
+      f.classList.add("current");
+    } else {
+      current = -1;
+    }
+    next.scrollIntoView({block: "start"});
+    location.hash = next.id;
+  }
+  var filter = document.getElementById("only-failures");
+  filter.addEventListener("change", function () {
+    document.body.classList.toggle("only-failures", filter.checked);
+  });
+  var keyViews = {"1": "side", "2": "blink", "3": "slider", "4": "diff",
+                  "s": "side", "b": "blink", "l": "slider", "d": "diff"};
+  document.addEventListener("keydown", function (e) {
+    if (e.ctrlKey || e.metaKey || e.altKey) return;
+    if (e.target && e.target.tagName === "INPUT" && e.target.type === "range") return;
+    var f = frames[current];
+    if (e.key === "j") focusFrame(current < 0 ? 0 : 1);
+    else if (e.key === "k") focusFrame(current < 0 ? 0 : -1);
+    else if (e.key === "n") jumpFailure(1);
+    else if (e.key === "p") jumpFailure(-1);
+    else if (e.key === "f") { filter.checked = !filter.checked;
+      filter.dispatchEvent(new Event("change")); }
+    else if (keyViews[e.key] && f) setView(f, keyViews[e.key]);
+    else if ((e.key === "ArrowLeft" || e.key === "ArrowRight") && f &&
+             f.dataset.view === "slider") {
+      var r = f.querySelector('input[type="range"]');
+      slide(f, Math.max(0, Math.min(100, Number(r.value) + (e.key === "ArrowLeft" ? -10 : 10))));
+    } else return;
+    e.preventDefault();
+  });
+})();
+"""
