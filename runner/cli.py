@@ -66,6 +66,12 @@ def register_run(subparsers) -> None:
         default=None,
         help="write events.jsonl (default: the scenario's output.events)",
     )
+    p.add_argument(
+        "--viewer",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="write viewer.html, a player of the run (default: the scenario's output.viewer)",
+    )
     add_override_arguments(p)
     p.add_argument(
         "--scale",
@@ -91,6 +97,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         events=out.events if args.events is None else args.events,
         scale=args.scale,
         quiet=args.quiet,
+        viewer=out.viewer if args.viewer is None else args.viewer,
     )
     target, summary = run_to_dir(scenario, args.out, options, limits)
     if not args.quiet:

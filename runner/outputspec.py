@@ -20,7 +20,7 @@ from collide2d.runner.nodes import Nodes
 
 FRAME_WORDS = ("all", "none", "last")
 EVERY_KEYS = ("every",)
-OUTPUT_KEYS = ("frames", "gif", "events")
+OUTPUT_KEYS = ("frames", "gif", "events", "viewer")
 GOLDEN_KEYS = ("frames", "time_tolerance", "max_diff_pixels", "color_threshold")
 
 
@@ -32,6 +32,7 @@ class Output:
     )
     gif: bool
     events: bool
+    viewer: bool = False  # viewer.html beside the GIF (runner.viewer)
 
 
 @dataclass(frozen=True)
@@ -105,7 +106,8 @@ class OutputReader(Nodes):
             frames, spec = self.frames(m["frames"][1], "output.frames", ticks)
         gif = self.boolean(m["gif"][1], "output.gif") if "gif" in m else True
         events = self.boolean(m["events"][1], "output.events") if "events" in m else True
-        return Output(frames=frames, frames_spec=spec, gif=gif, events=events)
+        viewer = self.boolean(m["viewer"][1], "output.viewer") if "viewer" in m else False
+        return Output(frames=frames, frames_spec=spec, gif=gif, events=events, viewer=viewer)
 
     def golden(self, top: dict, ticks: int) -> Golden:
         m = self.mapping(top["golden"][1], "golden", GOLDEN_KEYS) if "golden" in top else {}

@@ -29,7 +29,7 @@ from collide2d.engine.errors import Runaway
 from collide2d.engine.events import empty_events
 from collide2d.engine.invariants import kinetic_energy, momentum
 from collide2d.engine.raster import Renderer
-from collide2d.runner import budget, outputs, rundir
+from collide2d.runner import budget, outputs, rundir, viewer
 from collide2d.runner.frames import FrameRule
 from collide2d.runner.limits import Limits
 from collide2d.runner.progress import Progress
@@ -66,6 +66,7 @@ def drive(
     log_events: bool = False,
     on_events: Callable[[np.ndarray], None] | None = None,
     progress: Progress | None = None,
+    on_tick: Callable[[object], None] | None = None,
 ) -> tuple[object, dict]:
     """Run the scenario; returns (the model at the end, the summary).
 
@@ -73,6 +74,8 @@ def drive(
     `on_frame(k, index_frame)` as an (H, W) uint8 palette-index image that is only valid during
     the call.
     log_events: record events and pass each chunk's array to `on_events`.
+    on_tick: called with the model at tick 0 and after every tick (the viewer records each
+    tick's state); the model then advances one tick per call.
     """
     bodies = scenario.bodies
     options = models.scenario_options(
@@ -94,6 +97,8 @@ def drive(
     start = _energy_momentum(bodies, model.velocities())
     began = time.perf_counter()
 
+    if on_tick is not None:
+        on_tick(model)
     next_frame = frames.next_from(0)
     if next_frame == 0:
         on_frame(0, renderer.draw(model.positions()))
@@ -102,6 +107,8 @@ def drive(
         stop = min(scenario.ticks, model.tick + CHUNK_TICKS)
         if next_frame is not None:
             stop = min(stop, next_frame)
+        if on_tick is not None:
+            stop = model.tick + 1
         try:
             events = model.advance(stop - model.tick, log_events)
         except Runaway as exc:
@@ -112,6 +119,8 @@ def drive(
             ) from None
         if log_events and len(events) and on_events is not None:
             on_events(events)
+        if on_tick is not None:
+            on_tick(model)
         if model.tick == next_frame:
             on_frame(model.tick, renderer.draw(model.positions()))
             next_frame = frames.next_from(model.tick + 1)
@@ -171,6 +180,7 @@ class RunOptions:
     events: bool
     scale: int = 1
     quiet: bool = False
+    viewer: bool = False  # viewer.html beside the GIF (runner.viewer)
 
 
 def output_dir(out_root: str | os.PathLike, scenario: Scenario) -> Path:
@@ -250,6 +260,7 @@ def _write_run(scenario: Scenario, folder: Path, options: RunOptions, plan) -> d
         if gif.note and not options.quiet:
             print(f"{scenario.name}: {gif.note}", file=sys.stderr)
     log = outputs.EventsWriter(folder / "events.jsonl") if options.events else None
+    recorder = viewer.Recorder(scenario) if options.viewer else None  # refuses a run too long
     digits = max(6, len(str(scenario.ticks)))
 
     def on_frame(k: int, idx: np.ndarray) -> None:
@@ -266,9 +277,10 @@ def _write_run(scenario: Scenario, folder: Path, options: RunOptions, plan) -> d
             scenario,
             frames=plan.draw,
             on_frame=on_frame,
-            log_events=options.events,
-            on_events=log.write if log else None,
+            log_events=options.events or recorder is not None,
+            on_events=_tee(log.write if log else None, recorder),
             progress=progress,
+            on_tick=recorder.add if recorder is not None else None,
         )
         for writer in writers:
             writer.close()
@@ -277,8 +289,24 @@ def _write_run(scenario: Scenario, folder: Path, options: RunOptions, plan) -> d
             writer.abort()
         raise
     outputs.write_final_csv(folder / "final.csv", model.positions(), model.velocities())
+    if recorder is not None:
+        outputs.atomic_write_bytes(folder / viewer.VIEWER_FILE, recorder.page())
     outputs.write_json(folder / "summary.json", summary)
     return summary
+
+
+def _tee(write, recorder):
+    """The events callback: the log's writer and the viewer's recorder, whichever are on."""
+    if recorder is None:
+        return write
+    if write is None:
+        return recorder.events
+
+    def both(events):
+        write(events)
+        recorder.events(events)
+
+    return both
 
 
 def _check_finite(scenario: Scenario, model, start, end) -> None:

@@ -215,6 +215,7 @@ def json_schema() -> dict:
                     "frames": {"$ref": "#/$defs/frames"},
                     "gif": {"type": "boolean"},
                     "events": {"type": "boolean"},
+                    "viewer": {"type": "boolean"},
                 },
                 "additionalProperties": False,
             },

@@ -324,7 +324,13 @@ _JS = r"""
     var over = f.querySelector(".stack img.over");
     over.style.clipPath = "inset(0 0 0 " + r.value + "%)";
   }
+  function select(f) {
+    if (frames[current]) frames[current].classList.remove("current");
+    current = frames.indexOf(f);
+    f.classList.add("current");
+  }
   frames.forEach(function (f) {
+    f.addEventListener("click", function () { select(f); });
     f.querySelectorAll("button[data-view]").forEach(function (b) {
       b.addEventListener("click", function () { setView(f, b.dataset.view); });
     });

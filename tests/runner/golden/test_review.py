@@ -18,7 +18,9 @@ def _run(*argv):
 
 
 def _write(tree, name, **changes):
-    return synthetic.write(tree / "scenarios" / f"{name}.yaml", synthetic.spec(name=name, **changes))
+    return synthetic.write(
+        tree / "scenarios" / f"{name}.yaml", synthetic.spec(name=name, **changes)
+    )
 
 
 def _edit_manifest(tree, name, **changes):
@@ -129,7 +131,9 @@ def test_bless_from_report_accepts_the_run_shown_without_running(tree, capsys, m
     assert not calls
     golden = tree / "goldens" / "demo"
     for p in (tree / "rep" / "demo" / "run").rglob("*.*"):
-        assert (golden / p.relative_to(tree / "rep" / "demo" / "run")).read_bytes() == before[p.name]
+        assert (golden / p.relative_to(tree / "rep" / "demo" / "run")).read_bytes() == before[
+            p.name
+        ]
     assert _run("check") == 0  # the golden is now what the run gives
 
 

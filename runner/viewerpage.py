@@ -1,0 +1,372 @@
+"""The run viewer's page: one HTML file with its data, styles and script inline, no network.
+
+`page(data)` takes `runner.viewer.Recorder.data()` and returns `viewer.html`. The script inflates
+the positions with the browser's `DecompressionStream`, then draws each frame the way
+`engine.raster` does: the background, then every object's sprite pixels in id order at its rounded
+position, clipped to the world, into an ImageData at the world's size; that picture is scaled by
+the zoom (whole factors, no smoothing) onto the canvas and the overlays are drawn over it. At zoom
+1 with every overlay off, the canvas holds exactly the PNG frame's pixels.
+
+Controls: play / pause (space), one frame back and forward (left and right arrow keys, or the
+buttons), the frame slider (Home / End), the speed, the zoom (also the mouse wheel) and panning
+(drag the picture). The events list follows the frame (events of the current tick marked and
+scrolled into view); clicking an event jumps to its tick and outlines the objects involved.
+Hovering an object names it. Overlays: velocity arrows (half a second of motion), boxes (each
+object's pixel extent), contact flashes (a ring at each object of a pair or wall event, fading over
+`FLASH_FRAMES` frames) and labels.
+"""
+
+from __future__ import annotations
+
+import html
+
+from collide2d.runner.viewer import data_json
+
+FLASH_FRAMES = 4
+ZOOMS = (1, 2, 3, 4, 6, 8, 12, 16)
+SPEEDS = (0.1, 0.25, 0.5, 1, 2, 4, 8)
+
+
+def page(data: dict) -> bytes:
+    title = f"collide2d viewer: {data['name']}"
+    zooms = "".join(f'<option value="{z}">{z}x</option>' for z in ZOOMS)
+    speeds = "".join(
+        f'<option value="{s}"{" selected" if s == 1 else ""}>{s}x</option>' for s in SPEEDS
+    )
+    overlays = "".join(
+        f'<label><input type="checkbox" id="ov-{key}"> {label}</label> '
+        for key, label in (
+            ("velocity", "velocity"),
+            ("boxes", "boxes"),
+            ("flashes", "contacts"),
+            ("labels", "labels"),
+        )
+    )
+    body = f"""<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8">
+<meta name="viewport" content="width=device-width">
+<title>{html.escape(title)}</title><style>{_CSS}</style></head><body>
+<header><b>{html.escape(data["name"])}</b> <span class="dim">{html.escape(data["model"])} model,
+{data["width"]}x{data["height"]} px, {data["fps"]} fps, {len(data["names"])} objects</span></header>
+<div id="controls">
+<button type="button" id="back" title="one frame back (left arrow)">&#9664;&#9646;</button>
+<button type="button" id="play" title="play / pause (space)">play</button>
+<button type="button" id="fwd" title="one frame forward (right arrow)">&#9646;&#9654;</button>
+<input type="range" id="seek" min="0" max="{data["frames"] - 1}" value="0" aria-label="frame">
+<span id="tick">tick 0</span>
+<label>speed <select id="speed">{speeds}</select></label>
+<label>zoom <select id="zoom">{zooms}</select></label>
+<span class="overlays">{overlays}</span>
+</div>
+<div id="main"><div id="stage"><canvas id="view"></canvas></div>
+<div id="side"><div id="hover" class="dim">hover an object to name it</div>
+<h3>Events <span class="dim" id="event-count"></span></h3><ol id="events"></ol></div></div>
+<p id="status" class="dim">loading…</p>
+<script id="data" type="application/json">{data_json(data)}</script>
+<script>{_JS.replace("FLASH_FRAMES", str(FLASH_FRAMES))}</script>
+</body></html>
+"""
+    return body.encode("utf-8")
+
+
+_CSS = """
+body { font: 14px/1.4 system-ui, sans-serif; margin: 1em; background: #f4f4f4; color: #222; }
+.dim { color: #666; }
+#controls { margin: .5em 0; display: flex; gap: .6em; align-items: center; flex-wrap: wrap; }
+#controls button { min-width: 3em; }
+#seek { width: 320px; }
+#main { display: flex; gap: 1em; align-items: flex-start; }
+#stage { max-width: 960px; max-height: 720px; overflow: auto; border: 1px solid #999;
+  background: #000; cursor: grab; }
+#stage.dragging { cursor: grabbing; }
+canvas { display: block; image-rendering: pixelated; }
+#side { width: 320px; }
+#events { height: 560px; overflow: auto; margin: 0; padding: 0 0 0 3.5em; background: #fff;
+  border: 1px solid #ccc; font: 12px ui-monospace, monospace; }
+#events li { cursor: pointer; padding: 0 .3em; }
+#events li:hover { background: #eef; }
+#events li.now { background: #ffe08a; }
+#events li.selected { outline: 2px solid #c00; }
+"""
+
+_JS = r"""
+(function () {
+  "use strict";
+  var D = JSON.parse(document.getElementById("data").textContent);
+  var W = D.width, H = D.height, F = D.frames, N = D.names.length;
+  var status = document.getElementById("status");
+  var view = document.getElementById("view"), ctx = view.getContext("2d");
+  var world = document.createElement("canvas");
+  world.width = W; world.height = H;
+  var wctx = world.getContext("2d");
+  var image = wctx.createImageData(W, H);
+  var pix = new Uint32Array(image.data.buffer);
+  var seek = document.getElementById("seek"), tickText = document.getElementById("tick");
+  var playBtn = document.getElementById("play"), zoomSel = document.getElementById("zoom");
+  var speedSel = document.getElementById("speed"), list = document.getElementById("events");
+  var hover = document.getElementById("hover"), stage = document.getElementById("stage");
+  var ov = {};
+  ["velocity", "boxes", "flashes", "labels"].forEach(function (k) {
+    ov[k] = document.getElementById("ov-" + k);
+    ov[k].addEventListener("change", function () { draw(); });
+  });
+  function rgba(c) { return ((255 << 24) | (c[2] << 16) | (c[1] << 8) | c[0]) >>> 0; }
+  var bg = rgba(D.background);
+  var col = D.colors.map(rgba);
+  var pos = null, vel = null, off = null, ext = null;
+  var frame = 0, zoom = 1, playing = false, selected = null;
+  var byTick = {}, lit = [];
+
+  function bytes(b64) {
+    var s = atob(b64), out = new Uint8Array(s.length);
+    for (var i = 0; i < s.length; i++) out[i] = s.charCodeAt(i);
+    return out;
+  }
+  function inflate(b64) {
+    var stream = new Blob([bytes(b64)]).stream().pipeThrough(new DecompressionStream("deflate"));
+    return new Response(stream).arrayBuffer();
+  }
+  function undifference(a) {
+    for (var i = 0; i < N; i++) {
+      var base = i * F * 2;
+      for (var k = 1; k < F; k++) {
+        var p = base + k * 2;
+        a[p] = (a[p] + a[p - 2]) | 0;
+        a[p + 1] = (a[p + 1] + a[p - 1]) | 0;
+      }
+    }
+    return a;
+  }
+  function extents() {
+    var e = new Int32Array(N * 4), s = D.spriteStart;
+    for (var i = 0; i < N; i++) {
+      var x0 = 1e9, y0 = 1e9, x1 = -1e9, y1 = -1e9;
+      for (var j = s[i]; j < s[i + 1]; j++) {
+        x0 = Math.min(x0, off[2 * j]); x1 = Math.max(x1, off[2 * j]);
+        y0 = Math.min(y0, off[2 * j + 1]); y1 = Math.max(y1, off[2 * j + 1]);
+      }
+      if (x1 < x0) { x0 = 0; y0 = 0; x1 = -1; y1 = -1; }
+      e[4 * i] = x0; e[4 * i + 1] = y0; e[4 * i + 2] = x1; e[4 * i + 3] = y1;
+    }
+    return e;
+  }
+  function at(i, k) { var p = (i * F + k) * 2; return [pos[p], pos[p + 1]]; }
+
+  function paint(k) {
+    pix.fill(bg);
+    var s = D.spriteStart;
+    for (var i = 0; i < N; i++) {
+      var p = (i * F + k) * 2, x = pos[p], y = pos[p + 1], c = col[i];
+      for (var j = s[i]; j < s[i + 1]; j++) {
+        var px = x + off[2 * j], py = y + off[2 * j + 1];
+        if (px >= 0 && px < W && py >= 0 && py < H) pix[py * W + px] = c;
+      }
+    }
+    wctx.putImageData(image, 0, 0);
+  }
+  function centre(i, k) {
+    var q = at(i, k);
+    return [q[0] + (ext[4 * i] + ext[4 * i + 2] + 1) / 2,
+            q[1] + (ext[4 * i + 1] + ext[4 * i + 3] + 1) / 2];
+  }
+  function outline(i, k, colour, width) {
+    var q = at(i, k);
+    ctx.strokeStyle = colour; ctx.lineWidth = width;
+    ctx.strokeRect((q[0] + ext[4 * i]) * zoom - width / 2,
+                   (q[1] + ext[4 * i + 1]) * zoom - width / 2,
+                   (ext[4 * i + 2] - ext[4 * i] + 1) * zoom + width,
+                   (ext[4 * i + 3] - ext[4 * i + 1] + 1) * zoom + width);
+  }
+  function overlays(k) {
+    var i;
+    if (ov.boxes.checked) for (i = 0; i < N; i++) outline(i, k, "rgba(0,200,255,0.9)", 1);
+    if (ov.velocity.checked) {
+      ctx.strokeStyle = "#ff0"; ctx.fillStyle = "#ff0"; ctx.lineWidth = 1.5;
+      for (i = 0; i < N; i++) {
+        var v = [vel[(i * F + k) * 2], vel[(i * F + k) * 2 + 1]];
+        if (!v[0] && !v[1]) continue;
+        var c = centre(i, k), x0 = c[0] * zoom, y0 = c[1] * zoom;
+        var x1 = x0 + v[0] * 0.5 * zoom, y1 = y0 + v[1] * 0.5 * zoom;
+        var a = Math.atan2(y1 - y0, x1 - x0), h = 4 + zoom;
+        ctx.beginPath(); ctx.moveTo(x0, y0); ctx.lineTo(x1, y1); ctx.stroke();
+        ctx.beginPath(); ctx.moveTo(x1, y1);
+        ctx.lineTo(x1 - h * Math.cos(a - 0.5), y1 - h * Math.sin(a - 0.5));
+        ctx.lineTo(x1 - h * Math.cos(a + 0.5), y1 - h * Math.sin(a + 0.5));
+        ctx.closePath(); ctx.fill();
+      }
+    }
+    if (ov.flashes.checked) {
+      for (var back = 0; back < FLASH_FRAMES; back++) {
+        (byTick[k - back] || []).forEach(function (li) {
+          var e = D.events[li.dataset.index];
+          var alpha = 1 - back / FLASH_FRAMES;
+          ctx.strokeStyle = e[1] ? "rgba(255,96,0," + alpha + ")"
+                                 : "rgba(255,230,0," + alpha + ")";
+          ctx.lineWidth = 2;
+          [e[2], e[3]].forEach(function (i) {
+            if (i < 0) return;
+            var c = centre(i, k);
+            var side = Math.max(ext[4 * i + 2] - ext[4 * i], ext[4 * i + 3] - ext[4 * i + 1]);
+            var r = (side / 2 + 3 + back * 2) * zoom;
+            ctx.beginPath(); ctx.arc(c[0] * zoom, c[1] * zoom, r, 0, 2 * Math.PI); ctx.stroke();
+          });
+        });
+      }
+    }
+    if (ov.labels.checked) {
+      ctx.font = "11px sans-serif"; ctx.fillStyle = "#fff"; ctx.strokeStyle = "#000";
+      ctx.lineWidth = 3;
+      for (i = 0; i < N; i++) {
+        var q = at(i, k), lx = (q[0] + ext[4 * i]) * zoom, ly = (q[1] + ext[4 * i + 1]) * zoom - 3;
+        ctx.strokeText(D.names[i], lx, ly); ctx.fillText(D.names[i], lx, ly);
+      }
+    }
+    if (selected) {
+      [selected[2], selected[3]].forEach(function (i) { if (i >= 0) outline(i, k, "#f0f", 2); });
+    }
+  }
+  function draw() {
+    if (!pos) return;
+    paint(frame);
+    if (view.width !== W * zoom || view.height !== H * zoom) {
+      view.width = W * zoom; view.height = H * zoom;
+    }
+    ctx.imageSmoothingEnabled = false;
+    ctx.clearRect(0, 0, view.width, view.height);
+    ctx.drawImage(world, 0, 0, W * zoom, H * zoom);
+    overlays(frame);
+    seek.value = String(frame);
+    tickText.textContent = "tick " + frame + " / " + (F - 1) + " · t = " +
+      (frame / D.fps).toFixed(3) + " s";
+    view.dataset.tick = String(frame);
+    lit.forEach(function (li) { li.classList.remove("now"); });
+    lit = byTick[frame] || [];
+    lit.forEach(function (li) { li.classList.add("now"); });
+    if (lit.length) list.scrollTop = lit[0].offsetTop - list.clientHeight / 3;
+  }
+  function go(k) { frame = Math.max(0, Math.min(F - 1, k | 0)); draw(); }
+  function setPlaying(on) {
+    playing = on && F > 1;
+    playBtn.textContent = playing ? "pause" : "play";
+    document.body.dataset.playing = playing ? "1" : "0";
+    if (playing) {
+      if (frame >= F - 1) go(0);
+      last = null; acc = 0;
+      requestAnimationFrame(loop);
+    }
+  }
+  var last = null, acc = 0;
+  function loop(now) {
+    if (!playing) return;
+    if (last !== null) acc += (now - last) / 1000 * D.fps * Number(speedSel.value);
+    last = now;
+    if (acc >= 1) {
+      var step = Math.floor(acc); acc -= step;
+      go(frame + step);
+      if (frame >= F - 1) { setPlaying(false); return; }
+    }
+    requestAnimationFrame(loop);
+  }
+  function setZoom(z) { zoom = z; zoomSel.value = String(z); draw(); }
+
+  function buildEvents() {
+    document.getElementById("event-count").textContent = D.eventCount > D.events.length
+      ? "(first " + D.events.length + " of " + D.eventCount + ")" : "(" + D.eventCount + ")";
+    var frag = document.createDocumentFragment();
+    D.events.forEach(function (e, idx) {
+      var li = document.createElement("li");
+      li.dataset.index = String(idx);
+      li.dataset.tick = String(e[0]);
+      var who = e[1] ? D.names[e[2]] + " + " + D.names[e[3]] : D.names[e[2]] + " wall";
+      li.textContent = "tick " + e[0] + ": " + (e[1] ? "pair " : "wall ") + who +
+        " (" + e[4] + ")";
+      li.addEventListener("click", function () {
+        list.querySelectorAll("li.selected").forEach(function (o) {
+          o.classList.remove("selected");
+        });
+        li.classList.add("selected");
+        selected = e;
+        setPlaying(false);
+        go(e[0]);
+      });
+      (byTick[e[0]] = byTick[e[0]] || []).push(li);
+      frag.appendChild(li);
+    });
+    list.appendChild(frag);
+  }
+  function objectAt(wx, wy) {
+    for (var i = N - 1; i >= 0; i--) {
+      var q = at(i, frame);
+      if (wx >= q[0] + ext[4 * i] && wx <= q[0] + ext[4 * i + 2] &&
+          wy >= q[1] + ext[4 * i + 1] && wy <= q[1] + ext[4 * i + 3]) return i;
+    }
+    return -1;
+  }
+
+  playBtn.addEventListener("click", function () { setPlaying(!playing); });
+  document.getElementById("back").addEventListener("click", function () {
+    setPlaying(false); go(frame - 1);
+  });
+  document.getElementById("fwd").addEventListener("click", function () {
+    setPlaying(false); go(frame + 1);
+  });
+  seek.addEventListener("input", function () { setPlaying(false); go(Number(seek.value)); });
+  zoomSel.addEventListener("change", function () { setZoom(Number(zoomSel.value)); });
+  stage.addEventListener("wheel", function (e) {
+    e.preventDefault();
+    var zs = Array.prototype.map.call(zoomSel.options, function (o) { return Number(o.value); });
+    var i = zs.indexOf(zoom) + (e.deltaY < 0 ? 1 : -1);
+    if (i >= 0 && i < zs.length) setZoom(zs[i]);
+  }, {passive: false});
+  var drag = null;
+  stage.addEventListener("mousedown", function (e) {
+    drag = [e.clientX, e.clientY, stage.scrollLeft, stage.scrollTop];
+    stage.classList.add("dragging");
+  });
+  window.addEventListener("mouseup", function () {
+    drag = null; stage.classList.remove("dragging");
+  });
+  window.addEventListener("mousemove", function (e) {
+    if (!drag) return;
+    stage.scrollLeft = drag[2] - (e.clientX - drag[0]);
+    stage.scrollTop = drag[3] - (e.clientY - drag[1]);
+  });
+  view.addEventListener("mousemove", function (e) {
+    if (!pos) return;
+    var i = objectAt(Math.floor(e.offsetX / zoom), Math.floor(e.offsetY / zoom));
+    hover.textContent = i < 0 ? "—"
+      : D.names[i] + " (object " + i + (D.static[i] ? ", static" : "") + ")";
+    view.title = i < 0 ? "" : D.names[i];
+  });
+  document.addEventListener("keydown", function (e) {
+    if (e.ctrlKey || e.metaKey || e.altKey) return;
+    var t = e.target && e.target.tagName;
+    if (t === "INPUT" && e.target.type === "range") return;
+    if (t === "SELECT") return;
+    if (e.key === " ") setPlaying(!playing);
+    else if (e.key === "ArrowRight") { setPlaying(false); go(frame + 1); }
+    else if (e.key === "ArrowLeft") { setPlaying(false); go(frame - 1); }
+    else if (e.key === "Home") { setPlaying(false); go(0); }
+    else if (e.key === "End") { setPlaying(false); go(F - 1); }
+    else return;
+    e.preventDefault();
+  });
+
+  var fit = 1;
+  [1, 2, 3, 4, 6, 8, 12, 16].forEach(function (z) { if (W * z <= 960 && H * z <= 720) fit = z; });
+  var loads = [inflate(D.positions), inflate(D.velocities), inflate(D.sprites)];
+  Promise.all(loads).then(function (bufs) {
+    pos = undifference(new Int32Array(bufs[0]));
+    vel = new Float32Array(bufs[1]);
+    off = new Int32Array(bufs[2]);
+    ext = extents();
+    buildEvents();
+    setZoom(fit);
+    status.textContent = F + " frames";
+    document.body.dataset.ready = "1";
+  }).catch(function (err) {
+    status.textContent = "cannot read this viewer's data: " + err;
+    console.error(err);
+  });
+})();
+"""
