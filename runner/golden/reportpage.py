@@ -259,24 +259,27 @@ def _figure(rgb, caption: str, box=None) -> str:
 
 
 _CSS = """
-body { font: 14px/1.4 system-ui, sans-serif; margin: 1.5em; background: #fafafa; color: #222; }
-h1 { font-size: 1.4em; } h2 { font-size: 1.15em; margin-top: 1.5em; }
-.summary { font-size: 1.2em; font-weight: bold; } .summary.bad { color: #cf222e; }
-.summary.good { color: #1a7f37; }
+body { font: 14px/20px system-ui, sans-serif; margin: 20px; background: #fafafa; color: #222; }
+h1 { font-size: 20px; line-height: 28px; margin: 12px 0; } h2 { font-size: 16px; line-height: 24px;
+  margin: 24px 0 8px; }
+p { margin: 8px 0; }
+.summary { font-size: 18px; line-height: 24px; font-weight: bold; }
+.summary.bad { color: #cf222e; } .summary.good { color: #1a7f37; }
 .passed { color: #1a7f37; } .failed, .missing, .unreadable { color: #cf222e; }
 body.only-failures [data-status="passed"] { display: none; }
-.why { background: #fff8c5; border: 1px solid #d4a72c; padding: .4em .6em; }
-pre { background: #fff; border: 1px solid #ddd; padding: .6em; overflow-x: auto; }
-.frame { background: #fff; border: 1px solid #ddd; padding: .8em; margin: 1em 0;
-  display: flex; flex-wrap: wrap; gap: 1em; }
+.why { background: #fff8c5; border: 1px solid #d4a72c; padding: 6px 8px; }
+pre { background: #fff; border: 1px solid #ddd; padding: 8px; overflow-x: auto; line-height: 18px; }
+.frame { background: #fff; border: 1px solid #ddd; padding: 12px; margin: 16px 0;
+  display: flex; flex-wrap: wrap; gap: 16px; }
 .frame.current { outline: 3px solid #0969da; }
-.frame .msg { flex-basis: 100%; margin: 0; }
-.views button { border: 1px solid #bbb; background: #fff; padding: .2em .7em; cursor: pointer; }
+.frame .msg, .frame .views { flex-basis: 100%; margin: 0; }
+.views button { border: 1px solid #bbb; background: #fff; padding: 2px 10px; cursor: pointer;
+  font: 13px/18px system-ui, sans-serif; }
 .frame[data-view="side"] button[data-view="side"], .frame[data-view="blink"]
   button[data-view="blink"], .frame[data-view="slider"] button[data-view="slider"],
   .frame[data-view="diff"] button[data-view="diff"] { background: #222; color: #fff; }
-.panel { display: none; margin-top: .6em; }
-.frame[data-view="side"] .panel.side { display: flex; gap: .8em; }
+.panel { display: none; margin-top: 10px; }
+.frame[data-view="side"] .panel.side { display: flex; gap: 12px; }
 .frame[data-view="blink"] .panel.stack, .frame[data-view="slider"] .panel.stack,
   .frame[data-view="slider"] .panel.slider, .frame[data-view="diff"] .panel.diff {
   display: block; }
@@ -285,17 +288,17 @@ pre { background: #fff; border: 1px solid #ddd; padding: .6em; overflow-x: auto;
 .frame[data-view="blink"] .stack img.over { visibility: hidden; }
 .frame[data-view="blink"].show-run .stack img.over { visibility: visible; }
 .frame:not([data-view="slider"]) .stack img.over { clip-path: none !important; }
-figure { margin: 0; } figcaption, .caption { font-size: .85em; color: #555; }
+figure { margin: 0; } figcaption, .caption { font-size: 12px; line-height: 16px; color: #555; }
 img { image-rendering: pixelated; display: block; }
 .full { position: relative; border: 1px solid #999; }
 .mark { position: absolute; outline: 2px solid #0969da; pointer-events: none; }
-table.events { border-collapse: collapse; background: #fff; margin: .6em 0; }
-table.events td, table.events th { border: 1px solid #ddd; padding: .15em .6em;
-  font-family: ui-monospace, monospace; font-size: .9em; text-align: left; }
+table.events { border-collapse: collapse; background: #fff; margin: 8px 0; }
+table.events td, table.events th { border: 1px solid #ddd; padding: 2px 8px;
+  font: 12px/16px ui-monospace, monospace; text-align: left; }
 table.events tr.first { background: #ffd8d3; font-weight: bold; }
 table.events tr.differs { background: #fff0ee; }
 table.events tr.gap td { color: #777; font-style: italic; }
-kbd { border: 1px solid #bbb; border-radius: 3px; padding: 0 .3em; background: #fff; }
+kbd { border: 1px solid #bbb; border-radius: 3px; padding: 0 4px; background: #fff; }
 """
 
 _JS = r"""

@@ -20,7 +20,7 @@ from .conftest import save_screenshot, shot
 ROOT = Path(__file__).resolve().parents[2]
 EDITS = {
     "fig2_case1": ("position: [100, 100]", "position: [102, 100]"),
-    "fig2_case3": ("velocity: [10, 0]", "velocity: [20, 0]"),
+    "fig2_case3": ("velocity: [10, 10]", "velocity: [20, 10]"),
     "fig2_case2": None,
 }
 
@@ -94,8 +94,12 @@ def test_blink_and_slider_change_the_image_shown(clean_page, report_page):
     half = shot(stack)
     w = half.shape[1] // 2
     assert np.array_equal(half[:, :w], golden[:, :w]) and np.array_equal(half[:, w:], run[:, w:])
+    frame.locator(".msg").click()  # the keys act on the current frame, not the focused slider
     page.keyboard.press("ArrowLeft")  # the handle to 40 %: more of the run shows
     assert slider.input_value() == "40"
+    fewer = shot(stack)
+    w = fewer.shape[1] * 4 // 10
+    assert np.array_equal(fewer[:, :w], golden[:, :w]) and np.array_equal(fewer[:, w:], run[:, w:])
     frame.locator('button[data-view="diff"]').click()
     assert frame.locator(".panel.diff img").is_visible() and stack.is_hidden()
 
