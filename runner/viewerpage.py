@@ -70,20 +70,24 @@ def page(data: dict) -> bytes:
 
 
 _CSS = """
-body { font: 14px/1.4 system-ui, sans-serif; margin: 1em; background: #f4f4f4; color: #222; }
+body { font: 14px/20px system-ui, sans-serif; margin: 16px; background: #f4f4f4; color: #222; }
+header { height: 20px; overflow: hidden; }
 .dim { color: #666; }
-#controls { margin: .5em 0; display: flex; gap: .6em; align-items: center; flex-wrap: wrap; }
-#controls button { min-width: 3em; }
-#seek { width: 320px; }
-#main { display: flex; gap: 1em; align-items: flex-start; }
+#controls { margin: 8px 0; height: 32px; display: flex; gap: 10px; align-items: center;
+  white-space: nowrap; overflow: hidden; }
+#controls button { min-width: 44px; height: 26px; }
+#seek { width: 300px; }
+#main { display: flex; gap: 16px; align-items: flex-start; }
 #stage { max-width: 960px; max-height: 720px; overflow: auto; border: 1px solid #999;
   background: #000; cursor: grab; }
 #stage.dragging { cursor: grabbing; }
 canvas { display: block; image-rendering: pixelated; }
 #side { width: 320px; }
-#events { height: 560px; overflow: auto; margin: 0; padding: 0 0 0 3.5em; background: #fff;
-  border: 1px solid #ccc; font: 12px ui-monospace, monospace; }
-#events li { cursor: pointer; padding: 0 .3em; }
+#side h3 { font-size: 14px; line-height: 20px; margin: 8px 0; }
+#hover { height: 20px; }
+#events { height: 560px; overflow: auto; margin: 0; padding: 0 0 0 48px; background: #fff;
+  border: 1px solid #ccc; font: 12px/16px ui-monospace, monospace; }
+#events li { cursor: pointer; padding: 0 4px; }
 #events li:hover { background: #eef; }
 #events li.now { background: #ffe08a; }
 #events li.selected { outline: 2px solid #c00; }

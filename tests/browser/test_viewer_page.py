@@ -1,0 +1,122 @@
+"""The run viewer in Chromium: it draws the PNG frames' very pixels at zoom 1 (and their enlarged
+pixels at zoom 2), plays, steps, seeks to an event's tick and outlines the pair, names objects on
+hover, and its overlays draw over the frame; on a run of the shapes showcase (boxes, circles of
+odd and even diameter, polygons, fills) under the `exact` model, whose positions are fractional."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from collide2d.runner import cli
+
+from .conftest import save_screenshot, shot
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="module")
+def viewer_run(tmp_path_factory):
+    """(run folder, viewer URL) of the showcase run with every PNG frame and the viewer."""
+    tmp = tmp_path_factory.mktemp("viewer")
+    text = (ROOT / "scenarios" / "shapes_showcase.yaml").read_text()
+    text = text.replace("output: {frames: {every: 10}", "output: {frames: all")
+    (tmp / "showcase.yaml").write_text(text)
+    argv = ["run", str(tmp / "showcase.yaml"), "--out", str(tmp / "out"), "--model", "exact"]
+    assert cli.main([*argv, "--viewer", "--png", "--no-gif", "--quiet"]) == 0
+    folder = tmp / "out" / "showcase"
+    return folder, (folder / "viewer.html").as_uri()
+
+
+def _open(page, url, zoom=1):
+    page.goto(url)
+    page.wait_for_selector("body[data-ready='1']")
+    page.select_option("#zoom", str(zoom))
+    return page.locator("#view")
+
+
+def _tick(page) -> int:
+    return int(page.locator("#view").get_attribute("data-tick"))
+
+
+def _png(folder, k) -> np.ndarray:
+    return np.array(Image.open(folder / "frames" / f"frame_{k:06d}.png").convert("RGB"))
+
+
+def test_canvas_draws_the_png_frame_at_every_tick_shown(clean_page, viewer_run):
+    folder, url = viewer_run
+    canvas = _open(clean_page, url)
+    for k in (0, 7, 23, 41, 60):
+        clean_page.locator("#seek").fill(str(k))
+        assert _tick(clean_page) == k
+        assert np.array_equal(shot(canvas), _png(folder, k)), f"tick {k}"
+    clean_page.select_option("#zoom", "2")
+    big = _png(folder, 60).repeat(2, axis=0).repeat(2, axis=1)
+    assert np.array_equal(shot(canvas), big)
+
+
+def test_play_pause_and_single_steps(clean_page, viewer_run):
+    _folder, url = viewer_run
+    _open(clean_page, url)
+    clean_page.select_option("#speed", "8")
+    clean_page.locator("#play").click()
+    clean_page.wait_for_function("Number(document.getElementById('view').dataset.tick) >= 5")
+    clean_page.keyboard.press(" ")  # pause
+    assert clean_page.locator("body").get_attribute("data-playing") == "0"
+    k = _tick(clean_page)
+    clean_page.keyboard.press("ArrowRight")
+    assert _tick(clean_page) == k + 1
+    clean_page.keyboard.press("ArrowLeft")
+    clean_page.keyboard.press("ArrowLeft")
+    assert _tick(clean_page) == k - 1
+    clean_page.locator("#fwd").click()
+    assert _tick(clean_page) == k
+    clean_page.keyboard.press("End")
+    assert _tick(clean_page) == 60
+    assert "tick 60 / 60" in clean_page.locator("#tick").inner_text()
+
+
+def test_clicking_an_event_seeks_to_its_tick_and_outlines_the_pair(clean_page, viewer_run):
+    folder, url = viewer_run
+    canvas = _open(clean_page, url)
+    pair = clean_page.locator("#events li", has_text="pair").first
+    tick = int(pair.get_attribute("data-tick"))
+    assert tick > 0
+    pair.click()
+    assert _tick(clean_page) == tick
+    assert "selected" in pair.get_attribute("class") and "now" in pair.get_attribute("class")
+    got, png = shot(canvas), _png(folder, tick)
+    changed = (got != png).any(axis=2)
+    assert changed.any()
+    assert (got[changed] == (255, 0, 255)).all(axis=1).all()  # only the outline, in magenta
+    save_screenshot(clean_page.locator("body"), "viewer.png")
+
+
+def test_hover_names_the_object(clean_page, viewer_run):
+    _folder, url = viewer_run
+    canvas = _open(clean_page, url)
+    box = canvas.bounding_box()
+    # the static post: 6x30 px at (150, 100), never moves
+    clean_page.mouse.move(box["x"] + 152.5, box["y"] + 115.5)
+    assert clean_page.locator("#hover").inner_text() == "post (object 6, static)"
+    clean_page.mouse.move(box["x"] + 2.5, box["y"] + 140.5)
+    assert clean_page.locator("#hover").inner_text() == "—"
+
+
+def test_overlays_draw_over_the_frame_and_go_away(clean_page, viewer_run):
+    folder, url = viewer_run
+    canvas = _open(clean_page, url)
+    png = _png(folder, 0)
+    for key in ("velocity", "boxes", "labels"):
+        clean_page.locator(f"#ov-{key}").check()
+        assert not np.array_equal(shot(canvas), png), key
+        clean_page.locator(f"#ov-{key}").uncheck()
+        assert np.array_equal(shot(canvas), png), key
+    pair = clean_page.locator("#events li", has_text="pair").first
+    tick = int(pair.get_attribute("data-tick"))
+    clean_page.locator("#seek").fill(str(tick))
+    clean_page.locator("#ov-flashes").check()
+    assert not np.array_equal(shot(canvas), _png(folder, tick))
