@@ -23,7 +23,10 @@ CHROMIUM_CANDIDATES = ("/usr/bin/chromium", "/usr/bin/chromium-browser")
 
 
 def chromium_binary() -> str | None:
-    """The system Chromium, or None."""
+    """The system Chromium (or the one COLLIDE2D_CHROMIUM names), or None."""
+    if "COLLIDE2D_CHROMIUM" in os.environ:
+        path = os.environ["COLLIDE2D_CHROMIUM"]
+        return path if os.access(path, os.X_OK) else None
     for path in CHROMIUM_CANDIDATES:
         if os.access(path, os.X_OK):
             return path
@@ -36,7 +39,8 @@ def browser_type_launch_args(browser_type_launch_args):
     path = chromium_binary()
     if path is None:
         pytest.skip(
-            "no Chromium binary (looked for /usr/bin/chromium and chromium on PATH); "
+            "no Chromium binary (looked for COLLIDE2D_CHROMIUM, /usr/bin/chromium and chromium "
+            "on PATH); "
             "install Debian's package: apt-get install -y chromium"
         )
     return {**browser_type_launch_args, "executable_path": path}
@@ -44,8 +48,11 @@ def browser_type_launch_args(browser_type_launch_args):
 
 @pytest.fixture
 def browser_context_args(browser_context_args):
-    return {**browser_context_args, "device_scale_factor": 1, "viewport": {"width": 1200,
-                                                                          "height": 900}}
+    return {
+        **browser_context_args,
+        "device_scale_factor": 1,
+        "viewport": {"width": 1200, "height": 900},
+    }
 
 
 @pytest.fixture
@@ -63,12 +70,13 @@ def shot(locator) -> np.ndarray:
     return np.array(Image.open(io.BytesIO(locator.screenshot())).convert("RGB"))
 
 
-def save_screenshot(locator, name: str) -> None:
-    """Save a README screenshot when COLLIDE2D_SCREENSHOTS names a folder (a small PNG)."""
+def save_screenshot(target, name: str, **options) -> None:
+    """Save a README screenshot of a page or locator (`screenshot(**options)`) when
+    COLLIDE2D_SCREENSHOTS names a folder; a small PNG of at most 64 colours."""
     folder = os.environ.get("COLLIDE2D_SCREENSHOTS")
     if not folder:
         return
-    im = Image.open(io.BytesIO(locator.screenshot())).convert("RGB")
+    im = Image.open(io.BytesIO(target.screenshot(**options))).convert("RGB")
     im = im.quantize(colors=64, dither=Image.Dither.NONE)
     Path(folder).mkdir(parents=True, exist_ok=True)
     im.save(Path(folder) / name, optimize=True)

@@ -67,7 +67,10 @@ def test_summary_failures_first_and_the_filter(clean_page, report_page):
     assert page.locator("#sc-fig2_case1").is_visible()
     page.keyboard.press("f")
     assert page.locator("#sc-fig2_case2").is_visible()
-    save_screenshot(page.locator("#sc-fig2_case1 .frame").first, "report.png")
+    page.locator("#only-failures").check()
+    bottom = page.locator("#sc-fig2_case1 .frame .caption").first.bounding_box()
+    height = int(bottom["y"] + bottom["height"]) + 8
+    save_screenshot(page, "report.png", clip={"x": 0, "y": 0, "width": 1000, "height": height})
 
 
 def test_blink_and_slider_change_the_image_shown(clean_page, report_page):

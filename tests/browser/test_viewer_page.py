@@ -92,7 +92,6 @@ def test_clicking_an_event_seeks_to_its_tick_and_outlines_the_pair(clean_page, v
     changed = (got != png).any(axis=2)
     assert changed.any()
     assert (got[changed] == (255, 0, 255)).all(axis=1).all()  # only the outline, in magenta
-    save_screenshot(clean_page.locator("body"), "viewer.png")
 
 
 def test_hover_names_the_object(clean_page, viewer_run):
@@ -120,3 +119,7 @@ def test_overlays_draw_over_the_frame_and_go_away(clean_page, viewer_run):
     clean_page.locator("#seek").fill(str(tick))
     clean_page.locator("#ov-flashes").check()
     assert not np.array_equal(shot(canvas), _png(folder, tick))
+    clean_page.select_option("#zoom", "2")
+    for key in ("velocity", "labels"):
+        clean_page.locator(f"#ov-{key}").check()
+    save_screenshot(clean_page.locator("body"), "viewer.png")
