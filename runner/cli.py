@@ -27,6 +27,7 @@ from collide2d.runner.options import (
     overrides_from_args,
     positive_int,
 )
+from collide2d.runner.outputspec import OVERLAY_NAMES
 from collide2d.runner.run import RunOptions, RunStopped, run_to_dir
 from collide2d.runner.scenario import ScenarioError, load
 from collide2d.runner.stress import cli as stress_cli
@@ -72,6 +73,14 @@ def register_run(subparsers) -> None:
         default=None,
         help="write viewer.html, a player of the run (default: the scenario's output.viewer)",
     )
+    p.add_argument(
+        "--overlay",
+        type=overlay_names,
+        default=None,
+        metavar="LIST",
+        help="draw debug overlays into the PNG and GIF frames, comma-separated: "
+        f"{', '.join(OVERLAY_NAMES)}, or none (default: the scenario's output.overlay)",
+    )
     add_override_arguments(p)
     p.add_argument(
         "--scale",
@@ -86,6 +95,20 @@ def register_run(subparsers) -> None:
     p.set_defaults(func=cmd_run)
 
 
+def overlay_names(text: str) -> tuple[str, ...]:
+    """`--overlay a,b`: the overlay names in their fixed order; `none` for none."""
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    if names == ["none"]:
+        return ()
+    bad = [n for n in names if n not in OVERLAY_NAMES]
+    if bad or not names:
+        raise argparse.ArgumentTypeError(
+            f"unknown overlay {', '.join(bad) or repr(text)}; choose from "
+            f"{', '.join(OVERLAY_NAMES)} or none"
+        )
+    return tuple(n for n in OVERLAY_NAMES if n in names)
+
+
 def cmd_run(args: argparse.Namespace) -> int:
     path = args.scenario or demo_path()
     limits = limits_from_args(args)
@@ -98,6 +121,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         scale=args.scale,
         quiet=args.quiet,
         viewer=out.viewer if args.viewer is None else args.viewer,
+        overlay=out.overlay if args.overlay is None else args.overlay,
     )
     target, summary = run_to_dir(scenario, args.out, options, limits)
     if not args.quiet:

@@ -20,7 +20,9 @@ from collide2d.runner.nodes import Nodes
 
 FRAME_WORDS = ("all", "none", "last")
 EVERY_KEYS = ("every",)
-OUTPUT_KEYS = ("frames", "gif", "events", "viewer")
+OUTPUT_KEYS = ("frames", "gif", "events", "viewer", "overlay")
+# Debug overlays a scenario may ask to draw into its frames (runner.overlay draws them).
+OVERLAY_NAMES = ("velocity", "boxes", "contacts", "labels", "overlap")
 GOLDEN_KEYS = ("frames", "time_tolerance", "max_diff_pixels", "color_threshold")
 
 
@@ -33,6 +35,7 @@ class Output:
     gif: bool
     events: bool
     viewer: bool = False  # viewer.html beside the GIF (runner.viewer)
+    overlay: tuple[str, ...] = ()  # overlays drawn into every frame, goldens too (runner.overlay)
 
 
 @dataclass(frozen=True)
@@ -107,7 +110,19 @@ class OutputReader(Nodes):
         gif = self.boolean(m["gif"][1], "output.gif") if "gif" in m else True
         events = self.boolean(m["events"][1], "output.events") if "events" in m else True
         viewer = self.boolean(m["viewer"][1], "output.viewer") if "viewer" in m else False
-        return Output(frames=frames, frames_spec=spec, gif=gif, events=events, viewer=viewer)
+        overlay = ()
+        if "overlay" in m:
+            items = self.seq(m["overlay"][1], "output.overlay")
+            chosen = {self.choice(item, "output.overlay item", OVERLAY_NAMES) for item in items}
+            overlay = tuple(n for n in OVERLAY_NAMES if n in chosen)
+        return Output(
+            frames=frames,
+            frames_spec=spec,
+            gif=gif,
+            events=events,
+            viewer=viewer,
+            overlay=overlay,
+        )
 
     def golden(self, top: dict, ticks: int) -> Golden:
         m = self.mapping(top["golden"][1], "golden", GOLDEN_KEYS) if "golden" in top else {}

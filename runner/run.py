@@ -32,6 +32,7 @@ from collide2d.engine.raster import Renderer
 from collide2d.runner import budget, outputs, rundir, viewer
 from collide2d.runner.frames import FrameRule
 from collide2d.runner.limits import Limits
+from collide2d.runner.overlay import Overlay
 from collide2d.runner.progress import Progress
 from collide2d.runner.scenario import Scenario, ScenarioError
 
@@ -67,6 +68,7 @@ def drive(
     on_events: Callable[[np.ndarray], None] | None = None,
     progress: Progress | None = None,
     on_tick: Callable[[object], None] | None = None,
+    overlay=None,
 ) -> tuple[object, dict]:
     """Run the scenario; returns (the model at the end, the summary).
 
@@ -76,6 +78,8 @@ def drive(
     log_events: record events and pass each chunk's array to `on_events`.
     on_tick: called with the model at tick 0 and after every tick (the viewer records each
     tick's state); the model then advances one tick per call.
+    overlay: a `runner.overlay.Overlay`; it may wrap the model, takes the events and draws over
+    each frame before `on_frame` sees it.
     """
     bodies = scenario.bodies
     options = models.scenario_options(
@@ -91,6 +95,9 @@ def drive(
             f"{scenario.path or scenario.name}: error: the {scenario.model} model refused the "
             f"scene: {exc}"
         ) from None
+    if overlay is not None:
+        model = overlay.wrap(model)
+    logging = log_events or (overlay is not None and overlay.wants_events)
     if not isinstance(frames, FrameRule):
         frames = FrameRule.of(frames, scenario.ticks)
     renderer = Renderer(scenario.world, bodies) if frames else None
@@ -101,7 +108,7 @@ def drive(
         on_tick(model)
     next_frame = frames.next_from(0)
     if next_frame == 0:
-        on_frame(0, renderer.draw(model.positions()))
+        on_frame(0, _drawn(renderer, model, 0, overlay))
         next_frame = frames.next_from(1)
     while model.tick < scenario.ticks:
         stop = min(scenario.ticks, model.tick + CHUNK_TICKS)
@@ -110,7 +117,7 @@ def drive(
         if on_tick is not None:
             stop = model.tick + 1
         try:
-            events = model.advance(stop - model.tick, log_events)
+            events = model.advance(stop - model.tick, logging)
         except Runaway as exc:
             when = f"tick {stop}" if stop == model.tick + 1 else f"ticks {model.tick + 1}-{stop}"
             raise RunStopped(
@@ -119,10 +126,12 @@ def drive(
             ) from None
         if log_events and len(events) and on_events is not None:
             on_events(events)
+        if overlay is not None and logging:
+            overlay.events(events)
         if on_tick is not None:
             on_tick(model)
         if model.tick == next_frame:
-            on_frame(model.tick, renderer.draw(model.positions()))
+            on_frame(model.tick, _drawn(renderer, model, model.tick, overlay))
             next_frame = frames.next_from(model.tick + 1)
         if progress is not None:
             progress.update(model.tick)
@@ -147,6 +156,12 @@ def drive(
     return model, summary
 
 
+def _drawn(renderer, model, k: int, overlay) -> np.ndarray:
+    """Frame k's index picture, with the overlays when there are any."""
+    idx = renderer.draw(model.positions())
+    return idx if overlay is None else overlay.draw(k, idx, model)
+
+
 def simulate(
     scenario: Scenario,
     *,
@@ -157,7 +172,9 @@ def simulate(
     """Run in memory; frames in `keep_frames` come back as RGB arrays."""
     kept: dict[int, np.ndarray] = {}
     chunks: list[np.ndarray] = []
-    palette = scenario.palette
+    # overlays only when the scenario asks for them (then its goldens show them too)
+    layer = Overlay(scenario, scenario.output.overlay) if scenario.output.overlay else None
+    palette = layer.palette if layer is not None else scenario.palette
 
     model, summary = drive(
         scenario,
@@ -166,6 +183,7 @@ def simulate(
         log_events=log_events,
         on_events=chunks.append,
         progress=Progress.for_terminal(scenario.ticks, scenario.name) if progress else None,
+        overlay=layer,
     )
     events = np.concatenate(chunks) if chunks else empty_events()
     return RunResult(scenario, events, model.positions(), model.velocities(), kept, summary)
@@ -181,6 +199,7 @@ class RunOptions:
     scale: int = 1
     quiet: bool = False
     viewer: bool = False  # viewer.html beside the GIF (runner.viewer)
+    overlay: tuple = ()  # overlays drawn into the PNG and GIF frames (runner.overlay)
 
 
 def output_dir(out_root: str | os.PathLike, scenario: Scenario) -> Path:
@@ -246,11 +265,15 @@ def _write_run(scenario: Scenario, folder: Path, options: RunOptions, plan) -> d
     frames_dir = folder / "frames"
     if plan.png:
         frames_dir.mkdir()
+    layer = None
+    if options.overlay or options.viewer:
+        layer = Overlay(scenario, options.overlay, record=options.viewer)
+    palette = layer.palette if layer is not None else scenario.palette
     gif = None
     if plan.gif:
         gif = outputs.GifWriter(
             folder / "animation.gif",
-            scenario.palette,
+            palette,
             scenario.world.width,
             scenario.world.height,
             scenario.world.fps,
@@ -260,7 +283,8 @@ def _write_run(scenario: Scenario, folder: Path, options: RunOptions, plan) -> d
         if gif.note and not options.quiet:
             print(f"{scenario.name}: {gif.note}", file=sys.stderr)
     log = outputs.EventsWriter(folder / "events.jsonl") if options.events else None
-    recorder = viewer.Recorder(scenario) if options.viewer else None  # refuses a run too long
+    # the viewer refuses a run too long to view
+    recorder = viewer.Recorder(scenario, layer) if options.viewer else None
     digits = max(6, len(str(scenario.ticks)))
 
     def on_frame(k: int, idx: np.ndarray) -> None:
@@ -268,7 +292,7 @@ def _write_run(scenario: Scenario, folder: Path, options: RunOptions, plan) -> d
             gif.add(idx)
         if k in plan.png:
             name = f"frame_{k:0{digits}d}.png"
-            outputs.write_png(frames_dir / name, scenario.palette[idx], scale=options.scale)
+            outputs.write_png(frames_dir / name, palette[idx], scale=options.scale)
 
     progress = None if options.quiet else Progress.for_terminal(scenario.ticks, scenario.name)
     writers = [w for w in (gif, log) if w is not None]
@@ -281,6 +305,7 @@ def _write_run(scenario: Scenario, folder: Path, options: RunOptions, plan) -> d
             on_events=_tee(log.write if log else None, recorder),
             progress=progress,
             on_tick=recorder.add if recorder is not None else None,
+            overlay=layer,
         )
         for writer in writers:
             writer.close()

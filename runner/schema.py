@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from collide2d.engine.models import MODEL_NAMES
 from collide2d.runner import colors
+from collide2d.runner.outputspec import OVERLAY_NAMES
 from collide2d.runner.scenario import (
     BLOCK_SHAPES,
     DEFAULT_DURATION,
@@ -216,6 +217,10 @@ def json_schema() -> dict:
                     "gif": {"type": "boolean"},
                     "events": {"type": "boolean"},
                     "viewer": {"type": "boolean"},
+                    "overlay": {
+                        "type": "array",
+                        "items": {"enum": list(OVERLAY_NAMES)},
+                    },
                 },
                 "additionalProperties": False,
             },

@@ -62,7 +62,7 @@ class Recorder:
     """Collects one run's frames for its viewer; `add(model)` once per tick from 0, then
     `page()`. Raises ScenarioError at once when the run is too long to view."""
 
-    def __init__(self, scenario):
+    def __init__(self, scenario, layer=None):
         n, frames = scenario.bodies.n, scenario.ticks + 1
         if n * frames > MAX_POSITIONS:
             raise ScenarioError(
@@ -79,6 +79,9 @@ class Recorder:
         self.count = 0
         self.event_rows: list = []
         self.n_events = 0
+        self.layer = layer  # a runner.overlay.Overlay noting the paper model's overlaps, or None
+        self.overlap_rows: list = []
+        self._last = None
 
     def add(self, model) -> None:
         """Record the model's state as the next frame."""
@@ -87,9 +90,17 @@ class Recorder:
         self.pos[k] = np.clip(ipos, -POSITION_CLAMP, POSITION_CLAMP)
         self.vel[k] = model.velocities()
         self.count += 1
+        staged = self.layer.staged if self.layer is not None else None
+        if staged is not None and self._last is not None:
+            now = self._last[self._last["tick"] == k]
+            for a, b, xd, yd, rect, pa, pb in self.layer.pair_overlaps(k, now):
+                if len(self.overlap_rows) < MAX_EVENTS:
+                    self.overlap_rows.append([k, a, b, xd, yd, rect or [0, 0, 0, 0], pa, pb])
+            staged.forget_before(k + 1)
 
     def events(self, events: np.ndarray) -> None:
         """Keep an event chunk (EVENT_DTYPE records) for the list, up to MAX_EVENTS."""
+        self._last = events[events["tick"] == events["tick"][-1]] if len(events) else None
         room = MAX_EVENTS - len(self.event_rows)
         for rec in events[: max(room, 0)]:
             d = event_dict(rec)
@@ -125,6 +136,9 @@ class Recorder:
             "positions": packed(differenced(np.ascontiguousarray(pos))),
             "velocities": packed(np.ascontiguousarray(vel)),
             "events": self.event_rows,
+            "overlaps": self.overlap_rows,
+            "paper": scn.model == "paper",
+            "overlay": list(scn.output.overlay),
             "eventCount": int(self.n_events),
         }
 

@@ -40,6 +40,7 @@ def page(data: dict) -> bytes:
             ("boxes", "boxes"),
             ("flashes", "contacts"),
             ("labels", "labels"),
+            *((("overlap", "overlap before undo"),) if data["paper"] else ()),
         )
     )
     body = f"""<!DOCTYPE html>
@@ -110,10 +111,14 @@ _JS = r"""
   var speedSel = document.getElementById("speed"), list = document.getElementById("events");
   var hover = document.getElementById("hover"), stage = document.getElementById("stage");
   var ov = {};
-  ["velocity", "boxes", "flashes", "labels"].forEach(function (k) {
-    ov[k] = document.getElementById("ov-" + k);
+  var named = {velocity: "velocity", boxes: "boxes", contacts: "flashes", labels: "labels",
+               overlap: "overlap"};
+  ["velocity", "boxes", "flashes", "labels", "overlap"].forEach(function (k) {
+    ov[k] = document.getElementById("ov-" + k) ||
+      {checked: false, addEventListener: function () {}};
     ov[k].addEventListener("change", function () { draw(); });
   });
+  D.overlay.forEach(function (name) { ov[named[name]].checked = true; });
   function rgba(c) { return ((255 << 24) | (c[2] << 16) | (c[1] << 8) | c[0]) >>> 0; }
   var bg = rgba(D.background);
   var col = D.colors.map(rgba);
@@ -224,6 +229,26 @@ _JS = r"""
         var q = at(i, k), lx = (q[0] + ext[4 * i]) * zoom, ly = (q[1] + ext[4 * i + 1]) * zoom - 3;
         ctx.strokeText(D.names[i], lx, ly); ctx.fillText(D.names[i], lx, ly);
       }
+    }
+    if (ov.overlap.checked) {
+      D.overlaps.forEach(function (o) {
+        if (o[0] !== k) return;
+        ctx.setLineDash([3, 2]); ctx.strokeStyle = "#ccc"; ctx.lineWidth = 1;
+        [[o[1], o[6]], [o[2], o[7]]].forEach(function (ip) {
+          var i = ip[0], p = ip[1];
+          ctx.strokeRect((p[0] + ext[4 * i]) * zoom + 0.5, (p[1] + ext[4 * i + 1]) * zoom + 0.5,
+                         (ext[4 * i + 2] - ext[4 * i] + 1) * zoom - 1,
+                         (ext[4 * i + 3] - ext[4 * i + 1] + 1) * zoom - 1);
+        });
+        ctx.setLineDash([]);
+        var r = o[5];
+        if (r[2] > r[0]) {
+          ctx.fillStyle = "rgb(255,0,0)";
+          ctx.fillRect(r[0] * zoom, r[1] * zoom, (r[2] - r[0]) * zoom, (r[3] - r[1]) * zoom);
+        }
+        ctx.font = "12px sans-serif"; ctx.fillStyle = "#fff";
+        ctx.fillText("xdiff " + o[3] + ", ydiff " + o[4], (r[2] + 4) * zoom, (r[3] + 4) * zoom + 8);
+      });
     }
     if (selected) {
       [selected[2], selected[3]].forEach(function (i) { if (i >= 0) outline(i, k, "#f0f", 2); });

@@ -326,6 +326,18 @@ class Model:
         n = int(self._st[_S_EVENTS])
         return event_records(self._ev, self._ev[:n, ROW_TICK] / self.fps, n)
 
+    def advance_to_response(self, log: bool = True) -> np.ndarray:
+        """Run the next tick up to its response stage, where every object has moved (and the
+        walls have taken their steps back) but no pair has flipped or taken back anything yet:
+        `positions()` are then the places the pair rule sees, overlaps included (the paper's
+        Figure 2). `advance(1)` finishes the tick. Returns the events so far (its walls)."""
+        self._st[_S_EVENTS] = 0
+        self._run_to(self.tick * _N_STAGES + _STAGE_RESPONSE, bool(log))
+        n = int(self._st[_S_EVENTS])
+        events = event_records(self._ev, self._ev[:n, ROW_TICK] / self.fps, n).copy()
+        self._st[_S_EVENTS] = 0
+        return events
+
     def event_counts(self) -> tuple[int, int]:
         """(wall events, pair events) so far, logged or not."""
         return int(self._st[_S_WALLS]), int(self._st[_S_PAIR_EVENTS])

@@ -123,3 +123,20 @@ def test_overlays_draw_over_the_frame_and_go_away(clean_page, viewer_run):
     for key in ("velocity", "labels"):
         clean_page.locator(f"#ov-{key}").check()
     save_screenshot(clean_page.locator("body"), "viewer.png")
+
+
+def test_paper_overlap_before_the_undo_is_shown_at_its_tick(clean_page, tmp_path):
+    out = tmp_path / "out"
+    path = ROOT / "scenarios" / "fig2_case1.yaml"  # asks for the overlap overlay
+    assert cli.main(["run", str(path), "--out", str(out), "--viewer", "--no-gif", "--quiet"]) == 0
+    canvas = _open(clean_page, (out / "fig2_case1" / "viewer.html").as_uri())
+    assert clean_page.locator("#ov-overlap").is_checked()
+    for k, area in ((0, 0), (1, 16 * 1), (2, 0)):  # xdiff 16, ydiff 1 at tick 1
+        clean_page.locator("#seek").fill(str(k))
+        red = (shot(canvas) == (255, 0, 0)).all(axis=2)
+        assert red.sum() == area, k
+    clean_page.locator("#seek").fill("1")
+    ys, xs = np.nonzero((shot(canvas) == (255, 0, 0)).all(axis=2))
+    assert (xs.min(), xs.max(), ys.min(), ys.max()) == (104, 119, 110, 110)
+    clean_page.locator("#ov-overlap").uncheck()
+    assert not (shot(canvas) == (255, 0, 0)).all(axis=2).any()
