@@ -15,7 +15,9 @@ What the file holds, as JSON in the page:
   nothing); the browser inflates it with its own `DecompressionStream`;
 - velocities (px/s, float32, the same layout, not differenced), for the velocity arrows;
 - the events (tick, type, ids, side or axis), at most `MAX_EVENTS` of them (the count of the rest
-  is shown).
+  is shown);
+- for the `paper` model, each pair event's overlap before the take-back (`runner.overlay`), as
+  int32 rows of OVERLAP_COLUMNS, packed like the positions.
 
 A run of more than `MAX_POSITIONS` object-frames (ticks + 1 times objects) is refused before the
 first tick: its viewer would not open quickly.
@@ -42,6 +44,9 @@ MAX_EVENTS = 50_000
 # Positions are clamped to this many px from the origin (an int32; such an object is off screen).
 POSITION_CLAMP = 2**30
 ZLIB_LEVEL = 9
+# An overlap row: tick, a, b, xdiff, ydiff, the overlap x0 y0 x1 y1 (exclusive ends; all 0 when
+# empty), where a and b were (x, y each), as the pair rule saw them.
+OVERLAP_COLUMNS = 13
 
 
 def packed(array: np.ndarray) -> str:
@@ -95,7 +100,7 @@ class Recorder:
             now = self._last[self._last["tick"] == k]
             for a, b, xd, yd, rect, pa, pb in self.layer.pair_overlaps(k, now):
                 if len(self.overlap_rows) < MAX_EVENTS:
-                    self.overlap_rows.append([k, a, b, xd, yd, rect or [0, 0, 0, 0], pa, pb])
+                    self.overlap_rows.append([k, a, b, xd, yd, *(rect or (0, 0, 0, 0)), *pa, *pb])
             staged.forget_before(k + 1)
 
     def events(self, events: np.ndarray) -> None:
@@ -136,7 +141,7 @@ class Recorder:
             "positions": packed(differenced(np.ascontiguousarray(pos))),
             "velocities": packed(np.ascontiguousarray(vel)),
             "events": self.event_rows,
-            "overlaps": self.overlap_rows,
+            "overlaps": packed(np.array(self.overlap_rows, np.int32).reshape(-1, OVERLAP_COLUMNS)),
             "paper": scn.model == "paper",
             "overlay": list(scn.output.overlay),
             "eventCount": int(self.n_events),

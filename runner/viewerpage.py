@@ -231,17 +231,17 @@ _JS = r"""
       }
     }
     if (ov.overlap.checked) {
-      D.overlaps.forEach(function (o) {
+      overlapRows.forEach(function (o) {
         if (o[0] !== k) return;
         ctx.setLineDash([3, 2]); ctx.strokeStyle = "#ccc"; ctx.lineWidth = 1;
-        [[o[1], o[6]], [o[2], o[7]]].forEach(function (ip) {
+        [[o[1], [o[9], o[10]]], [o[2], [o[11], o[12]]]].forEach(function (ip) {
           var i = ip[0], p = ip[1];
           ctx.strokeRect((p[0] + ext[4 * i]) * zoom + 0.5, (p[1] + ext[4 * i + 1]) * zoom + 0.5,
                          (ext[4 * i + 2] - ext[4 * i] + 1) * zoom - 1,
                          (ext[4 * i + 3] - ext[4 * i + 1] + 1) * zoom - 1);
         });
         ctx.setLineDash([]);
-        var r = o[5];
+        var r = [o[5], o[6], o[7], o[8]];
         if (r[2] > r[0]) {
           ctx.fillStyle = "rgb(255,0,0)";
           ctx.fillRect(r[0] * zoom, r[1] * zoom, (r[2] - r[0]) * zoom, (r[3] - r[1]) * zoom);
@@ -383,11 +383,15 @@ _JS = r"""
 
   var fit = 1;
   [1, 2, 3, 4, 6, 8, 12, 16].forEach(function (z) { if (W * z <= 960 && H * z <= 720) fit = z; });
-  var loads = [inflate(D.positions), inflate(D.velocities), inflate(D.sprites)];
+  var overlapRows = [];
+  var loads = [inflate(D.positions), inflate(D.velocities), inflate(D.sprites),
+               inflate(D.overlaps)];
   Promise.all(loads).then(function (bufs) {
     pos = undifference(new Int32Array(bufs[0]));
     vel = new Float32Array(bufs[1]);
     off = new Int32Array(bufs[2]);
+    var flat = new Int32Array(bufs[3]);
+    for (var r = 0; r + 13 <= flat.length; r += 13) overlapRows.push(flat.subarray(r, r + 13));
     ext = extents();
     buildEvents();
     setZoom(fit);

@@ -6,7 +6,7 @@ files as the scenario's golden. Each is read back as a golden is (`store`: every
 against the manifest's hashes, hostile content refused, no symbolic link followed), and it is
 refused when the scenario file was edited after the report was written (the manifest's scenario
 hash differs): the report would no longer show what the scenario gives. With no NAME, every
-scenario the report holds a run of is blessed.
+scenario the report holds a run of and lists as failed (its `summary.json`) is blessed.
 """
 
 from __future__ import annotations
@@ -18,6 +18,7 @@ from pathlib import Path
 
 from collide2d.runner.exitcodes import EXIT_BAD_INPUT, EXIT_OK
 from collide2d.runner.golden import report
+from collide2d.runner.golden import serialize as ser
 from collide2d.runner.golden.session import CREATED, UNCHANGED, UPDATED
 from collide2d.runner.golden.store import (
     DEFAULT_MAX_FRAME_PIXELS,
@@ -51,12 +52,22 @@ def _is_link(path: Path) -> bool:
 
 
 def runs_in(report_dir: Path) -> list[str]:
-    """The names of the scenarios whose run the report keeps, sorted."""
-    return sorted(
+    """The names of the scenarios whose run the report keeps, sorted: those its summary.json
+    lists as not passed (a folder left by an older report of the same folder is not blessed)."""
+    held = {
         p.name
         for p in report_dir.iterdir()
         if not p.is_symlink() and (p / report.RUN_DIR / report.MANIFEST_FILE).is_file()
-    )
+    }
+    summary = report_dir / report.SUMMARY_FILE
+    if _is_link(summary) or not summary.is_file():
+        return sorted(held)
+    try:
+        data = ser.load_json(summary.read_bytes()[: 64 * 1024 * 1024])
+        failed = {s["name"] for s in data["scenarios"] if s["status"] != report.STATUS_PASSED}
+    except (ValueError, KeyError, TypeError):
+        return sorted(held)
+    return sorted(held & failed)
 
 
 def bless_from_report(args, prepare) -> int:

@@ -140,3 +140,13 @@ def test_ten_thousand_frames_of_fifty_objects_stay_small(tmp_path):
     data = _page_data(page.read_text())
     assert data["frames"] == 10_001 and len(data["names"]) == 50
     assert page.stat().st_size < 1_500_000  # raw int32 positions alone would be 4 MB
+
+
+def test_paper_viewer_keeps_each_pair_overlap_before_the_undo(tmp_path):
+    path = ROOT / "scenarios" / "fig2_case1.yaml"
+    assert cli.main(["run", str(path), "--out", str(tmp_path), "--viewer", "--quiet"]) == 0
+    data = _page_data((tmp_path / "fig2_case1" / "viewer.html").read_text())
+    rows = _unpack(data["overlaps"], np.int32).reshape(-1, viewer.OVERLAP_COLUMNS)
+    # tick 1: blue (0) moved down to y 101, green (1) up to y 110: 16 x 1 px overlap
+    assert rows.tolist() == [[1, 0, 1, 16, 1, 104, 110, 120, 111, 100, 101, 104, 110]]
+    assert data["paper"] and data["overlay"] == ["overlap"]

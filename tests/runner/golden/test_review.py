@@ -159,3 +159,18 @@ def test_bless_from_report_refuses_a_tampered_run(tree, capsys):
     assert _run("bless", "--from-report", "rep") == 2
     assert "final.csv" in capsys.readouterr().err
     assert (tree / "goldens" / "demo" / "manifest.json").read_bytes() == old
+
+
+def test_bless_from_report_skips_runs_an_older_report_left(tree, capsys):
+    _write(tree, "other")
+    assert _run("bless") == 0
+    _write(tree, "other", pixels=synthetic.BASE["pixels"] + [[4, 6, 1, 0, 0, 9]])
+    assert _run("check", "--report", "rep") == 1  # keeps rep/other/run
+    _write(tree, "other")  # back as blessed; now demo differs
+    _write(tree, "demo", pixels=synthetic.BASE["pixels"] + [[4, 5, 1, 0, 0, 9]])
+    assert _run("check", "--report", "rep") == 1
+    assert (tree / "rep" / "other" / "run").is_dir()  # the older report's run is still there
+    capsys.readouterr()
+    assert _run("bless", "--from-report", "rep") == 0
+    out = capsys.readouterr().out
+    assert out.startswith("updated   demo:") and "other" not in out
