@@ -99,10 +99,25 @@ def register(subparsers, *, load=None, simulate=None) -> None:
             p.add_argument(
                 "--report", metavar="DIR", help="write expected/actual/diff images and HTML"
             )
+            _cluster_arguments(p)
         else:
             p.add_argument("--prune", action="store_true", help="remove goldens no scenario uses")
         _common(p)
         p.set_defaults(func=partial(command, load=load, simulate=simulate))
+
+
+def _cluster_arguments(p) -> None:
+    """--workers N | --scheduler ADDRESS: run the scenarios on Dask (runner.sweep)."""
+    from collide2d.runner.sweep.cli import add_cluster_arguments
+
+    add_cluster_arguments(p)
+
+
+def _cluster_runs(args, scenarios, run):
+    """None, or the scenarios' runs done on a Dask cluster (runner.sweep.checks)."""
+    from collide2d.runner.sweep.checks import cluster_runs
+
+    return cluster_runs(args, scenarios, run, _Usage)
 
 
 def _common(p) -> None:
@@ -145,13 +160,17 @@ def check_command(args, *, load=default_load, simulate=default_simulate) -> int:
                 raise _Usage(str(exc)) from None
         # Unused goldens are only known when every scenario is checked.
         used = None if args.scenarios else [scn.name for _p, scn in scenarios]
+        runs = _cluster_runs(args, scenarios, partial(run_scenario, simulate=simulate))
     except _Usage as exc:
         return exc.exit()
     outcomes, status, errors = [], EXIT_OK, 0
     for i, (path, scn) in enumerate(scenarios, start=1):
         _progress(args, f"[{i}/{len(scenarios)}] checking {scn.name}")
         try:
-            result = run_scenario(scn, simulate, progress=_show_progress(args))
+            if runs is not None:  # run on a Dask cluster (--workers, --scheduler)
+                result = runs[i - 1]()
+            else:
+                result = run_scenario(scn, simulate, progress=_show_progress(args))
             outcome = check_run(scn, result, store, path=path, report_dir=report_dir)
         except Exception as exc:  # one scenario never stops the others
             status = max(status, _scenario_failed(args, "checking", path, scn, exc))

@@ -54,7 +54,7 @@ def connect(workers: int | None = None, scheduler: str | None = None):
         n_workers=workers or os.cpu_count() or 1,
         threads_per_worker=1,
         processes=True,
-        dashboard_address=None,
+        dashboard_address=":0",  # the HTTP server on a free port: 8787 may be taken
         silence_logs=logging.ERROR,
     )
     try:
