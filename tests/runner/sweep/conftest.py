@@ -2,16 +2,14 @@
 
 from __future__ import annotations
 
-from pathlib import Path
 
 import pytest
 
-SCENARIOS = Path(__file__).resolve().parents[3] / "scenarios"
 
 
 @pytest.fixture(scope="module")
 def client():
-    """A Client on an in-process LocalCluster of two one-thread workers (closed after the module)."""
+    """A Client on an in-process LocalCluster of two one-thread workers, closed afterwards."""
     distributed = pytest.importorskip("distributed")
     cluster = distributed.LocalCluster(
         n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None
