@@ -1,10 +1,8 @@
-"""Fixtures of the sweep tests: the project's scenarios folder and an in-process Dask cluster."""
+"""Fixtures of the sweep tests: an in-process Dask cluster."""
 
 from __future__ import annotations
 
-
 import pytest
-
 
 
 @pytest.fixture(scope="module")
