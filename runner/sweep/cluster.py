@@ -17,7 +17,9 @@ from __future__ import annotations
 import contextlib
 import logging
 import os
+import signal
 import sys
+import threading
 import uuid
 
 from collide2d.runner.progress import BAR_WIDTH, Progress
@@ -40,6 +42,21 @@ def require_dask(what: str = "this command") -> None:
 
 
 @contextlib.contextmanager
+def _ctrl_c_for_this_process_only():
+    """Start worker processes with SIGINT ignored (they inherit it): Ctrl-C on a terminal reaches
+    every process of the group, and only this one should act on it (cancel, write, close the
+    cluster) instead of each worker printing a traceback as it dies."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    before = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, before)
+
+
+@contextlib.contextmanager
 def connect(workers: int | None = None, scheduler: str | None = None):
     """A Client on the cluster at `scheduler`, or on an embedded LocalCluster of `workers`
     processes (default: one per core)."""
@@ -50,13 +67,14 @@ def connect(workers: int | None = None, scheduler: str | None = None):
         with Client(scheduler, timeout=CONNECT_TIMEOUT_S) as client:
             yield client
         return
-    cluster = LocalCluster(
-        n_workers=workers or os.cpu_count() or 1,
-        threads_per_worker=1,
-        processes=True,
-        dashboard_address=":0",  # the HTTP server on a free port: 8787 may be taken
-        silence_logs=logging.ERROR,
-    )
+    with _ctrl_c_for_this_process_only():
+        cluster = LocalCluster(
+            n_workers=workers or os.cpu_count() or 1,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=":0",  # the HTTP server on a free port: 8787 may be taken
+            silence_logs=logging.ERROR,
+        )
     try:
         with Client(cluster) as client:
             yield client

@@ -78,6 +78,19 @@ def test_check_on_a_cluster_says_what_a_local_check_says(tmp_path):
     assert "1 passed, 1 failed" in local.stdout
 
 
+def _group_ends(pgid: int, within_s: float = 30.0) -> bool:
+    """True once no process of the group is left (killing what is left after within_s)."""
+    deadline = time.monotonic() + within_s
+    while time.monotonic() < deadline:
+        try:
+            os.killpg(pgid, 0)
+        except ProcessLookupError:
+            return True
+        time.sleep(0.1)
+    os.killpg(pgid, signal.SIGKILL)
+    return False
+
+
 def _start(*args, log: Path):
     return subprocess.Popen(
         [str(BIN / "dask"), *args],
@@ -163,3 +176,31 @@ def test_a_worker_killed_mid_sweep_loses_no_row(tmp_path):
     finally:
         for proc in reversed(procs):
             _stop(proc)
+
+
+def test_ctrl_c_writes_the_rows_done_marked_incomplete(tmp_path):
+    out = tmp_path / "out"
+    proc = subprocess.Popen(
+        [str(BIN / "collide2d"), "sweep", FIFTY, "--set", "ticks=20000", "--seeds", "1-40",
+         "--workers", "2", "--out", str(out)],
+        cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL,
+        text=True, start_new_session=True,
+    )  # fmt: skip
+    try:
+        first = proc.stderr.readline()  # printed once the cluster is up
+        assert first == "sweep: 40 runs on 2 local workers\n"
+        time.sleep(1.5)
+        os.killpg(proc.pid, signal.SIGINT)  # as a terminal's Ctrl-C: the whole group
+        out_text, err_text = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+    assert proc.returncode == 130
+    assert _group_ends(proc.pid), "a worker process outlived the sweep"
+    assert "Traceback" not in err_text and "KeyboardInterrupt" not in err_text
+    status = json.loads((out / "sweep" / "sweep.json").read_text())
+    assert status["complete"] is False and status["done"] < 40
+    rows = (out / "sweep" / "results.csv").read_text().splitlines()[1:]
+    assert len(rows) == status["done"] == len({r.split(",")[1] for r in rows})
+    assert f"cancelled; {status['done']} of 40 runs written, marked incomplete" in err_text
