@@ -42,9 +42,12 @@ def is_sweep_file(path: str, limits: Limits | None = None) -> bool:
 
 
 def _shown(node) -> str:
+    """A value as written in flow style: `12`, `[10, 10]`, `{x: 1}`."""
     if isinstance(node, yaml.ScalarNode):
         return node.value
-    return yaml.serialize(node, default_flow_style=True, width=10**9).strip()
+    if isinstance(node, yaml.SequenceNode):
+        return "[" + ", ".join(_shown(n) for n in node.value) + "]"
+    return "{" + ", ".join(f"{_shown(k)}: {_shown(v)}" for k, v in node.value) + "}"
 
 
 def _pairs(nodes: Nodes, node) -> list:

@@ -1,0 +1,139 @@
+"""Benchmark of `collide2d sweep` on Dask: the same sweep on 1 and 2 local workers and through a
+local `dask scheduler`, against the runs done one after another in this process.
+
+    python benchmarks/sweep_scaling.py [--runs 200] [--ticks 1000] [--repeats 3]
+
+The sweep is RUNS runs of scenarios/paper_fifty_boxes.yaml at TICKS ticks (seeds 1..RUNS), each
+run as a sweep worker does it (`runner.sweep.runs.run_one`: the per-tick checked run, then the
+timed run). Figures, medians of REPEATS, clusters started and warmed up (every kernel loaded in
+every worker) before timing:
+
+- serial: the runs one after another in this process, no Dask;
+- local N: `driver.run_sweep` on an embedded LocalCluster of N processes (N = 1, 2);
+- scheduler: the same on a `dask scheduler` with two `dask worker` processes on 127.0.0.1;
+- overhead per run: (local 1 - serial) / RUNS, what Dask adds to each run on one worker;
+- speed-up: local 1 / local 2.
+
+Measure on a quiet machine: other work on the cores shows directly in the ratios.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import signal
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENARIO = ROOT / "scenarios" / "paper_fifty_boxes.yaml"
+
+
+def _runs(n: int, ticks: int):
+    from collide2d.runner.sweep.matrix import expand, parse_set
+
+    return expand([str(SCENARIO)], [parse_set(f"ticks={ticks}")], tuple(range(1, n + 1)))
+
+
+def _timed(fn, repeats: int) -> float:
+    times = []
+    for _ in range(repeats):
+        began = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - began)
+    return statistics.median(times)
+
+
+def _on(client, runs, repeats: int) -> float:
+    from collide2d.runner.sweep import driver
+
+    driver.run_sweep(client, runs[: 2 * len(client.nthreads())])  # every worker warm
+
+    def sweep():
+        figures, _pos, complete = driver.run_sweep(client, runs)
+        assert complete and len(figures) == len(runs)
+
+    return _timed(sweep, repeats)
+
+
+def _scheduler_cluster(folder: Path, workers: int):
+    """(address, processes) of a `dask scheduler` and `workers` `dask worker`s on 127.0.0.1."""
+    dask = str(Path(sys.executable).parent / "dask")
+    info = folder / "scheduler.json"
+    procs = [
+        subprocess.Popen(
+            [dask, "scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
+             "--scheduler-file", str(info)],
+            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True,
+        )
+    ]  # fmt: skip
+    deadline = time.monotonic() + 60
+    while not info.is_file():
+        if time.monotonic() > deadline:
+            raise TimeoutError("dask scheduler did not start")
+        time.sleep(0.1)
+    time.sleep(0.2)
+    address = json.loads(info.read_text())["address"]
+    for i in range(workers):
+        procs.append(
+            subprocess.Popen(
+                [dask, "worker", address, "--host", "127.0.0.1", "--nthreads", "1",
+                 "--no-dashboard", "--name", f"w{i}"],
+                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True,
+            )
+        )  # fmt: skip
+    return address, procs
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--runs", type=int, default=200)
+    parser.add_argument("--ticks", type=int, default=1000)
+    parser.add_argument("--repeats", type=int, default=3)
+    args = parser.parse_args()
+    from distributed import Client
+
+    from collide2d.runner.sweep import cluster
+    from collide2d.runner.sweep.runs import run_one
+
+    began = time.perf_counter()
+    runs = _runs(args.runs, args.ticks)
+    matrix_s = time.perf_counter() - began
+    run_one(runs[0].scenario)  # kernels loaded here too
+    figures = {}
+    serial = _timed(lambda: [run_one(r.scenario) for r in runs], args.repeats)
+    for n in (1, 2):
+        with cluster.connect(workers=n) as client:
+            figures[f"local {n}"] = _on(client, runs, args.repeats)
+    with tempfile.TemporaryDirectory() as folder:
+        address, procs = _scheduler_cluster(Path(folder), 2)
+        try:
+            with Client(address, timeout=60) as client:
+                client.wait_for_workers(2, timeout=60)
+                figures["scheduler 2"] = _on(client, runs, args.repeats)
+        finally:
+            for p in reversed(procs):
+                os.killpg(p.pid, signal.SIGTERM)
+                p.wait(timeout=30)
+    one, two = figures["local 1"], figures["local 2"]
+    print(
+        f"{args.runs} runs of {SCENARIO.stem} at {args.ticks} ticks, medians of {args.repeats}, "
+        f"{os.cpu_count()} cores"
+    )
+    print(f"matrix (load and check every run):  {matrix_s:8.3f} s")
+    print(f"serial, in this process:            {serial:8.3f} s")
+    for name, seconds in figures.items():
+        print(f"{name + ' worker(s):':36s}{seconds:8.3f} s")
+    print(f"speed-up, 2 workers over 1:         {one / two:8.2f} x")
+    print(f"Dask overhead per run (1 worker):   {(one - serial) / args.runs * 1e3:8.2f} ms")
+    print(f"per run, serial:                    {serial / args.runs * 1e3:8.2f} ms")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
