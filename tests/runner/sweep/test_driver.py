@@ -67,7 +67,7 @@ def test_the_table_is_the_same_bytes_on_one_worker_or_two(client, runs, tmp_path
     two = results.csv_text(columns(AXES, SEEDS), results.rows(runs, figures, positions))
     with (
         distributed.LocalCluster(
-            n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+            n_workers=1, threads_per_worker=1, processes=False, dashboard_address=":0"
         ) as one_cluster,
         distributed.Client(one_cluster) as one,
     ):
