@@ -14,6 +14,7 @@ import pytest
 
 from collide2d.runner.run import drive
 from collide2d.runner.sweep import driver, results
+from collide2d.runner.sweep.cluster import RunsProgress
 from collide2d.runner.sweep.matrix import columns, expand, parse_set
 from collide2d.runner.sweep.runs import mark_outside, run_one
 
@@ -128,3 +129,9 @@ def test_boxes_out_of_the_world_are_marked_once_each():
     assert left.tolist() == [False, True, True, True]
     mark_outside(np.zeros((4, 2)), size, 20.0, 20.0, 1e-9, left)
     assert left.tolist() == [False, True, True, True]
+
+
+def test_progress_counts_runs_and_gives_an_eta():
+    bar = RunsProgress(200, "sweep", io.StringIO())
+    assert bar.line(50, 10.0) == f"sweep [{'#' * 7}{'-' * 23}] 50/200 runs, 30.0s left"
+    assert bar.line(0, 0.0).endswith("0/200 runs, ETA unknown")
