@@ -6,7 +6,7 @@ local `dask scheduler`, against the runs done one after another in this process.
 The sweep is RUNS runs of scenarios/paper_fifty_boxes.yaml at TICKS ticks (seeds 1..RUNS), each
 run as a sweep worker does it (`runner.sweep.runs.run_one`: the per-tick checked run, then the
 timed run). Figures, medians of REPEATS, clusters started and warmed up (every kernel loaded in
-every worker) before timing:
+every worker) before timing, the repeats interleaved across the setups:
 
 - serial: the runs one after another in this process, no Dask;
 - local N: `driver.run_sweep` on an embedded LocalCluster of N processes (N = 1, 2);
@@ -20,6 +20,7 @@ Measure on a quiet machine: other work on the cores shows directly in the ratios
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import signal
@@ -40,25 +41,20 @@ def _runs(n: int, ticks: int):
     return expand([str(SCENARIO)], [parse_set(f"ticks={ticks}")], tuple(range(1, n + 1)))
 
 
-def _timed(fn, repeats: int) -> float:
-    times = []
-    for _ in range(repeats):
-        began = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - began)
-    return statistics.median(times)
+def _warm(client, runs) -> None:
+    """Every worker runs one run first (kernels loaded, imports done)."""
+    from collide2d.runner.sweep.runs import run_one
+
+    client.run(run_one, runs[0].scenario)
 
 
-def _on(client, runs, repeats: int) -> float:
+def _sweep_s(client, runs) -> float:
     from collide2d.runner.sweep import driver
 
-    driver.run_sweep(client, runs[: 2 * len(client.nthreads())])  # every worker warm
-
-    def sweep():
-        figures, _pos, complete = driver.run_sweep(client, runs)
-        assert complete and len(figures) == len(runs)
-
-    return _timed(sweep, repeats)
+    began = time.perf_counter()
+    figures, _pos, complete = driver.run_sweep(client, runs)
+    assert complete and len(figures) == len(runs)
+    return time.perf_counter() - began
 
 
 def _scheduler_cluster(folder: Path, workers: int):
@@ -90,6 +86,12 @@ def _scheduler_cluster(folder: Path, workers: int):
     return address, procs
 
 
+def _stop(procs) -> None:
+    for p in reversed(procs):
+        os.killpg(p.pid, signal.SIGTERM)
+        p.wait(timeout=30)
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--runs", type=int, default=200)
@@ -105,21 +107,27 @@ def main() -> int:
     runs = _runs(args.runs, args.ticks)
     matrix_s = time.perf_counter() - began
     run_one(runs[0].scenario)  # kernels loaded here too
-    figures = {}
-    serial = _timed(lambda: [run_one(r.scenario) for r in runs], args.repeats)
-    for n in (1, 2):
-        with cluster.connect(workers=n) as client:
-            figures[f"local {n}"] = _on(client, runs, args.repeats)
-    with tempfile.TemporaryDirectory() as folder:
+    times: dict[str, list[float]] = {"serial": [], "local 1": [], "local 2": [], "scheduler 2": []}
+    with contextlib.ExitStack() as stack, tempfile.TemporaryDirectory() as folder:
+        clients = {
+            "local 1": stack.enter_context(cluster.connect(workers=1)),
+            "local 2": stack.enter_context(cluster.connect(workers=2)),
+        }
         address, procs = _scheduler_cluster(Path(folder), 2)
-        try:
-            with Client(address, timeout=60) as client:
-                client.wait_for_workers(2, timeout=60)
-                figures["scheduler 2"] = _on(client, runs, args.repeats)
-        finally:
-            for p in reversed(procs):
-                os.killpg(p.pid, signal.SIGTERM)
-                p.wait(timeout=30)
+        stack.callback(_stop, procs)
+        clients["scheduler 2"] = stack.enter_context(Client(address, timeout=60))
+        clients["scheduler 2"].wait_for_workers(2, timeout=60)
+        for client in clients.values():
+            _warm(client, runs)
+        for _ in range(args.repeats):  # interleaved, so that a busy spell hits every setup
+            began = time.perf_counter()
+            for r in runs:
+                run_one(r.scenario)
+            times["serial"].append(time.perf_counter() - began)
+            for name, client in clients.items():
+                times[name].append(_sweep_s(client, runs))
+    figures = {name: statistics.median(t) for name, t in times.items()}
+    serial = figures.pop("serial")
     one, two = figures["local 1"], figures["local 2"]
     print(
         f"{args.runs} runs of {SCENARIO.stem} at {args.ticks} ticks, medians of {args.repeats}, "

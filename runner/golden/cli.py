@@ -2,7 +2,8 @@
 
 Inputs: command-line arguments — scenario files or names (none: every file in `scenarios/`), the
 project root (`--root`, default the nearest folder upward with `scenarios/`), `--report DIR`,
-`--prune`, `--quiet`, `--max-events-per-tick N` (the exact model's cap, over each scenario's).
+`--prune`, `--quiet`, `--max-events-per-tick N` (the exact model's cap, over each scenario's),
+`--workers N` / `--scheduler ADDRESS` (check: the runs on Dask, `runner.sweep.checks`).
 Outputs: console text (stdout: one block per scenario and a closing count;
 stderr: errors and, on a terminal, progress), report folders, golden folders, and the exit status:
 0 fine, 1 a check found a difference (or a golden is missing, damaged or hostile), 2 bad input or

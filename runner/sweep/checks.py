@@ -10,8 +10,6 @@ bad input (`usage`, the check's exception for it).
 
 from __future__ import annotations
 
-import sys
-
 
 def _outcome(value, error):
     def result():
@@ -47,6 +45,4 @@ def cluster_runs(args, scenarios, run, usage):
         )
     if not complete:
         raise KeyboardInterrupt
-    if progress is None and not args.quiet and sys.stderr.isatty():
-        print(f"ran {len(items)} scenarios on the cluster", file=sys.stderr)
     return [_outcome(*got[i]) for i in range(len(items))]
