@@ -11,7 +11,8 @@ every worker) before timing, the repeats interleaved across the setups:
 - serial: the runs one after another in this process, no Dask;
 - local N: `driver.run_sweep` on an embedded LocalCluster of N processes (N = 1, 2);
 - scheduler: the same on a `dask scheduler` with two `dask worker` processes on 127.0.0.1;
-- overhead per run: (local 1 - serial) / RUNS, what Dask adds to each run on one worker;
+- overhead per run: (local 1 - serial) / RUNS, what Dask adds to each run on one worker, and
+  the scheduling alone: RUNS tasks that do nothing, per task;
 - speed-up: local 1 / local 2.
 
 Measure on a quiet machine: other work on the cores shows directly in the ratios.
@@ -46,6 +47,17 @@ def _warm(client, runs) -> None:
     from collide2d.runner.sweep.runs import run_one
 
     client.run(run_one, runs[0].scenario)
+
+
+def _nothing(i: int) -> int:
+    return i
+
+
+def _empty_s(client, n: int) -> float:
+    """Seconds for n tasks that do nothing: the scheduling alone."""
+    began = time.perf_counter()
+    client.gather(client.map(_nothing, range(n), pure=False))
+    return time.perf_counter() - began
 
 
 def _sweep_s(client, runs) -> float:
@@ -126,6 +138,7 @@ def main() -> int:
             times["serial"].append(time.perf_counter() - began)
             for name, client in clients.items():
                 times[name].append(_sweep_s(client, runs))
+                times.setdefault(f"empty {name}", []).append(_empty_s(client, len(runs)))
     figures = {name: statistics.median(t) for name, t in times.items()}
     serial = figures.pop("serial")
     one, two = figures["local 1"], figures["local 2"]
@@ -136,7 +149,12 @@ def main() -> int:
     print(f"matrix (load and check every run):  {matrix_s:8.3f} s")
     print(f"serial, in this process:            {serial:8.3f} s")
     for name, seconds in figures.items():
-        print(f"{name + ' worker(s):':36s}{seconds:8.3f} s")
+        if not name.startswith("empty"):
+            print(f"{name + ' worker(s):':36s}{seconds:8.3f} s")
+    for name, seconds in figures.items():
+        if name.startswith("empty"):
+            label = f"scheduling per task, {name[6:]}:"
+            print(f"{label:36s}{seconds / args.runs * 1e3:8.2f} ms")
     print(f"speed-up, 2 workers over 1:         {one / two:8.2f} x")
     print(f"Dask overhead per run (1 worker):   {(one - serial) / args.runs * 1e3:8.2f} ms")
     print(f"per run, serial:                    {serial / args.runs * 1e3:8.2f} ms")
