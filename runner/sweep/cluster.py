@@ -73,7 +73,7 @@ def connect(workers: int | None = None, scheduler: str | None = None):
             threads_per_worker=1,
             processes=True,
             dashboard_address=":0",  # the HTTP server on a free port: 8787 may be taken
-            silence_logs=logging.ERROR,
+            silence_logs=logging.CRITICAL,  # shutdown races log tracebacks; rows say what failed
         )
     try:
         with Client(cluster) as client:
