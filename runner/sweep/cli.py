@@ -105,7 +105,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         print(f"collide2d: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
     target = Path(args.out) / REPORT_DIR
-    if target.is_symlink() or Path(args.out).is_symlink():
+    if target.is_symlink():
         print(
             f"collide2d: error: {target} is a symbolic link; name another folder", file=sys.stderr
         )

@@ -78,6 +78,11 @@ def test_bad_input_exits_2_and_writes_nothing(tmp_path, capsys):
     assert main(["sweep", sweep, str(FIFTY), "--out", str(out)]) == 2
     assert "give one sweep file on its own" in capsys.readouterr().err
     assert not out.exists()
+    out.mkdir()
+    (out / "sweep").symlink_to(tmp_path)
+    assert main(["sweep", str(FIFTY), "--out", str(out)]) == 2
+    assert "sweep is a symbolic link" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["matrix.yaml", "out"]
 
 
 def test_without_dask_sweep_says_how_to_install_it(tmp_path, capsys, monkeypatch):
