@@ -101,9 +101,10 @@ def progress_for(total: int, label: str, quiet: bool) -> Progress | None:
     return RunsProgress(total, label)
 
 
-def run_all(client, fn, items, on_result, *, progress=None, label="collide2d") -> bool:
+def run_all(client, fn, items, on_result, *, progress=None, label="collide2d", sizes=None) -> bool:
     """Run fn(item) for every item on the cluster; on_result(i, value, error) for each as it
-    finishes. True when every item got its result, False when cancelled by Ctrl-C."""
+    finishes. True when every item got its result, False when cancelled by Ctrl-C. `progress`
+    counts items, or `sizes[i]` for item i (runs in a batch)."""
     from distributed import as_completed
 
     token = uuid.uuid4().hex[:12]
@@ -122,7 +123,7 @@ def run_all(client, fn, items, on_result, *, progress=None, label="collide2d") -
                 value, error = None, exc
             on_result(i, value, error)
             future.release()
-            done += 1
+            done += sizes[i] if sizes is not None else 1
             if progress is not None:
                 progress.update(done)
     except KeyboardInterrupt:

@@ -6,6 +6,7 @@ the world (`mark_outside`); this first run also loads or compiles the kernels, s
 lands in the timing. Then once as `collide2d run` does (`runner.run.drive`, no frames, no log),
 timed: its summary gives the wall time, the events by type and the energy and momentum at both
 ends. A model that stops the run (a runaway) makes a row with status `stopped` and its message.
+`run_batch(scenarios)` runs several, in order, as one Dask task (`runner.sweep.driver`).
 
 Kernels are numba's with `cache=True`: a worker process compiles (or loads from the cache on
 disk) each kernel the first time it runs it and keeps it for every later run it is given.
@@ -61,6 +62,24 @@ def _checked(scenario) -> tuple[float, int]:
         deepest = max(deepest, float(max_penetration(pos, size)[0]))
         mark_outside(pos, size, width, height, OUTSIDE_TOL_PX, left)
     return deepest, int(left.sum())
+
+
+def run_batch(scenarios) -> list[tuple[dict, np.ndarray | None]]:
+    """run_one of each scenario, in order; a run that raises (a bug) is a row with status
+    `error` and the exception in its note, and the others still run."""
+    out = []
+    for scenario in scenarios:
+        try:
+            out.append(run_one(scenario))
+        except Exception as exc:
+            out.append((error_figures(exc), None))
+    return out
+
+
+def error_figures(exc: BaseException) -> dict:
+    """The figures of a run that failed unexpectedly: status `error`, the exception as note."""
+    detail = " ".join(str(exc).split())[:300]
+    return {"status": STATUS_ERROR, "note": f"{type(exc).__name__}: {detail}"}
 
 
 def run_one(scenario) -> tuple[dict, np.ndarray | None]:

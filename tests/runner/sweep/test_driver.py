@@ -15,8 +15,9 @@ import pytest
 from collide2d.runner.run import drive
 from collide2d.runner.sweep import driver, results
 from collide2d.runner.sweep.cluster import RunsProgress
+from collide2d.runner.sweep.driver import batch_size
 from collide2d.runner.sweep.matrix import columns, expand, parse_set
-from collide2d.runner.sweep.runs import mark_outside, run_one
+from collide2d.runner.sweep.runs import mark_outside, run_batch, run_one
 
 distributed = pytest.importorskip("distributed")
 
@@ -135,3 +136,22 @@ def test_progress_counts_runs_and_gives_an_eta():
     bar = RunsProgress(200, "sweep", io.StringIO())
     assert bar.line(50, 10.0) == f"sweep [{'#' * 7}{'-' * 23}] 50/200 runs, 30.0s left"
     assert bar.line(0, 0.0).endswith("0/200 runs, ETA unknown")
+
+
+def test_runs_in_batches_give_the_same_rows(client, runs):
+    assert [batch_size(n, t) for n, t in ((200, 2), (8, 2), (6, 2), (10**6, 4))] == [13, 1, 1, 32]
+    one = driver.run_sweep(client, runs, batch=1)
+    four = driver.run_sweep(client, runs, batch=4)
+    assert four[2] and sorted(four[0]) == list(range(6))
+    strip = [
+        {k: v for k, v in r.items() if k != "run_time_s"} for r in results.rows(runs, *one[:2])
+    ]
+    assert strip == [
+        {k: v for k, v in r.items() if k != "run_time_s"} for r in results.rows(runs, *four[:2])
+    ]
+
+
+def test_a_run_that_raises_is_an_error_row_and_its_batch_goes_on(runs):
+    done = run_batch([runs[0].scenario, None, runs[1].scenario])
+    assert [row["status"] for row, _pos in done] == ["ok", "error", "ok"]
+    assert done[1][0]["note"].startswith("AttributeError: ") and done[1][1] is None
