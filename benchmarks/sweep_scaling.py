@@ -6,7 +6,7 @@ local `dask scheduler`, against the runs done one after another in this process.
 The sweep is RUNS runs of scenarios/paper_fifty_boxes.yaml at TICKS ticks (seeds 1..RUNS), each
 run as a sweep worker does it (`runner.sweep.runs.run_one`: the per-tick checked run, then the
 timed run). Figures, medians of REPEATS, clusters started and warmed up (every kernel loaded in
-every worker) before timing, the repeats interleaved across the setups:
+every worker) before timing, one cluster at a time, the serial runs timed between them:
 
 - serial: the runs one after another in this process, no Dask;
 - local N: `driver.run_sweep` on an embedded LocalCluster of N processes (N = 1, 2);
@@ -21,7 +21,6 @@ Measure on a quiet machine: other work on the cores shows directly in the ratios
 from __future__ import annotations
 
 import argparse
-import contextlib
 import json
 import os
 import signal
@@ -119,26 +118,34 @@ def main() -> int:
     runs = _runs(args.runs, args.ticks)
     matrix_s = time.perf_counter() - began
     run_one(runs[0].scenario)  # kernels loaded here too
-    times: dict[str, list[float]] = {"serial": [], "local 1": [], "local 2": [], "scheduler 2": []}
-    with contextlib.ExitStack() as stack, tempfile.TemporaryDirectory() as folder:
-        clients = {
-            "local 1": stack.enter_context(cluster.connect(workers=1)),
-            "local 2": stack.enter_context(cluster.connect(workers=2)),
-        }
+    times: dict[str, list[float]] = {"serial": []}
+
+    def serial() -> None:
+        began = time.perf_counter()
+        for r in runs:
+            run_one(r.scenario)
+        times["serial"].append(time.perf_counter() - began)
+
+    def measure(name: str, client) -> None:
+        _warm(client, runs)
+        for _ in range(args.repeats):
+            times.setdefault(name, []).append(_sweep_s(client, runs))
+            times.setdefault(f"empty {name}", []).append(_empty_s(client, len(runs)))
+        serial()  # between the setups, so that a busy spell shows in both
+
+    # one cluster at a time: a second embedded cluster in this process slows the first's runs
+    serial()
+    for n in (1, 2):
+        with cluster.connect(workers=n) as client:
+            measure(f"local {n}", client)
+    with tempfile.TemporaryDirectory() as folder:
         address, procs = _scheduler_cluster(Path(folder), 2)
-        stack.callback(_stop, procs)
-        clients["scheduler 2"] = stack.enter_context(Client(address, timeout=60))
-        clients["scheduler 2"].wait_for_workers(2, timeout=60)
-        for client in clients.values():
-            _warm(client, runs)
-        for _ in range(args.repeats):  # interleaved, so that a busy spell hits every setup
-            began = time.perf_counter()
-            for r in runs:
-                run_one(r.scenario)
-            times["serial"].append(time.perf_counter() - began)
-            for name, client in clients.items():
-                times[name].append(_sweep_s(client, runs))
-                times.setdefault(f"empty {name}", []).append(_empty_s(client, len(runs)))
+        try:
+            with Client(address, timeout=60) as client:
+                client.wait_for_workers(2, timeout=60)
+                measure("scheduler 2", client)
+        finally:
+            _stop(procs)
     figures = {name: statistics.median(t) for name, t in times.items()}
     serial = figures.pop("serial")
     one, two = figures["local 1"], figures["local 2"]
