@@ -97,3 +97,16 @@ def test_without_dask_sweep_says_how_to_install_it(tmp_path, capsys, monkeypatch
     assert main(["check", "fig2_case1", "--workers", "2", "--root", str(SCENARIOS.parent)]) == 2
     assert 'pip install "collide2d[dask]"' in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_the_example_sweep_file_expands_to_its_runs():
+    from collide2d.runner.sweep.matrix import expand
+
+    example = SCENARIOS.parent / "sweeps" / "paper_fps.yaml"
+    scenarios, axes, seeds = sweepfile.read(str(example))
+    runs = expand(scenarios, axes, seeds)
+    assert len(runs) == 90
+    assert {(r.params["model"], r.params["fps"]) for r in runs} == {
+        (m, f) for m in ("paper", "stepped", "exact") for f in ("10", "30", "60")
+    }
+    assert {r.scenario.world.fps for r in runs if r.params["fps"] == "30"} == {30}
