@@ -42,11 +42,17 @@ def _runs(n: int, ticks: int):
     return expand([str(SCENARIO)], [parse_set(f"ticks={ticks}")], tuple(range(1, n + 1)))
 
 
-def _warm(client, runs) -> None:
-    """Every worker runs one run first (kernels loaded, imports done)."""
+def _first_run_s(scenario) -> float:
     from collide2d.runner.sweep.runs import run_one
 
-    client.run(run_one, runs[0].scenario)
+    began = time.perf_counter()
+    run_one(scenario)
+    return time.perf_counter() - began
+
+
+def _warm(client, runs) -> float:
+    """Every worker runs one run first (imports done, kernels loaded); the slowest, in seconds."""
+    return max(client.run(_first_run_s, runs[0].scenario).values())
 
 
 def _nothing(i: int) -> int:
@@ -127,8 +133,10 @@ def main() -> int:
             run_one(r.scenario)
         times["serial"].append(time.perf_counter() - began)
 
+    first: list[float] = []
+
     def measure(name: str, client) -> None:
-        _warm(client, runs)
+        first.append(_warm(client, runs))
         for _ in range(args.repeats):
             times.setdefault(name, []).append(_sweep_s(client, runs))
             times.setdefault(f"empty {name}", []).append(_empty_s(client, len(runs)))
@@ -152,6 +160,7 @@ def main() -> int:
         f"{os.cpu_count()} cores (on a busy machine the fastest repeat is nearer the cost)"
     )
     print(f"matrix (load and check every run):  {matrix_s:8.3f} s")
+    print(f"a fresh worker's first run:         {statistics.median(first):8.3f} s (median)")
     for way in (statistics.median, min):
         figures = {name: way(t) for name, t in times.items()}
         serial_s = figures.pop("serial")
