@@ -31,6 +31,7 @@ from collide2d.runner.outputspec import OVERLAY_NAMES
 from collide2d.runner.run import RunOptions, RunStopped, run_to_dir
 from collide2d.runner.scenario import ScenarioError, load
 from collide2d.runner.stress import cli as stress_cli
+from collide2d.runner.sweep import cli as sweep_cli
 
 
 def demo_path() -> str:
@@ -145,6 +146,7 @@ def build_parser() -> argparse.ArgumentParser:
     validate.register(subparsers)
     stress_cli.register(subparsers)
     bench_cli.register(subparsers)
+    sweep_cli.register(subparsers)
     for sub in subparsers.choices.values():
         sub.add_argument(
             "--debug", action="store_true", help="print the traceback of an unexpected error"

@@ -207,12 +207,17 @@ class Scenario:
     max_events_per_tick: int = DEFAULT_MAX_EVENTS_PER_TICK
 
 
-def load(path, *, overrides: dict | None = None, limits: Limits | None = None) -> Scenario:
-    """Read and check the scenario file at `path` (str or os.PathLike); ScenarioError if bad."""
+def load(
+    path, *, overrides: dict | None = None, limits: Limits | None = None, edit=None
+) -> Scenario:
+    """Read and check the scenario file at `path` (str or os.PathLike); ScenarioError if bad.
+
+    `edit(root) -> root`, when given, changes the composed YAML node tree before it is read (a
+    sweep's dotted keys, `runner.sweep.matrix`); the result is checked like the file itself."""
     shown = os.fspath(path)
     limits = limits if limits is not None else Limits()
     text, digest = ys.read_file(path, limits)
-    return _Reader(shown, shown, overrides, limits).scenario(text, digest)
+    return _Reader(shown, shown, overrides, limits).scenario(text, digest, edit)
 
 
 def loads(text: str, path: str = "<string>", *, overrides=None, limits=None) -> Scenario:
@@ -246,8 +251,10 @@ class _Reader(Nodes):
 
     # -- the document
 
-    def scenario(self, text: str, digest: str) -> Scenario:
+    def scenario(self, text: str, digest: str, edit=None) -> Scenario:
         root = ys.compose(text, self.path, self.limits)
+        if edit is not None:
+            root = edit(root)
         self.root = root
         top = self.mapping(root, "the scenario", TOP_KEYS)
         self.version(top, root)

@@ -39,6 +39,12 @@ QUICK_LADDER = {"paper": [(30, 1), (60, 1)], "stepped": [(60, 1), (60, 4)], "exa
 QUICK_DURATION_S = 0.5
 
 
+def position_error(pos: np.ndarray, ref: np.ndarray) -> float:
+    """The mean distance (px) between each object's position and its reference position; (n, 2)
+    arrays of the same objects (also the position error of `collide2d sweep`)."""
+    return float(np.linalg.norm(pos - ref, axis=1).mean()) if len(pos) else 0.0
+
+
 def _pair_counts(events) -> Counter:
     pairs = events[events["type"] == EV_PAIR]
     return Counter(zip(pairs["a"].tolist(), pairs["b"].tolist(), strict=True))
@@ -83,7 +89,7 @@ def error_ladder(names, models_, quick: bool, echo, folder: Path = PROJECT_SCENA
                     f"error    {name:24s} {model:7s} fps={fps:<4d} substeps={substeps:<3d} "
                     f"{row['run_time_s'] * 1e3:9.2f} ms  pos err {row['position_error_px']:.3g} px"
                 )
-        _mark_pareto(scene_rows)
+        mark_pareto(scene_rows)
         rows.extend(scene_rows)
     return rows
 
@@ -130,12 +136,12 @@ def _error_row(scenario, model, fps, substeps, duration, ref, repeats) -> dict:
         "missed": missed,
         "energy_drift": (energy1 - energy0) / energy0 if energy0 else 0.0,
         "max_penetration_px": deepest,
-        "position_error_px": float(np.linalg.norm(at_horizon - ref["horizon"], axis=1).mean()),
+        "position_error_px": position_error(at_horizon, ref["horizon"]),
         "horizon_s": ref["horizon_s"],
     }
 
 
-def _mark_pareto(rows: list[dict]) -> None:
+def mark_pareto(rows: list[dict]) -> None:
     """pareto = "yes" for the rows no other row beats on both run time and position error."""
     for r in rows:
         beaten = any(

@@ -2,7 +2,8 @@
 
 Inputs: command-line arguments — scenario files or names (none: every file in `scenarios/`), the
 project root (`--root`, default the nearest folder upward with `scenarios/`), `--report DIR`,
-`--prune`, `--quiet`, `--max-events-per-tick N` (the exact model's cap, over each scenario's).
+`--prune`, `--quiet`, `--max-events-per-tick N` (the exact model's cap, over each scenario's),
+`--workers N` / `--scheduler ADDRESS` (check: the runs on Dask, `runner.sweep.checks`).
 Outputs: console text (stdout: one block per scenario and a closing count;
 stderr: errors and, on a terminal, progress), report folders, golden folders, and the exit status:
 0 fine, 1 a check found a difference (or a golden is missing, damaged or hostile), 2 bad input or
@@ -102,11 +103,26 @@ def register(subparsers, *, load=None, simulate=None) -> None:
                 "--report", metavar="DIR", help="write expected/actual/diff images and HTML"
             )
             add_check_formats(p)
+            _cluster_arguments(p)
         else:
             p.add_argument("--prune", action="store_true", help="remove goldens no scenario uses")
             add_from_report(p)
         _common(p)
         p.set_defaults(func=partial(command, load=load, simulate=simulate))
+
+
+def _cluster_arguments(p) -> None:
+    """--workers N | --scheduler ADDRESS: run the scenarios on Dask (runner.sweep)."""
+    from collide2d.runner.sweep.cli import add_cluster_arguments
+
+    add_cluster_arguments(p)
+
+
+def _cluster_runs(args, scenarios, run):
+    """None, or the scenarios' runs done on a Dask cluster (runner.sweep.checks)."""
+    from collide2d.runner.sweep.checks import cluster_runs
+
+    return cluster_runs(args, scenarios, run, _Usage)
 
 
 def _common(p) -> None:
@@ -153,13 +169,17 @@ def check_command(args, *, load=default_load, simulate=default_simulate) -> int:
             out = Output(args)
         except GoldenError as exc:
             raise _Usage(str(exc)) from None
+        runs = _cluster_runs(args, scenarios, partial(run_scenario, simulate=simulate))
     except _Usage as exc:
         return exc.exit()
     outcomes, status, errors = [], EXIT_OK, []
     for i, (path, scn) in enumerate(scenarios, start=1):
         _progress(args, f"[{i}/{len(scenarios)}] checking {scn.name}")
         try:
-            result = run_scenario(scn, simulate, progress=_show_progress(args))
+            if runs is not None:  # run on a Dask cluster (--workers, --scheduler)
+                result = runs[i - 1]()
+            else:
+                result = run_scenario(scn, simulate, progress=_show_progress(args))
             outcome = check_run(scn, result, store, path=path, report_dir=report_dir)
         except Exception as exc:  # one scenario never stops the others
             status = max(status, _scenario_failed(args, "checking", path, scn, exc))

@@ -14,7 +14,7 @@ def test_pareto_marks_the_rows_nothing_beats_on_both_counts():
         {"run_time_s": 0.5, "position_error_px": 9.0},
         {"run_time_s": 1.0, "position_error_px": 5.0},  # a tie is not beaten
     ]
-    error._mark_pareto(rows)
+    error.mark_pareto(rows)
     assert [r["pareto"] for r in rows] == ["yes", "yes", "no", "yes", "yes"]
 
 

@@ -1,0 +1,137 @@
+"""The `sweep` subcommand: its arguments, and the run that builds the matrix, runs it, writes it.
+
+`register` adds the subcommand without loading Dask; `cmd_sweep` reads the matrix (scenario files
+and `--set`/`--seeds`, or one sweep file), loads and checks every run before anything runs, runs
+them on the cluster (`--scheduler`, else an embedded LocalCluster of `--workers` processes) and
+writes OUT/sweep/. Exit status: 0 done, 2 bad input (nothing written) or Dask not installed,
+3 when a run failed unexpectedly (its row says so), 130 when cancelled by Ctrl-C (the rows done
+are written, marked incomplete).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+from collide2d.runner.exitcodes import EXIT_BAD_INPUT, EXIT_OK, EXIT_UNEXPECTED
+
+EXIT_CANCELLED = 130
+REPORT_DIR = "sweep"
+
+
+def add_cluster_arguments(parser: argparse.ArgumentParser) -> None:
+    """--workers N | --scheduler ADDRESS (also on `check`)."""
+    from collide2d.runner.options import positive_int
+
+    where = parser.add_mutually_exclusive_group()
+    where.add_argument(
+        "--workers",
+        type=positive_int,
+        metavar="N",
+        help="run on an embedded Dask cluster of N processes (default: one per core)",
+    )
+    where.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="run on the Dask cluster whose scheduler is at ADDRESS (tcp://HOST:PORT), started "
+        "with `dask scheduler` and `dask worker`",
+    )
+
+
+def register(subparsers) -> None:
+    """Add the `sweep` subcommand to an argparse subparsers object."""
+    from collide2d.runner.options import add_limit_arguments
+
+    p = subparsers.add_parser(
+        "sweep",
+        help="run scenarios over a matrix of settings and seeds on Dask; a table of results",
+        description="Run every combination of the --set values and --seeds for each scenario "
+        "(or the matrix of one sweep file) on a Dask cluster, and write OUT/sweep/results.csv "
+        "(one row per run, sorted by its parameters), results.md and, with the plot extra and "
+        "the exact model in the sweep, runtime_vs_error.png.",
+    )
+    p.add_argument(
+        "scenarios", nargs="+", metavar="SCENARIO", help="scenario files, or one sweep file"
+    )
+    p.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        dest="sets",
+        metavar="KEY=V1,V2",
+        help="sweep KEY over these values (repeat): model, fps, ticks, substeps, geometry or a "
+        "dotted scenario key such as world.width or generate.0.count",
+    )
+    p.add_argument("--seeds", metavar="A-B", help="sweep every generate block's seed over A..B")
+    add_cluster_arguments(p)
+    p.add_argument("--out", default="out", metavar="DIR", help="output folder (default: out)")
+    p.add_argument("--quiet", action="store_true", help="no progress, no summary")
+    add_limit_arguments(p)
+    p.set_defaults(func=cmd_sweep)
+
+
+def matrix_from_args(args):
+    """(scenario paths, axes, seeds) from the command line (and a sweep file)."""
+    from collide2d.runner.options import limits_from_args
+    from collide2d.runner.sweep import matrix, sweepfile
+
+    limits = limits_from_args(args)
+    paths, axes, seeds = list(args.scenarios), [], None
+    files = [p for p in paths if Path(p).is_file() and sweepfile.is_sweep_file(p, limits)]
+    if files:
+        if len(paths) > 1:
+            raise matrix.SweepError(f"give one sweep file on its own ({files[0]} is one)")
+        paths, axes, seeds = sweepfile.read(files[0], limits)
+    given = [matrix.parse_set(s, limits) for s in args.sets]
+    axes = [a for a in axes if a.key not in {g.key for g in given}] + given
+    if args.seeds is not None:
+        seeds = matrix.parse_seeds(args.seeds)
+    for path in paths:
+        if not Path(path).is_file():
+            raise matrix.SweepError(f"{path}: no such scenario file")
+    return paths, axes, seeds, limits
+
+
+def cmd_sweep(args: argparse.Namespace) -> int:
+    from collide2d.runner.sweep import cluster, driver, matrix, results
+
+    try:
+        cluster.require_dask("collide2d sweep")
+        paths, axes, seeds, limits = matrix_from_args(args)
+        runs = matrix.expand(paths, axes, seeds, limits)
+    except (cluster.DaskMissing, matrix.SweepError) as exc:
+        print(f"collide2d: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    target = Path(args.out) / REPORT_DIR
+    if target.is_symlink():
+        print(
+            f"collide2d: error: {target} is a symbolic link; name another folder", file=sys.stderr
+        )
+        return EXIT_BAD_INPUT
+    columns = matrix.columns(axes, seeds)
+    with cluster.connect(args.workers, args.scheduler) as client:
+        if not args.quiet:
+            where = args.scheduler or f"{args.workers or os.cpu_count()} local workers"
+            print(f"sweep: {len(runs)} runs on {where}", file=sys.stderr, flush=True)
+        progress = cluster.progress_for(len(runs), "sweep", args.quiet)
+        figures, positions, complete = driver.run_sweep(client, runs, progress=progress)
+    table = results.rows(runs, figures, positions)
+    written = results.write(target, columns, table, len(runs), complete)
+    failed = [r for r in table if r["status"] == "error"]
+    if not complete:
+        print(
+            f"sweep: cancelled; {len(table)} of {len(runs)} runs written, marked incomplete -> "
+            f"{target}",
+            file=sys.stderr,
+        )
+        return EXIT_CANCELLED
+    for row in failed:
+        print(f"collide2d: run failed: {row['scenario']}: {row['note']}", file=sys.stderr)
+    if not args.quiet:
+        stopped = sum(r["status"] == "stopped" for r in table)
+        said = f", {stopped} stopped by their model" if stopped else ""
+        said += f", {len(failed)} failed" if failed else ""
+        print(f"sweep: {len(table)} runs{said} -> {target} ({', '.join(written)})")
+    return EXIT_UNEXPECTED if failed else EXIT_OK

@@ -1,0 +1,206 @@
+"""Sweeps and checks on process clusters as users start them: `collide2d sweep --workers 2`, and
+a cluster of `dask scheduler` and two `dask worker` processes on 127.0.0.1, one of them killed
+mid-sweep; every process started here is ended here."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from collide2d.runner.sweep import driver, results
+from collide2d.runner.sweep.matrix import columns, expand, parse_set
+from collide2d.runner.sweep.runs import run_one
+
+distributed = pytest.importorskip("distributed")
+
+ROOT = Path(__file__).resolve().parents[3]
+SCENARIOS = ROOT / "scenarios"
+FIFTY = str(SCENARIOS / "paper_fifty_boxes.yaml")
+BIN = Path(sys.executable).parent
+START_S = 60  # the longest a scheduler or worker may take to come up on a busy machine
+
+
+def _cli(*args, cwd=ROOT, timeout=240):
+    return subprocess.run(
+        [str(BIN / "collide2d"), *args],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        stdin=subprocess.DEVNULL,
+    )
+
+
+def _without_wall_time(text: str) -> list[str]:
+    return [line.rsplit(",", 1)[0] for line in text.splitlines()]
+
+
+def test_sweep_on_the_default_local_cluster_matches_an_in_process_one(tmp_path, client):
+    sweep_file = tmp_path / "matrix.yaml"
+    sweep_file.write_text(
+        f"sweep: 1\nscenarios: [{FIFTY}]\nset:\n  model: [exact, paper]\n  ticks: 40\nseeds: 1-2\n"
+    )
+    out = tmp_path / "out"
+    done = _cli("sweep", str(sweep_file), "--workers", "2", "--out", str(out), "--quiet")
+    assert done.returncode == 0, done.stderr
+    assert done.stdout == "" and done.stderr == ""
+    written = (out / "sweep" / "results.csv").read_text()
+    axes = [parse_set("model=exact,paper"), parse_set("ticks=40")]
+    runs = expand([FIFTY], axes, (1, 2))
+    figures, positions, _ = driver.run_sweep(client, runs)
+    mine = results.csv_text(columns(axes, (1, 2)), results.rows(runs, figures, positions))
+    assert _without_wall_time(written) == _without_wall_time(mine)
+    assert json.loads((out / "sweep" / "sweep.json").read_text())["complete"] is True
+
+
+def test_check_on_a_cluster_says_what_a_local_check_says(tmp_path):
+    root = tmp_path / "project"
+    (root / "scenarios").mkdir(parents=True)
+    for name in ("fig2_case1", "tunnelling_1fps"):
+        shutil.copy(SCENARIOS / f"{name}.yaml", root / "scenarios")
+        shutil.copytree(ROOT / "goldens" / name, root / "goldens" / name)
+    # a golden that no longer matches: the cluster must report it as the local check does
+    final = root / "goldens" / "tunnelling_1fps" / "final.csv"
+    final.write_text(final.read_text().replace("0,220,115", "0,221,115", 1))
+    local = _cli("check", "--root", str(root))
+    remote = _cli("check", "--root", str(root), "--workers", "1")
+    assert local.returncode == remote.returncode == 1
+    assert remote.stdout == local.stdout
+    assert local.stdout.startswith("ok      fig2_case1\n")
+    assert "1 passed, 1 failed" in local.stdout
+
+
+def _group_ends(pgid: int, within_s: float = 30.0) -> bool:
+    """True once no process of the group is left (killing what is left after within_s)."""
+    deadline = time.monotonic() + within_s
+    while time.monotonic() < deadline:
+        try:
+            os.killpg(pgid, 0)
+        except ProcessLookupError:
+            return True
+        time.sleep(0.1)
+    os.killpg(pgid, signal.SIGKILL)
+    return False
+
+
+def _start(*args, log: Path):
+    return subprocess.Popen(
+        [str(BIN / "dask"), *args],
+        stdout=log.open("w"),
+        stderr=subprocess.STDOUT,
+        stdin=subprocess.DEVNULL,
+        cwd=ROOT,
+        start_new_session=True,
+    )
+
+
+def _stop(proc) -> None:
+    if proc.poll() is None:
+        os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait(timeout=30)
+
+
+def test_a_worker_killed_mid_sweep_loses_no_row(tmp_path):
+    addr_file = tmp_path / "scheduler.json"
+    procs = []
+    try:
+        procs.append(
+            _start(
+                "scheduler",
+                "--host",
+                "127.0.0.1",
+                "--port",
+                "0",
+                "--no-dashboard",
+                "--scheduler-file",
+                str(addr_file),
+                log=tmp_path / "scheduler.log",
+            )
+        )
+        deadline = time.monotonic() + START_S
+        while not addr_file.is_file():
+            assert time.monotonic() < deadline, (tmp_path / "scheduler.log").read_text()
+            time.sleep(0.1)
+        time.sleep(0.2)  # the file is written whole before the scheduler listens
+        address = json.loads(addr_file.read_text())["address"]
+        assert address.startswith("tcp://127.0.0.1:")
+        workers = {}
+        for name in ("a", "b"):
+            workers[name] = _start(
+                "worker",
+                address,
+                "--host",
+                "127.0.0.1",
+                "--nthreads",
+                "1",
+                "--no-nanny",
+                "--no-dashboard",
+                "--name",
+                name,
+                log=tmp_path / f"worker-{name}.log",
+            )
+            procs.append(workers[name])
+        runs = expand([FIFTY], [parse_set("ticks=4000")], tuple(range(1, 9)))
+        killed = []
+
+        def kill_a_busy_worker(run, row):
+            if killed:
+                return
+            busy = [addr for addr, keys in client.processing().items() if keys]
+            names = {a: w["name"] for a, w in client.scheduler_info()["workers"].items()}
+            victim = names[busy[0]] if busy else "a"
+            workers[victim].send_signal(signal.SIGKILL)
+            killed.append((victim, bool(busy)))
+
+        with distributed.Client(address, timeout=START_S) as client:
+            client.wait_for_workers(2, timeout=START_S)
+            figures, positions, complete = driver.run_sweep(client, runs, on_row=kill_a_busy_worker)
+        ((victim, busy),) = killed  # a worker with a run in hand, killed while rows were missing
+        assert busy and workers[victim].wait(timeout=30) == -signal.SIGKILL
+        assert complete and sorted(figures) == list(range(len(runs)))
+        for run in runs:
+            want, _pos = run_one(run.scenario)
+            got = figures[run.index]
+            assert got["status"] == "ok"
+            assert {k: v for k, v in got.items() if k != "run_time_s"} == {
+                k: v for k, v in want.items() if k != "run_time_s"
+            }
+    finally:
+        for proc in reversed(procs):
+            _stop(proc)
+
+
+def test_ctrl_c_writes_the_rows_done_marked_incomplete(tmp_path):
+    out = tmp_path / "out"
+    proc = subprocess.Popen(
+        [str(BIN / "collide2d"), "sweep", FIFTY, "--set", "ticks=20000", "--seeds", "1-40",
+         "--workers", "2", "--out", str(out)],
+        cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL,
+        text=True, start_new_session=True,
+    )  # fmt: skip
+    try:
+        first = proc.stderr.readline()  # printed once the cluster is up
+        assert first == "sweep: 40 runs on 2 local workers\n"
+        time.sleep(1.5)
+        os.killpg(proc.pid, signal.SIGINT)  # as a terminal's Ctrl-C: the whole group
+        out_text, err_text = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+    assert proc.returncode == 130
+    assert _group_ends(proc.pid), "a worker process outlived the sweep"
+    assert "Traceback" not in err_text and "KeyboardInterrupt" not in err_text
+    status = json.loads((out / "sweep" / "sweep.json").read_text())
+    assert status["complete"] is False and status["done"] < 40
+    rows = (out / "sweep" / "results.csv").read_text().splitlines()[1:]
+    assert len(rows) == status["done"] == len({r.split(",")[1] for r in rows})
+    assert f"cancelled; {status['done']} of 40 runs written, marked incomplete" in err_text

@@ -1,0 +1,157 @@
+"""Sweeps on a real (in-process) Dask cluster: every row's figures are the run's own, rows come
+out in parameter order whatever the worker count, the position error is measured against the
+exact run of the same seed, and Ctrl-C keeps the rows finished so far, marked incomplete."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from collide2d.runner.run import drive
+from collide2d.runner.sweep import driver, results
+from collide2d.runner.sweep.cluster import RunsProgress
+from collide2d.runner.sweep.driver import batch_size
+from collide2d.runner.sweep.matrix import columns, expand, parse_set
+from collide2d.runner.sweep.runs import mark_outside, run_batch, run_one
+
+distributed = pytest.importorskip("distributed")
+
+SCENARIOS = Path(__file__).resolve().parents[3] / "scenarios"
+FIFTY = str(SCENARIOS / "paper_fifty_boxes.yaml")
+AXES = [parse_set("model=paper,exact"), parse_set("ticks=60")]
+SEEDS = (3, 1, 2)
+
+
+def _without_wall_time(text: str) -> str:
+    return "\n".join(line.rsplit(",", 1)[0] for line in text.splitlines())
+
+
+@pytest.fixture(scope="module")
+def runs():
+    return expand([FIFTY], AXES, tuple(sorted(SEEDS)))
+
+
+def test_rows_hold_each_runs_own_figures(client, runs):
+    figures, positions, complete = driver.run_sweep(client, runs)
+    assert complete and sorted(figures) == list(range(6))
+    table = results.rows(runs, figures, positions)
+    assert [(r["seed"], r["model"]) for r in table] == [
+        (s, m) for s in ("1", "2", "3") for m in ("exact", "paper")
+    ]
+    for run, row in zip(runs, table, strict=True):
+        model, summary = drive(run.scenario)
+        assert row["status"] == "ok"
+        assert (row["wall_events"], row["pair_events"]) == (
+            summary["events"]["wall"],
+            summary["events"]["pair"],
+        )
+        assert row["objects"] == 50 and row["left_world"] == 0
+        np.testing.assert_array_equal(positions[run.index], model.positions())
+    for exact, paper in zip(table[::2], table[1::2], strict=True):
+        # the exact model keeps energy; it is its own reference; paper is measured against it
+        assert abs(exact["energy_drift"]) < 1e-12 and exact["position_error_px"] == 0.0
+        assert exact["worst_overlap_px"] < 1e-9 and paper["worst_overlap_px"] >= 0.0
+        index = {(r.params["seed"], r.params["model"]): r.index for r in runs}
+        ref = positions[index[exact["seed"], "exact"]]
+        mine = positions[index[paper["seed"], "paper"]]
+        want = float(np.mean(np.hypot(*(mine - ref).T)))
+        assert paper["position_error_px"] == pytest.approx(want, rel=1e-12)
+        assert paper["position_error_px"] > 1.0
+
+
+def test_the_table_is_the_same_bytes_on_one_worker_or_two(client, runs, tmp_path):
+    figures, positions, _ = driver.run_sweep(client, runs)
+    two = results.csv_text(columns(AXES, SEEDS), results.rows(runs, figures, positions))
+    with (
+        distributed.LocalCluster(
+            n_workers=1, threads_per_worker=1, processes=False, dashboard_address=":0"
+        ) as one_cluster,
+        distributed.Client(one_cluster) as one,
+    ):
+        figures1, positions1, _ = driver.run_sweep(one, runs)
+    one_text = results.csv_text(columns(AXES, SEEDS), results.rows(runs, figures1, positions1))
+    assert _without_wall_time(one_text) == _without_wall_time(two)
+    assert one_text.splitlines()[0].endswith(",note,run_time_s")
+    assert len(one_text.splitlines()) == 7
+
+
+def test_ctrl_c_keeps_the_finished_rows_marked_incomplete(client, runs, tmp_path):
+    seen = []
+
+    def interrupt(run, row):
+        seen.append(run.index)
+        if len(seen) == 2:
+            raise KeyboardInterrupt
+
+    figures, positions, complete = driver.run_sweep(client, runs, on_row=interrupt)
+    assert not complete
+    assert sorted(figures) == sorted(seen) and len(seen) == 2
+    table = results.rows(runs, figures, positions)
+    written = results.write(tmp_path / "sweep", columns(AXES, SEEDS), table, len(runs), False)
+    assert "results.csv" in written
+    status = json.loads((tmp_path / "sweep" / "sweep.json").read_text())
+    assert status == {"runs": 6, "done": 2, "complete": False}
+    rows = list(csv.DictReader(io.StringIO((tmp_path / "sweep" / "results.csv").read_text())))
+    assert len(rows) == 2
+    assert (
+        "**Incomplete**: cancelled with 2 of 6 runs done"
+        in (tmp_path / "sweep" / "results.md").read_text()
+    )
+
+
+def test_a_run_the_model_stops_is_a_row_with_its_message():
+    runaway = expand([FIFTY], [parse_set("model=exact"), parse_set("ticks=5")], None)[0]
+    figures, pos = run_one(runaway.scenario)
+    assert figures["status"] == "ok" and pos.shape == (50, 2)
+    from collide2d.runner.scenario import loads
+
+    jam = loads(
+        "version: 1\nworld: {width: 20, height: 20, fps: 10}\n"
+        "model: {kind: exact, max_events_per_tick: 5}\nticks: 3\n"
+        "objects:\n"
+        "  - {shape: box, size: [10, 10], position: [0, 0], velocity: [10, 0]}\n"
+        "  - {shape: box, size: [10, 10], position: [10, 0], velocity: [-10, 0]}\n"
+    )
+    figures, pos = run_one(jam)
+    assert figures["status"] == "stopped" and pos is None
+    assert "max_events_per_tick" in figures["note"] or "events" in figures["note"]
+
+
+def test_boxes_out_of_the_world_are_marked_once_each():
+    pos = np.array([[0.0, 0.0], [-0.5, 3.0], [15.0, 15.0], [5.0, 11.0]])
+    size = np.full((4, 2), 10.0)
+    left = np.zeros(4, np.bool_)
+    mark_outside(pos, size, 20.0, 20.0, 1e-9, left)
+    assert left.tolist() == [False, True, True, True]
+    mark_outside(np.zeros((4, 2)), size, 20.0, 20.0, 1e-9, left)
+    assert left.tolist() == [False, True, True, True]
+
+
+def test_progress_counts_runs_and_gives_an_eta():
+    bar = RunsProgress(200, "sweep", io.StringIO())
+    assert bar.line(50, 10.0) == f"sweep [{'#' * 7}{'-' * 23}] 50/200 runs, 30.0s left"
+    assert bar.line(0, 0.0).endswith("0/200 runs, ETA unknown")
+
+
+def test_runs_in_batches_give_the_same_rows(client, runs):
+    assert [batch_size(n, t) for n, t in ((200, 2), (8, 2), (6, 2), (10**6, 4))] == [13, 1, 1, 32]
+    one = driver.run_sweep(client, runs, batch=1)
+    four = driver.run_sweep(client, runs, batch=4)
+    assert four[2] and sorted(four[0]) == list(range(6))
+    strip = [
+        {k: v for k, v in r.items() if k != "run_time_s"} for r in results.rows(runs, *one[:2])
+    ]
+    assert strip == [
+        {k: v for k, v in r.items() if k != "run_time_s"} for r in results.rows(runs, *four[:2])
+    ]
+
+
+def test_a_run_that_raises_is_an_error_row_and_its_batch_goes_on(runs):
+    done = run_batch([runs[0].scenario, None, runs[1].scenario])
+    assert [row["status"] for row, _pos in done] == ["ok", "error", "ok"]
+    assert done[1][0]["note"].startswith("AttributeError: ") and done[1][1] is None
