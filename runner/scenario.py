@@ -100,6 +100,7 @@ from collide2d.runner.outputspec import (
     Output,
     OutputReader,
 )
+from collide2d.runner.table import table_of
 from collide2d.runner.yamlsafe import ScenarioError
 
 __all__ = [
@@ -261,13 +262,16 @@ class _Reader(Nodes):
         rules = ModelRules.of(model, geometry, self.model_from)
         objects = ObjectReader(self.path, self.limits, world, rules, self.fps_from)
         listed = objects.objects(top)
-        blocks = objects.blocks(top, len(listed))
+        table = table_of(self, top, self.file_path, self.limits, world, rules.paper_rates)
+        blocks = objects.blocks(top, len(listed) + (table.n if table else 0))
         outputs = OutputReader(self.path, self.limits, self.ticks_from)
         output = outputs.output(top, ticks)
         golden = outputs.golden(top, ticks)
-        bodies, names, lines, palette = assemble.bodies(self, listed, blocks, world, background)
+        bodies, names, lines, palette = assemble.bodies(
+            self, listed, blocks, world, background, table
+        )
         if model == "exact":
-            self.room(world, bodies, geometry, names, listed, lines)
+            self.room(world, bodies, geometry, names, listed, lines, table)
         return Scenario(
             path=self.file_path,
             name=name,
@@ -424,7 +428,7 @@ class _Reader(Nodes):
             geometry = "exact" if kind == "exact" else "box"
         return kind, substeps, geometry, cap
 
-    def room(self, world, bodies, geometry, names, listed, lines) -> None:
+    def room(self, world, bodies, geometry, names, listed, lines, table=None) -> None:
         """Refuse, at the object, a moving object with no room on an axis it moves on (the exact
         model would collide it again and again with no time passing; engine.models.exact)."""
         found = no_room(world, bodies, geometry)
@@ -434,6 +438,8 @@ class _Reader(Nodes):
         message = self.prefix(self.model_from) + no_room_message(found, bodies, names)
         if i < len(listed):
             raise self.error(listed[i].node, message)
+        if table is not None and i < table.n:
+            raise table.error(i, "x", message)
         raise ys.ScenarioError(self.path, lines[i], 1, message)
 
     def ticks(self, top: dict, fps: int) -> int:
