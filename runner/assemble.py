@@ -120,7 +120,11 @@ def bodies(
 
     if table is not None:
         names: list = list(table.names)
-        lines: list = [reader.root.start_mark.line + 1 if reader.root is not None else 1] * n_listed
+        lines: list = (
+            list(table.lines)
+            if table.lines is not None
+            else [reader.root.start_mark.line + 1 if reader.root is not None else 1] * n_listed
+        )
     else:
         names = [o.name for o in listed]
         lines = [o.node.start_mark.line + 1 for o in listed]

@@ -69,7 +69,7 @@ from collide2d.engine.models.exact import MAX_EVENTS_PER_TICK
 from collide2d.engine.noroom import no_room, no_room_message
 from collide2d.engine.shapes import GEOMETRIES
 from collide2d.engine.world import Bodies, WorldSpec
-from collide2d.runner import assemble
+from collide2d.runner import assemble, yamlfast
 from collide2d.runner import yamlsafe as ys
 from collide2d.runner.assemble import PALETTE_SIZE
 from collide2d.runner.limits import Limits
@@ -248,6 +248,18 @@ class _Reader(Nodes):
     # -- the document
 
     def scenario(self, text: str, digest: str) -> Scenario:
+        """The scenario of `text`; a long object list one flow mapping per line takes the fast
+        lane (runner.yamlfast), and anything it declines or any error it meets is read again
+        through the general path, which alone decides what a file means or why it is refused."""
+        fast = yamlfast.split(text)
+        if fast is not None and yamlfast.nodes(fast) + len(fast.rest) <= self.limits.max_yaml_nodes:
+            try:
+                return self._scenario(fast.rest, digest, fast)
+            except (yamlfast.FallBack, ScenarioError):
+                self.model_from = self.fps_from = self.ticks_from = None
+        return self._scenario(text, digest, None)
+
+    def _scenario(self, text: str, digest: str, fast) -> Scenario:
         root = ys.compose(text, self.path, self.limits)
         self.root = root
         top = self.mapping(root, "the scenario", TOP_KEYS)
@@ -262,7 +274,15 @@ class _Reader(Nodes):
         rules = ModelRules.of(model, geometry, self.model_from)
         objects = ObjectReader(self.path, self.limits, world, rules, self.fps_from)
         listed = objects.objects(top)
-        table = table_of(self, top, self.file_path, self.limits, world, rules.paper_rates)
+        if fast is not None:
+            node = top["objects"][1] if "objects" in top else None
+            if not (isinstance(node, yaml.SequenceNode) and not node.value):
+                raise yamlfast.FallBack
+            if node.start_mark.line + 1 != fast.first_line:
+                raise yamlfast.FallBack
+            table = yamlfast.table(fast, world, rules.paper_rates, self.limits.max_objects)
+        else:
+            table = table_of(self, top, self.file_path, self.limits, world, rules.paper_rates)
         blocks = objects.blocks(top, len(listed) + (table.n if table else 0))
         outputs = OutputReader(self.path, self.limits, self.ticks_from)
         output = outputs.output(top, ticks)

@@ -74,6 +74,7 @@ class Table:
     color_of: np.ndarray
     names: tuple
     where: object  # where(row, column) -> ScenarioError maker, see _Place
+    lines: tuple | None = None  # each object's line in the scenario, when it has its own
 
     @property
     def n(self) -> int:
