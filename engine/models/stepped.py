@@ -41,9 +41,11 @@ from numba import njit, prange
 from collide2d.engine.broadphase import (
     KEY_MASK,
     KEY_SHIFT,
+    METHOD_CELLS,
     METHOD_GRID,
     METHOD_SWEEP,
     candidates,
+    cell_candidates_split,
     choose,
     workspace,
 )
@@ -262,7 +264,7 @@ def _relist(S, margin, method, cell, bp):
             hi[i, 1] = pos[i, 1] + size[i, 1] + margin
             anchor[i, 0] = pos[i, 0]
             anchor[i, 1] = pos[i, 1]
-        k = candidates(method, lo, hi, movable, cell, order, keys, ws)
+        k = _candidates(method, lo, hi, movable, cell, order, keys, ws, state[ST_CHUNKS])
         if method == METHOD_GRID:
             break
         stray = 0
@@ -271,10 +273,19 @@ def _relist(S, margin, method, cell, bp):
         if stray <= REORDER_ROWS * math.sqrt(n) * n:
             break
         _reorder(S, order)
-    if k > keys.shape[0]:
+    while k > keys.shape[0]:
         keys = np.empty(2 * k, np.int64)
-        k = candidates(method, lo, hi, movable, cell, order, keys, ws)
+        k = _candidates(method, lo, hi, movable, cell, order, keys, ws, state[ST_CHUNKS])
     return keys, k
+
+
+@njit(cache=True)
+def _candidates(method, lo, hi, movable, cell, order, keys, ws, chunks):
+    """broadphase.candidates, its pair tests split among `chunks` threads for the cells method
+    when more than one (the same keys in the same order)."""
+    if chunks > 1 and method == METHOD_CELLS:
+        return cell_candidates_split(lo, hi, movable, cell, order, keys, ws, chunks)
+    return candidates(method, lo, hi, movable, cell, order, keys, ws)
 
 
 @njit(cache=True)

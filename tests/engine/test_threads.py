@@ -116,3 +116,28 @@ def test_a_run_gives_the_same_bytes_with_any_threads(tmp_path, monkeypatch):
         )
     assert outs[0] == outs[1]
     assert {"s/events.jsonl", "s/final.csv"} <= set(outs[0]) and len(outs[0]) == 4
+
+
+@pytest.mark.parametrize("chunks, room", [(2, 4000), (3, 4000), (4, 40)])
+def test_the_cells_broad_phase_split_gives_the_same_keys(chunks, room):
+    from collide2d.engine import broadphase as bp
+
+    rng = np.random.default_rng(chunks)
+    lo = rng.uniform(0, 200, (700, 2))
+    hi = lo + rng.uniform(1, 9, (700, 2))
+    movable = rng.random(700) < 0.9
+    ws = bp.workspace(700)
+    one, split = np.empty(room, np.int64), np.empty(room, np.int64)
+    order1, order2 = np.empty(700, np.int64), np.empty(700, np.int64)
+    k1 = bp.cell_candidates(lo, hi, movable, 9.5, order1, one, ws)
+    k2 = bp.cell_candidates_split(lo, hi, movable, 9.5, order2, split, bp.workspace(700), chunks)
+    assert order1.tobytes() == order2.tobytes()
+    if k1 <= room and k2 <= room:
+        assert k1 == k2 and one[:k1].tobytes() == split[:k2].tobytes() and k1 > 100
+    else:  # too small: both ask for more, and then agree
+        assert k2 > room
+        big = np.empty(2 * max(k1, k2), np.int64)
+        k3 = bp.cell_candidates_split(lo, hi, movable, 9.5, order2, big, bp.workspace(700), chunks)
+        full = np.empty(2 * max(k1, k2), np.int64)
+        k4 = bp.cell_candidates(lo, hi, movable, 9.5, order1, full, ws)
+        assert k3 == k4 and big[:k3].tobytes() == full[:k4].tobytes()
