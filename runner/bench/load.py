@@ -6,8 +6,8 @@ decimals, four colours) are written three ways into a temporary folder: a YAML l
 mapping per line (the fast lane, runner.yamlfast), a CSV table (`objects: {file: bodies.csv}`,
 runner.table) and, once, the same YAML list read by the general path alone (the fast lane turned
 off). Each is loaded by `runner.scenario.load` in a fresh `python` process that reports the load's
-wall time and its peak resident memory (`ru_maxrss`) beside that of the same process before
-loading (imports done); the median of LOAD_REPEATS processes. Rows are one figure each.
+wall time and its peak resident memory (VmHWM on Linux, else `ru_maxrss`) beside that of the
+same process before loading (imports done); the median of LOAD_REPEATS processes. Rows are one figure each.
 """
 
 from __future__ import annotations
@@ -30,15 +30,24 @@ COLORS = ("red", "white", "blue", "green")
 _CHILD = """
 import json, resource, sys, time
 from collide2d.runner import scenario, yamlfast
+def peak_kb():
+    # this process's own high-water mark (ru_maxrss may carry the parent's across exec)
+    try:
+        with open("/proc/self/status") as f:
+            for line in f:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1])
+    except OSError:
+        pass
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
 if sys.argv[2] == "general":
     yamlfast.split = lambda text: None
 scenario.loads("version: 1\\nobjects: []\\n")
-before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+before = peak_kb()
 began = time.perf_counter()
 s = scenario.load(sys.argv[1])
 spent = time.perf_counter() - began
-peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-print(json.dumps({"s": spent, "n": s.bodies.n, "before_kb": before, "peak_kb": peak}))
+print(json.dumps({"s": spent, "n": s.bodies.n, "before_kb": before, "peak_kb": peak_kb()}))
 """
 
 
