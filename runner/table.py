@@ -316,16 +316,18 @@ def _read_npy(opened: str, shown: str, limits: Limits):
 
 
 def _words(data, name: str, default: str, lower: bool = True) -> tuple[np.ndarray, np.ndarray]:
-    """A text column as (its distinct values, stripped (and lower-cased), as an array of str;
-    each row's index into them); [default] for every row when the column is absent. Stripping
-    and comparing run over the distinct values only."""
+    """A text column as (its distinct values in order of first use, stripped (and lower-cased),
+    as an array of str; each row's index into them); [default] for every row when the column is
+    absent. Stripping and comparing run over the distinct values only."""
     n = data.shape[0]
     if name not in data.dtype.names:
         return np.array([default]), np.zeros(n, np.int64)
-    col = data[name]
-    unique, inverse = np.unique(col, return_inverse=True)
+    first_seen: dict = {}  # the distinct values in order of first use (a dict: no string sort)
+    inverse = np.array(
+        [first_seen.setdefault(v, len(first_seen)) for v in data[name].tolist()], np.int64
+    )
     words = []
-    for u in unique.tolist():
+    for u in first_seen:
         if isinstance(u, bytes):
             u = u.decode("utf-8", "replace")
         u = str(u).strip()
@@ -507,21 +509,15 @@ def _colors(data, refuse) -> tuple[list, np.ndarray]:
     n = data.shape[0]
     if "color" not in data.dtype.names:
         return [DEFAULT_COLOR], np.zeros(n, np.int64)
-    words, of = _words(data, "color", "", lower=False)
-    first = np.full(words.shape[0], n, np.int64)
-    np.minimum.at(first, of, np.arange(n))
-    order = np.argsort(first, kind="stable")  # by first use
-    rank = np.empty_like(order)
-    rank[order] = np.arange(order.shape[0])
+    words, of = _words(data, "color", "", lower=False)  # in order of first use
     rgb = []
-    for u in order.tolist():
-        word = str(words[u])
+    for u, word in enumerate(words.tolist()):
         try:
             rgb.append(colors.parse_color_text(word) if word else DEFAULT_COLOR)
         except ValueError as exc:
             refuse(of == u, "color", lambda r, exc=exc: str(exc))
             rgb.append(DEFAULT_COLOR)
-    return rgb, rank[of]
+    return rgb, of
 
 
 TABLE_KEYS = ("file",)

@@ -7,7 +7,8 @@ mapping per line (the fast lane, runner.yamlfast), a CSV table (`objects: {file:
 runner.table) and, once, the same YAML list read by the general path alone (the fast lane turned
 off). Each is loaded by `runner.scenario.load` in a fresh `python` process that reports the load's
 wall time and its peak resident memory (VmHWM on Linux, else `ru_maxrss`) beside that of the
-same process before loading (imports done); the median of LOAD_REPEATS processes. Rows are one figure each.
+same process before loading (imports done); the median of LOAD_REPEATS processes. Rows are one
+figure each.
 """
 
 from __future__ import annotations
