@@ -17,6 +17,12 @@ from __future__ import annotations
 
 import os
 
+# Threads waiting at the end of a split stage sleep instead of spinning (OpenMP's default spins):
+# on a machine shared with other work a spinning thread holds a core another thread needs, and a
+# split stage then took ten times as long as one thread (measured on 2 cores at load 9). Set before
+# numba starts its threads; a value the user set is kept.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
 # Objects from which a stage splits its work among threads (tuned on the standard scene of
 # `collide2d bench`: 2 cores pay from about 20,000 boxes).
 PARALLEL_MIN_OBJECTS = 20_000
