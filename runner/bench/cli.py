@@ -16,18 +16,8 @@ from pathlib import Path
 from collide2d.engine import models
 from collide2d.runner.exitcodes import EXIT_BAD_INPUT, EXIT_OK
 
-PARTS = (
-    "scaling",
-    "error",
-    "peers",
-    "skips",
-    "targets",
-    "paper",
-    "exact",
-    "raster",
-    "stages",
-    "load",
-)
+PARTS = ("scaling", "error", "peers", "skips", "targets", "paper", "exact", "raster")
+PARTS += ("stages", "load")  # runner/bench/stages.py, load.py
 DEFAULT_PARTS = ("scaling", "error", "skips", "targets")
 REPORT_DIR = "bench"
 
