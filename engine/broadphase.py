@@ -38,7 +38,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from collide2d.engine.sort import heap_argsort, sort_order
 
@@ -264,6 +264,16 @@ def cell_candidates(lo, hi, movable, cell, order, out, ws):
         order[i] = i
     if n < 2:
         return 0
+    nx, ny = _cell_grid(lo, hi, cell, order, ws)  # the counting sort by cell
+    key, start, box = ws[2], ws[3], ws[4]
+    return _cell_pairs(0, n, order, key, start, box, movable, nx, ny, out, 0, out.shape[0])
+
+
+@njit(cache=True)
+def _cell_grid(lo, hi, cell, order, ws):
+    """The counting sort of `cell_candidates`: (nx, ny) of its grid; order, ws[2] (each box's
+    cell), ws[3] (cell starts) and ws[4] (boxes by slot) filled."""
+    n = lo.shape[0]
     key, start, box = ws[2], ws[3], ws[4]
     x0, y0, x1, y1, side = _bounds(lo, hi)
     span_x = x1 - x0
@@ -295,9 +305,16 @@ def cell_candidates(lo, hi, movable, cell, order, out, ws):
         box[slot, 1] = lo[i, 1]
         box[slot, 2] = hi[i, 0]
         box[slot, 3] = hi[i, 1]
+    return nx, ny
+
+
+@njit(cache=True)
+def _cell_pairs(s0, s1, order, key, start, box, movable, nx, ny, out, base, room):
+    """The pairs of `cell_candidates` for the boxes in slots s0 ... s1-1, written to
+    out[base:base + room] while they fit; returns how many."""
     k = 0
-    m = out.shape[0]
-    for s in range(n):
+    m = room
+    for s in range(s0, s1):
         a = order[s]
         c = key[a]
         cx = c % nx
@@ -327,9 +344,53 @@ def cell_candidates(lo, hi, movable, cell, order, out, ws):
                     & (ma | movable[b])
                 )
                 if k < m:
-                    out[k] = _key(a, b)
+                    out[base + k] = _key(a, b)
                 k += meet
     return k
+
+
+@njit(cache=True, parallel=True)
+def _cell_pairs_split(order, key, start, box, movable, nx, ny, out, n, chunks):
+    """`_cell_pairs` over all n slots cut into `chunks` contiguous runs, one per thread, each
+    writing into its own share of `out`; the shares are then moved together in run order, so the
+    keys come in the order one thread gives. When a share is too small the count returned is
+    more than `out` holds (the caller grows it and asks again)."""
+    room = out.shape[0]
+    share = room // chunks
+    found = np.zeros(chunks, np.int64)
+    for c in prange(chunks):
+        found[c] = _cell_pairs(
+            c * n // chunks, (c + 1) * n // chunks, order, key, start, box, movable, nx, ny,
+            out, c * share, share,
+        )
+    total = 0
+    fits = True
+    for c in range(chunks):
+        total += found[c]
+        fits = fits and found[c] <= share
+    if not fits:
+        return max(total, room + 1)
+    k = 0
+    for c in range(chunks):
+        for r in range(found[c]):
+            out[k + r] = out[c * share + r]
+        k += found[c]
+    return k
+
+
+@njit(cache=True)
+def cell_candidates_split(lo, hi, movable, cell, order, out, ws, chunks):
+    """`cell_candidates` with its pair tests split among `chunks` threads: the same keys in the
+    same order (or, when `out` is too small for a share, a count past its size)."""
+    n = lo.shape[0]
+    for i in range(n):
+        order[i] = i
+    if n < 2:
+        return 0
+    nx, ny = _cell_grid(lo, hi, cell, order, ws)
+    return _cell_pairs_split(order, ws[2], ws[3], ws[4], movable, nx, ny, out, n, chunks)
+
+
 
 
 def choose(

@@ -8,6 +8,10 @@ background and `Bodies.looks.color[i]` the colour of object i; the RGB picture i
 `engine.draw` (DDA outlines, midpoint circles, fills), later ids on top, pixels outside the world
 dropped.
 
+A full redraw of a scene of engine.threads.PARALLEL_MIN_OBJECTS objects or more is split among
+threads by bands of rows (each band cleared and drawn clipped to itself, every object in id
+order): the same bytes as one thread.
+
 `Renderer.draw` keeps the previous frame and repaints only the rectangles where something moved
 (paper section III.B); `Renderer.draw_full` clears and repaints everything. Both give the same
 pixels. The pixel loops are numba kernels over arrays; with `NUMBA_DISABLE_JIT=1` the same source
@@ -17,9 +21,10 @@ runs as plain Python.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from collide2d.engine.draw import _draw_one, _fill_rect
+from collide2d.engine.threads import chunks_for
 from collide2d.engine.world import KIND_CIRCLE, KIND_POLYGON, Bodies, WorldSpec
 
 # Rounded positions are clamped to +-POSITION_LIMIT_PX (px) so that pixel arithmetic on an object
@@ -75,6 +80,46 @@ def _redraw_all(buf, ipos, art, scratch):
             _draw_one(
                 buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, cx0, cy0, cx1, cy1
             )
+
+
+@njit(cache=True)
+def _draw_band(buf, y0, y1, ipos, kind, wh, color, fill, vert_start, verts, ext, scratch):
+    """Clear rows y0 ... y1-1 of the frame and draw every object in id order, clipped to them."""
+    h, w = buf.shape
+    for y in range(y0, y1):
+        for x in range(w):
+            buf[y, x] = 0
+    for i in range(kind.shape[0]):
+        x = ipos[i, 0]
+        y = ipos[i, 1]
+        cx0 = max(x + ext[i, 0], 0)
+        cy0 = max(y + ext[i, 1], y0)
+        cx1 = min(x + ext[i, 2], w - 1)
+        cy1 = min(y + ext[i, 3], y1 - 1)
+        if cx0 <= cx1 and cy0 <= cy1:
+            _draw_one(
+                buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, cx0, cy0, cx1, cy1
+            )
+
+
+@njit(cache=True, parallel=True)
+def _draw_bands(buf, ipos, kind, wh, color, fill, vert_start, verts, ext, scratch, bands):
+    """The frame cut into `bands` bands of rows, one per thread; each band cleared and every
+    object drawn clipped to it, in id order. Clipping keeps each pixel's colour (the dirty-region
+    redraw relies on the same), so the frame equals `_redraw_all`'s, to the byte."""
+    h = buf.shape[0]
+    for b in prange(bands):
+        _draw_band(
+            buf, b * h // bands, (b + 1) * h // bands, ipos, kind, wh, color, fill, vert_start,
+            verts, ext, scratch[b],
+        )
+
+
+@njit(cache=True)
+def _redraw_split(buf, ipos, art, scratch, bands):
+    """`_redraw_all` split among threads by bands of rows (`_draw_bands`); scratch (bands, k)."""
+    kind, wh, color, fill, vert_start, verts, ext = art
+    _draw_bands(buf, ipos, kind, wh, color, fill, vert_start, verts, ext, scratch, bands)
 
 
 @njit(cache=True)
@@ -219,6 +264,9 @@ class Renderer:
         self._scratch = np.empty(
             max(1, int(counts.max(initial=0)), int(diam.max(initial=0))), np.int64
         )
+        # a full redraw of a large scene is split among threads by bands of rows
+        self._bands = min(chunks_for(n), max(1, self.height))
+        self._band_scratch = np.empty((self._bands, self._scratch.shape[0]), np.int64)
         self._buf = np.zeros((self.height, self.width), np.uint8)
         self._old = np.zeros((n, 2), np.int64)
         self._new = np.zeros((n, 2), np.int64)
@@ -235,7 +283,10 @@ class Renderer:
         _round_into(np.ascontiguousarray(pos), self._new)
 
     def _full(self) -> np.ndarray:
-        _redraw_all(self._buf, self._new, self._art, self._scratch)
+        if self._bands > 1:
+            _redraw_split(self._buf, self._new, self._art, self._band_scratch, self._bands)
+        else:
+            _redraw_all(self._buf, self._new, self._art, self._scratch)
         self._old, self._new = self._new, self._old
         self._drawn = True
         self.last_was_full = True

@@ -18,11 +18,26 @@ from collide2d.runner.objects import Block, Listed
 PALETTE_SIZE = 256  # palette rows: the background and up to 255 object colours
 
 
-def bodies(reader: Nodes, listed: list[Listed], blocks: list[Block], world: WorldSpec, background):
+def bodies(
+    reader: Nodes,
+    listed: list[Listed],
+    blocks: list[Block],
+    world: WorldSpec,
+    background,
+    table=None,
+):
+    """(Bodies, names, lines, palette) of the listed objects, or the rows of a `table`
+    (runner.table, checked already but for overlaps), then the generate blocks."""
+    if table is not None:
+        listed = _TableRows(table, reader)
     n_listed = len(listed)
-    pos = np.array([o.pos for o in listed], np.float64).reshape(-1, 2)
-    size = np.array([o.size for o in listed], np.float64).reshape(-1, 2)
-    check_placement(reader, listed, pos, size, world)
+    if table is not None:
+        pos, size = table.pos, table.size
+        check_table_placement(table)
+    else:
+        pos = np.array([o.pos for o in listed], np.float64).reshape(-1, 2)
+        size = np.array([o.size for o in listed], np.float64).reshape(-1, 2)
+        check_placement(reader, listed, pos, size, world)
 
     palette = [background]
     index: dict[tuple[int, int, int], int] = {}
@@ -30,17 +45,26 @@ def bodies(reader: Nodes, listed: list[Listed], blocks: list[Block], world: Worl
     def color_index(rgb, node) -> int:
         if rgb not in index:
             if len(palette) >= PALETTE_SIZE:
-                raise reader.error(
-                    node,
+                said = (
                     f"too many colours: the palette holds {PALETTE_SIZE} "
                     f"(the background and {PALETTE_SIZE - 1} object "
-                    "colours)",
+                    "colours)"
                 )
+                if isinstance(node, _RowNode):
+                    raise node.table.error(node.row, "color", said)
+                raise reader.error(node, said)
             index[rgb] = len(palette)
             palette.append(rgb)
         return index[rgb]
 
-    listed_colors = [color_index(o.color, o.color_node or o.node) for o in listed]
+    if table is not None:
+        _, where = np.unique(table.color_of, return_index=True)
+        to_palette = [
+            color_index(rgb, _RowNode(table, r)) for rgb, r in zip(table.colors, where, strict=True)
+        ]
+        listed_colors = np.asarray(to_palette, np.int64)[table.color_of]
+    else:
+        listed_colors = [color_index(o.color, o.color_node or o.node) for o in listed]
     block_colors = [color_index(b.color, b.color_node or b.node) for b in blocks]
 
     try:
@@ -57,15 +81,18 @@ def bodies(reader: Nodes, listed: list[Listed], blocks: list[Block], world: Worl
         b = np.repeat(np.asarray(block_values, dtype).reshape(len(blocks)), rep)
         return np.concatenate([a, b])
 
-    kind = per_object([o.kind for o in listed], [b.kind for b in blocks], np.int8)
-    static = per_object([o.static for o in listed], [b.static for b in blocks], bool)
-    mass = per_object([o.mass for o in listed], [b.mass for b in blocks], np.float64)
+    def column(name):
+        return getattr(table, name) if table is not None else [getattr(o, name) for o in listed]
+
+    kind = per_object(column("kind"), [b.kind for b in blocks], np.int8)
+    static = per_object(column("static"), [b.static for b in blocks], bool)
+    mass = per_object(column("mass"), [b.mass for b in blocks], np.float64)
     mass[static] = np.inf
     color = per_object(listed_colors, block_colors, np.uint8)
-    fill = per_object([o.fill for o in listed], [b.fill for b in blocks], bool)
+    fill = per_object(column("fill"), [b.fill for b in blocks], bool)
     all_pos = np.concatenate([pos] + [d[0] for d in drawn]).reshape(n, 2)
     all_vel = np.concatenate(
-        [np.array([o.vel for o in listed], np.float64).reshape(-1, 2)] + [d[1] for d in drawn]
+        [np.array(column("vel"), np.float64).reshape(-1, 2)] + [d[1] for d in drawn]
     ).reshape(n, 2)
     block_size = [
         np.broadcast_to(np.asarray(b.spec.size, np.float64), (c, 2))
@@ -73,9 +100,11 @@ def bodies(reader: Nodes, listed: list[Listed], blocks: list[Block], world: Worl
     ]
     all_size = np.concatenate([size] + block_size).reshape(n, 2)
     nverts = np.zeros(n, np.int64)
-    nverts[:n_listed] = [0 if o.verts is None else o.verts.shape[0] for o in listed]
+    polys = []
+    if table is None:
+        nverts[:n_listed] = [0 if o.verts is None else o.verts.shape[0] for o in listed]
+        polys = [o.verts for o in listed if o.verts is not None]
     vert_start = np.concatenate([[0], np.cumsum(nverts)]).astype(np.int64)
-    polys = [o.verts for o in listed if o.verts is not None]
     verts = np.concatenate(polys).astype(np.int64) if polys else np.zeros((0, 2), np.int64)
     bodies = Bodies(
         kind=kind,
@@ -89,8 +118,16 @@ def bodies(reader: Nodes, listed: list[Listed], blocks: list[Block], world: Worl
         looks=Looks(color=color, fill=fill),
     )
 
-    names: list = [o.name for o in listed]
-    lines: list = [o.node.start_mark.line + 1 for o in listed]
+    if table is not None:
+        names: list = list(table.names)
+        lines: list = (
+            list(table.lines)
+            if table.lines is not None
+            else [reader.root.start_mark.line + 1 if reader.root is not None else 1] * n_listed
+        )
+    else:
+        names = [o.name for o in listed]
+        lines = [o.node.start_mark.line + 1 for o in listed]
     for b, c in zip(blocks, counts, strict=True):
         names.extend([f"{b.name}-{j}" for j in range(c)] if b.name is not None else [None] * c)
         lines.extend([b.node.start_mark.line + 1] * c)
@@ -129,3 +166,35 @@ def _box_text(p, s) -> str:
     x0, x1 = fmt(float(p[0])), fmt(float(p[0] + s[0]))
     y0, y1 = fmt(float(p[1])), fmt(float(p[1] + s[1]))
     return f"[{x0}, {x1}) x [{y0}, {y1})"
+
+
+class _TableRows:
+    """A table standing where the list of objects would be: its length, for the counts."""
+
+    def __init__(self, table, reader):
+        self.table = table
+
+    def __len__(self) -> int:
+        return self.table.n
+
+
+class _RowNode:
+    """A table row standing where a YAML node would be in an error (a colour past the palette)."""
+
+    def __init__(self, table, row):
+        self.table, self.row = table, row
+
+
+def check_table_placement(table) -> None:
+    """No two boxes of a table overlapping (touching is fine); inside the world was checked by
+    column when the table was read."""
+    found = gen.first_overlap(table.pos, table.size)
+    if found is not None:
+        a, b = found
+        raise table.error(
+            b,
+            "x",
+            f"object {b} overlaps object {a} at the start: boxes "
+            f"{_box_text(table.pos[b], table.size[b])} and "
+            f"{_box_text(table.pos[a], table.size[a])}",
+        )

@@ -23,6 +23,8 @@ from collide2d.runner.options import (
     add_cap_argument,
     add_limit_arguments,
     add_override_arguments,
+    add_threads_argument,
+    apply_threads,
     limits_from_args,
     overrides_from_args,
     positive_int,
@@ -93,6 +95,7 @@ def register_run(subparsers) -> None:
     p.add_argument("--quiet", action="store_true", help="no progress bar, no notes")
     add_limit_arguments(p, output=True)
     add_cap_argument(p)
+    add_threads_argument(p)
     p.set_defaults(func=cmd_run)
 
 
@@ -111,6 +114,7 @@ def overlay_names(text: str) -> tuple[str, ...]:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
+    apply_threads(args)
     path = args.scenario or demo_path()
     limits = limits_from_args(args)
     scenario = load(path, overrides=overrides_from_args(args), limits=limits)

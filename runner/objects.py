@@ -239,6 +239,8 @@ class ObjectReader(Nodes):
         if "objects" not in top:
             return []
         node = top["objects"][1]
+        if isinstance(node, yaml.MappingNode):  # a table of objects (runner.table)
+            return []
         items = self.seq(node, "objects")
         if len(items) > self.limits.max_objects:
             raise self.error(

@@ -94,3 +94,22 @@ def overrides_from_args(args: argparse.Namespace) -> dict:
     return {
         key: getattr(args, key, None) for key in ("model", "fps", "ticks", "max_events_per_tick")
     }
+
+
+def add_threads_argument(p: argparse.ArgumentParser) -> None:
+    """`--threads N`: threads the kernels may use (default: every core; engine.threads)."""
+    p.add_argument(
+        "--threads",
+        type=positive_int,
+        default=None,
+        metavar="N",
+        help="threads for the stages that split large scenes (default: all cores); the "
+        "results are the same bytes for any N",
+    )
+
+
+def apply_threads(args: argparse.Namespace) -> int:
+    """Put the command line's `--threads` (or all cores) in force; the number in force."""
+    from collide2d.engine.threads import set_threads
+
+    return set_threads(getattr(args, "threads", None))

@@ -69,7 +69,7 @@ from collide2d.engine.models.exact import MAX_EVENTS_PER_TICK
 from collide2d.engine.noroom import no_room, no_room_message
 from collide2d.engine.shapes import GEOMETRIES
 from collide2d.engine.world import Bodies, WorldSpec
-from collide2d.runner import assemble
+from collide2d.runner import assemble, yamlfast
 from collide2d.runner import yamlsafe as ys
 from collide2d.runner.assemble import PALETTE_SIZE
 from collide2d.runner.limits import Limits
@@ -100,6 +100,7 @@ from collide2d.runner.outputspec import (
     Output,
     OutputReader,
 )
+from collide2d.runner.table import table_of
 from collide2d.runner.yamlsafe import ScenarioError
 
 __all__ = [
@@ -252,6 +253,19 @@ class _Reader(Nodes):
     # -- the document
 
     def scenario(self, text: str, digest: str, edit=None) -> Scenario:
+        """The scenario of `text`, with `edit` (a sweep's dotted keys) applied to its node tree; a
+        long object list one flow mapping per line takes the fast lane (runner.yamlfast) when
+        nothing is edited, and anything it declines or any error it meets is read again through
+        the general path, which alone decides what a file means or why it is refused."""
+        fast = yamlfast.split(text) if edit is None else None
+        if fast is not None and yamlfast.nodes(fast) + len(fast.rest) <= self.limits.max_yaml_nodes:
+            try:
+                return self._scenario(fast.rest, digest, fast)
+            except (yamlfast.FallBack, ScenarioError):
+                self.model_from = self.fps_from = self.ticks_from = None
+        return self._scenario(text, digest, None, edit)
+
+    def _scenario(self, text: str, digest: str, fast, edit=None) -> Scenario:
         root = ys.compose(text, self.path, self.limits)
         if edit is not None:
             root = edit(root)
@@ -268,13 +282,24 @@ class _Reader(Nodes):
         rules = ModelRules.of(model, geometry, self.model_from)
         objects = ObjectReader(self.path, self.limits, world, rules, self.fps_from)
         listed = objects.objects(top)
-        blocks = objects.blocks(top, len(listed))
+        if fast is not None:
+            node = top["objects"][1] if "objects" in top else None
+            if not (isinstance(node, yaml.SequenceNode) and not node.value):
+                raise yamlfast.FallBack
+            if node.start_mark.line + 1 != fast.first_line:
+                raise yamlfast.FallBack
+            table = yamlfast.table(fast, world, rules.paper_rates, self.limits.max_objects)
+        else:
+            table = table_of(self, top, self.file_path, self.limits, world, rules.paper_rates)
+        blocks = objects.blocks(top, len(listed) + (table.n if table else 0))
         outputs = OutputReader(self.path, self.limits, self.ticks_from)
         output = outputs.output(top, ticks)
         golden = outputs.golden(top, ticks)
-        bodies, names, lines, palette = assemble.bodies(self, listed, blocks, world, background)
+        bodies, names, lines, palette = assemble.bodies(
+            self, listed, blocks, world, background, table
+        )
         if model == "exact":
-            self.room(world, bodies, geometry, names, listed, lines)
+            self.room(world, bodies, geometry, names, listed, lines, table)
         return Scenario(
             path=self.file_path,
             name=name,
@@ -431,7 +456,7 @@ class _Reader(Nodes):
             geometry = "exact" if kind == "exact" else "box"
         return kind, substeps, geometry, cap
 
-    def room(self, world, bodies, geometry, names, listed, lines) -> None:
+    def room(self, world, bodies, geometry, names, listed, lines, table=None) -> None:
         """Refuse, at the object, a moving object with no room on an axis it moves on (the exact
         model would collide it again and again with no time passing; engine.models.exact)."""
         found = no_room(world, bodies, geometry)
@@ -441,6 +466,8 @@ class _Reader(Nodes):
         message = self.prefix(self.model_from) + no_room_message(found, bodies, names)
         if i < len(listed):
             raise self.error(listed[i].node, message)
+        if table is not None and i < table.n:
+            raise table.error(i, "x", message)
         raise ys.ScenarioError(self.path, lines[i], 1, message)
 
     def ticks(self, top: dict, fps: int) -> int:

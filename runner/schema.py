@@ -208,7 +208,25 @@ def json_schema() -> dict:
                 "minimum": 0,
                 "description": f"seconds; ticks = duration * fps; default {DEFAULT_DURATION}",
             },
-            "objects": {"type": "array", "items": {"$ref": "#/$defs/object"}},
+            "objects": {
+                "oneOf": [
+                    {"type": "array", "items": {"$ref": "#/$defs/object"}},
+                    {
+                        "type": "object",
+                        "properties": {
+                            "file": {
+                                "type": "string",
+                                "pattern": r"\.(csv|npy|CSV|NPY)$",
+                                "description": "a table of objects (.csv or .npy) in the "
+                                "scenario's folder; columns id, shape, w, h, x, y, vx, vy, "
+                                "mass, color, name, static, fill",
+                            }
+                        },
+                        "required": ["file"],
+                        "additionalProperties": False,
+                    },
+                ]
+            },
             "generate": {"type": "array", "items": {"$ref": "#/$defs/block"}},
             "output": {
                 "type": "object",

@@ -139,7 +139,7 @@ from collide2d.engine.world import Bodies, WorldSpec
 # Most wall and pair events one tick may take before the run is stopped as a runaway.
 MAX_EVENTS_PER_TICK = 1_000_000
 # After an event, predict again only the objects it touched ("touched", the model), or every
-# moving object ("all": the same events at the same times up to rounding, at the cost the local
+# moving object ("all": the same events and state to the bit, at the cost the local
 # re-prediction saves; its heap room grows with n^2, so only for small scenes: tests and
 # `collide2d bench`).
 REPREDICT = ("touched", "all")
@@ -195,14 +195,22 @@ def _on_wall(i, side, t, F, N, world, jobs):
 @hot
 def _on_pair(a, b, code, nx, ny, t, F, N, jobs):
     """a and b touch: the elastic exchange; then each moving one is predicted again, but not
-    against the other. Returns the number of jobs (0: they were not approaching, no event)."""
-    _move_to(a, t, F)
-    _move_to(b, t, F)
+    against the other. Returns the number of jobs (0: they were not approaching, no event).
+
+    The exchange reads only velocities, so it is decided before anything moves: a pair that
+    turns out not to approach leaves both objects exactly as they were, clocks included (moving
+    one to t by a rounded step would make a later prediction of it differ in its last bits from
+    one made before, and the local re-prediction then drift from the full one). For the same
+    reason a static object never moves its clock: its counter does not change either, so the
+    entries of its other pairs stay valid, and they must equal what asking again would give."""
     vax, vay, vbx, vby, changed = exchange(
         F[a, VX], F[a, VY], F[b, VX], F[b, VY], F[a, INV_MASS], F[b, INV_MASS], code, nx, ny
     )
     if not changed:
         return 0
+    for i in (a, b):
+        if N[i, STATIC] == 0:  # a static object's clock stays at 0: its entries never go stale
+            _move_to(i, t, F)
     F[a, VX], F[a, VY], F[b, VX], F[b, VY] = vax, vay, vbx, vby
     n_jobs = 0
     for i, other in ((a, b), (b, a)):
@@ -225,9 +233,8 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
 
     With `everyone` (the `repredict="all"` option) every other moving object is predicted again
     as well after each event (contacts only, against all but the partner of its last pair
-    event): the work the local re-prediction saves. The events are the same; a time asked again
-    may differ in its last bits, since an object's clock moves by one rounded step when a pair
-    it is in turns out not to approach.
+    event): the work the local re-prediction saves. The events and the state are the same, to
+    the bit: a prediction reads only the pair's state, and only an event changes it.
 
     Returns a status: STATUS_DONE; STATUS_HEAP_FULL / STATUS_LOG_FULL (grow, call again: nothing
     was lost); STATUS_CAP (a runaway; stops mid-tick, before the event past the cap, so that a call

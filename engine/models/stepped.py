@@ -36,14 +36,16 @@ import time
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from collide2d.engine.broadphase import (
     KEY_MASK,
     KEY_SHIFT,
+    METHOD_CELLS,
     METHOD_GRID,
     METHOD_SWEEP,
     candidates,
+    cell_candidates_split,
     choose,
     workspace,
 )
@@ -62,6 +64,7 @@ from collide2d.engine.events import (
 from collide2d.engine.response import exchange, fold, separate
 from collide2d.engine.shapes import GEOMETRIES, build_cores
 from collide2d.engine.sort import heap_argsort, sort_keys
+from collide2d.engine.threads import chunks_for
 from collide2d.engine.world import Bodies, WorldSpec
 
 # The candidate list's margin, px: this many of the fastest object's step (|v|·dt), within
@@ -77,6 +80,8 @@ DRIFT_SLACK_REL = 1e-12
 # The wall and pair event counters and this step's overlapping pairs in the broad phase's `state`
 # array, this step's drift in its `params` (see `_run`).
 ST_WALLS, ST_PAIRS, ST_NEAR = 3, 4, 5
+# How many chunks (threads) the move and narrow stages split into (1: none), in `state`.
+ST_CHUNKS = 6
 P_DRIFT = 3
 # Candidate slots to start with per object (the buffers double when full).
 CANDIDATES_PER_OBJECT = 4
@@ -120,16 +125,12 @@ def _fold_row(folds, n_folds, e, axis, low, high, first_low):
 
 
 @njit(cache=True)
-def _move_walls(S, dt, folds):
-    """Move every object for dt seconds, then reflect it back into the world.
-
-    S: the state arrays (a `State`). folds (2n, 4) int64 receives a row per object and axis that
-    folded. Returns (how many rows, the farthest any object now is from its anchor on an axis, px).
-    """
-    pos, vel, size, inv_mass, static, movable, span, ext, rank, anchor = S
+def _move_range(pos, vel, static, span, ext, anchor, first, last, dt, folds, n_folds):
+    """Move objects first ... last-1 (inside) for dt seconds and reflect each back into the
+    world; their fold rows go to folds from row n_folds. Returns (rows now, the farthest any of
+    them is from its anchor on an axis, px)."""
     drift = 0.0
-    n_folds = 0
-    for i in range(pos.shape[0]):
+    for i in range(first, last):
         if static[i]:
             continue
         x = pos[i, 0] + vel[i, 0] * dt
@@ -147,6 +148,51 @@ def _move_walls(S, dt, folds):
         pos[i, 0] = x
         pos[i, 1] = y
         drift = max(drift, abs(x - anchor[i, 0]), abs(y - anchor[i, 1]))
+    return n_folds, drift
+
+
+@njit(cache=True)
+def _move_walls(S, dt, folds):
+    """Move every object for dt seconds, then reflect it back into the world.
+
+    S: the state arrays (a `State`). folds (2n, 4) int64 receives a row per object and axis that
+    folded. Returns (how many rows, the farthest any object now is from its anchor on an axis, px).
+    """
+    pos, vel, size, inv_mass, static, movable, span, ext, rank, anchor = S
+    return _move_range(pos, vel, static, span, ext, anchor, 0, pos.shape[0], dt, folds, 0)
+
+
+@njit(cache=True)
+def _move_walls_split(S, dt, folds, chunks):
+    """`_move_walls` with the objects cut into `chunks` contiguous runs, one per thread (see
+    `_move_chunks`): the same rows, drift and state, to the bit."""
+    pos, vel, size, inv_mass, static, movable, span, ext, rank, anchor = S
+    return _move_chunks(pos, vel, static, span, ext, anchor, dt, folds, chunks)
+
+
+@njit(cache=True, parallel=True)
+def _move_chunks(pos, vel, static, span, ext, anchor, dt, folds, chunks):
+    """Run c of `chunks` writes its fold rows from row 2 x its first object (each object folds
+    on two axes at most); then the runs' rows are moved together in run order."""
+    n = pos.shape[0]
+    rows = np.zeros(chunks, np.int64)
+    drifts = np.zeros(chunks)
+    for c in prange(chunks):
+        first = c * n // chunks
+        k, d = _move_range(
+            pos, vel, static, span, ext, anchor, first, (c + 1) * n // chunks, dt, folds, 2 * first
+        )
+        rows[c] = k - 2 * first
+        drifts[c] = d
+    n_folds = 0
+    drift = 0.0
+    for c in range(chunks):
+        first = 2 * (c * n // chunks)
+        for r in range(rows[c]):
+            for col in range(4):
+                folds[n_folds + r, col] = folds[first + r, col]
+        n_folds += rows[c]
+        drift = max(drift, drifts[c])
     return n_folds, drift
 
 
@@ -218,7 +264,7 @@ def _relist(S, margin, method, cell, bp):
             hi[i, 1] = pos[i, 1] + size[i, 1] + margin
             anchor[i, 0] = pos[i, 0]
             anchor[i, 1] = pos[i, 1]
-        k = candidates(method, lo, hi, movable, cell, order, keys, ws)
+        k = _candidates(method, lo, hi, movable, cell, order, keys, ws, state[ST_CHUNKS])
         if method == METHOD_GRID:
             break
         stray = 0
@@ -227,20 +273,27 @@ def _relist(S, margin, method, cell, bp):
         if stray <= REORDER_ROWS * math.sqrt(n) * n:
             break
         _reorder(S, order)
-    if k > keys.shape[0]:
+    while k > keys.shape[0]:
         keys = np.empty(2 * k, np.int64)
-        k = candidates(method, lo, hi, movable, cell, order, keys, ws)
+        k = _candidates(method, lo, hi, movable, cell, order, keys, ws, state[ST_CHUNKS])
     return keys, k
 
 
 @njit(cache=True)
-def _overlapping(pos, size, ext, keys, n_keys, near):
-    """The listed pairs whose boxes overlap now with positive area, as keys of object ids
-    ascending, written to `near` when they fit; returns how many (the caller grows `near` and
-    asks again)."""
+def _candidates(method, lo, hi, movable, cell, order, keys, ws, chunks):
+    """broadphase.candidates, its pair tests split among `chunks` threads for the cells method
+    when more than one (the same keys in the same order)."""
+    if chunks > 1 and method == METHOD_CELLS:
+        return cell_candidates_split(lo, hi, movable, cell, order, keys, ws, chunks)
+    return candidates(method, lo, hi, movable, cell, order, keys, ws)
+
+
+@njit(cache=True)
+def _overlap_range(pos, size, ext, keys, first, last, near, base, room):
+    """The listed pairs keys[first:last] whose boxes overlap now with positive area, as keys of
+    object ids ascending, written to near[base:base + room] while they fit; returns how many."""
     k = 0
-    room = near.shape[0]
-    for c in range(n_keys):
+    for c in range(first, last):
         a = keys[c] >> KEY_SHIFT
         b = keys[c] & KEY_MASK
         if (
@@ -252,10 +305,49 @@ def _overlapping(pos, size, ext, keys, n_keys, near):
             if k < room:
                 ea = ext[a]
                 eb = ext[b]
-                near[k] = (min(ea, eb) << KEY_SHIFT) | max(ea, eb)
+                near[base + k] = (min(ea, eb) << KEY_SHIFT) | max(ea, eb)
             k += 1
-    if k <= room:
+    return k
+
+
+@njit(cache=True)
+def _overlapping(pos, size, ext, keys, n_keys, near):
+    """The listed pairs whose boxes overlap now with positive area, as keys of object ids
+    ascending, written to `near` when they fit; returns how many (the caller grows `near` and
+    asks again)."""
+    k = _overlap_range(pos, size, ext, keys, 0, n_keys, near, 0, near.shape[0])
+    if k <= near.shape[0]:
         sort_keys(near, k)
+    return k
+
+
+@njit(cache=True, parallel=True)
+def _overlapping_split(pos, size, ext, keys, n_keys, near, chunks):
+    """`_overlapping` with the listed pairs cut into `chunks` contiguous runs, one per thread: run
+    c writes its keys into its own share of `near`, then the shares are moved together in run
+    order and sorted. The same keys as `_overlapping`; when a share is too small the count
+    returned is more than `near` holds, and the caller grows it and asks again."""
+    room = near.shape[0]
+    share = room // chunks
+    found = np.zeros(chunks, np.int64)
+    for c in prange(chunks):
+        found[c] = _overlap_range(
+            pos, size, ext, keys, c * n_keys // chunks, (c + 1) * n_keys // chunks, near,
+            c * share, share
+        )
+    total = 0
+    fits = True
+    for c in range(chunks):
+        total += found[c]
+        fits = fits and found[c] <= share
+    if not fits:
+        return max(total, room + 1)
+    k = 0
+    for c in range(chunks):
+        for r in range(found[c]):
+            near[k + r] = near[c * share + r]
+        k += found[c]
+    sort_keys(near, k)
     return k
 
 
@@ -318,6 +410,14 @@ def _pairs(S, width, height, exact, cores, near, n_near, tick, t, log, rows, tim
     return rows, times, n_ev
 
 
+@njit(cache=True)
+def _narrow(S, keys, n_keys, near, chunks):
+    """The narrow phase: `_overlapping`, split among `chunks` threads when more than one."""
+    if chunks > 1:
+        return _overlapping_split(S.pos, S.size, S.ext, keys, n_keys, near, chunks)
+    return _overlapping(S.pos, S.size, S.ext, keys, n_keys, near)
+
+
 # The stages of one step, in the order `_step` runs them; `Model.profile` times each by name
 # through the same kernel.
 STAGES = ("move", "broad", "narrow", "response")
@@ -333,7 +433,10 @@ def _step(first, last, S, dt, width, height, exact, cores, tick, t, log, rows, t
     if first <= _MOVE < last:
         # move, walls: every object; the walls' events in id order; how far anything drifted
         # from where the candidate list was made
-        n_folds, params[P_DRIFT] = _move_walls(S, dt, folds)
+        if state[ST_CHUNKS] > 1:
+            n_folds, params[P_DRIFT] = _move_walls_split(S, dt, folds, state[ST_CHUNKS])
+        else:
+            n_folds, params[P_DRIFT] = _move_walls(S, dt, folds)
         if n_folds:
             for r in range(n_folds):  # one wall event per fold
                 state[ST_WALLS] += folds[r, 1] + folds[r, 2]
@@ -348,11 +451,11 @@ def _step(first, last, S, dt, width, height, exact, cores, tick, t, log, rows, t
             bp = (keys, near, order, lo, hi, folds, state, params, ws)
     if first <= _NARROW < last:
         # the listed pairs that overlap, in (a, b) order
-        state[ST_NEAR] = _overlapping(S.pos, S.size, S.ext, keys, state[0], near)
-        if state[ST_NEAR] > near.shape[0]:
+        state[ST_NEAR] = _narrow(S, keys, state[0], near, state[ST_CHUNKS])
+        while state[ST_NEAR] > near.shape[0]:
             near = np.empty(2 * state[ST_NEAR], np.int64)
             bp = (keys, near, order, lo, hi, folds, state, params, ws)
-            state[ST_NEAR] = _overlapping(S.pos, S.size, S.ext, keys, state[0], near)
+            state[ST_NEAR] = _narrow(S, keys, state[0], near, state[ST_CHUNKS])
     if first <= _RESPONSE < last:
         rows, times, n_ev = _pairs(
             S,
@@ -381,7 +484,8 @@ def _run(world, substeps, tick0, ticks, log, S, exact, cores, rows, times, bp):
     S: the state arrays (a `State`). bp = (keys, near, order, lo, hi, folds, state, params, ws):
     the candidate list kept between calls (see the module docstring) and scratch; state = [keys
     listed (-1: no list yet), method, whether pairs can happen at all, wall events and pair events
-    so far, logged or not (ST_WALLS, ST_PAIRS), overlapping pairs of this step (ST_NEAR)]; params
+    so far, logged or not (ST_WALLS, ST_PAIRS), overlapping pairs of this step (ST_NEAR), chunks
+    the move and narrow stages split into among threads (ST_CHUNKS, engine.threads)]; params
     = [margin px, grid cell px, drift slack px, this step's drift px (P_DRIFT)].
     """
     width, height, fps = world
@@ -572,7 +676,7 @@ def _broad_phase(world, pos, vel, size, movable, substeps, skip, broadphase):
         np.empty_like(pos),  # lo
         np.empty_like(pos),  # hi
         np.empty((2 * n, 4), np.int64),  # folds
-        np.array([-1, method, int(possible), 0, 0, 0], np.int64),  # state (see _run)
+        np.array([-1, method, int(possible), 0, 0, 0, chunks_for(n)], np.int64),  # see _run
         np.array([margin, cell, slack, 0.0]),
         workspace(n),
     )

@@ -17,6 +17,7 @@ from collide2d.engine import models
 from collide2d.runner.exitcodes import EXIT_BAD_INPUT, EXIT_OK
 
 PARTS = ("scaling", "error", "peers", "skips", "targets", "paper", "exact", "raster")
+PARTS += ("stages", "load")  # runner/bench/stages.py, load.py
 DEFAULT_PARTS = ("scaling", "error", "skips", "targets")
 REPORT_DIR = "bench"
 
@@ -94,6 +95,14 @@ def cmd_bench(args: argparse.Namespace) -> int:
         rows += exact.exact(quick, echo)
     if "raster" in parts:
         rows += raster.raster(quick, echo, folder)
+    if "stages" in parts:
+        from collide2d.runner.bench import stages
+
+        rows += stages.stages(quick, echo, args.n)
+    if "load" in parts:
+        from collide2d.runner.bench import load
+
+        rows += load.load(quick, echo)
     seconds = time.perf_counter() - began
     target.mkdir(parents=True, exist_ok=True)
     args_line = "collide2d bench " + " ".join(sys.argv[2:]) if len(sys.argv) > 1 else "bench"

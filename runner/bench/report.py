@@ -23,6 +23,8 @@ FIGURE_PARTS = {
     "paper": "Paper model: the section IV demo",
     "exact": "Exact model: events per second",
     "raster": "Drawing and writing frames",
+    "stages": "Stages: time per body-step, one thread and all, and pymunk in the same run",
+    "load": "Loading a big scene",
 }
 COLUMNS = (
     "part",

@@ -762,23 +762,16 @@ def test_bad_options_are_refused():
 # --- the skip: predicting again only what an event touched --------------------------------------
 
 
-@settings(max_examples=12, deadline=None)
-@given(st.integers(0, 10_000))
-def test_predicting_only_what_an_event_touched_gives_the_same_events(seed):
-    # Without the skip every moving object is predicted again after each event. The events are
-    # the same, in the same order, at the same instants up to rounding: a pair's time is swept
-    # from the pair's state, and an object whose clock moved in a non-event (a pair that was not
-    # approaching) carries its position to it by one rounded step, so a time asked again may
-    # differ in the last bits. Long runs of a dense scene amplify that (chaos), so this looks at
-    # small scenes over a few seconds.
+def _skip_scene(seed, n=24):
+    """A small scene of boxes and circles, some static, with masses: many pairs that turn out
+    not to approach when their entry comes up, and static objects hit by several movers."""
     rng = np.random.default_rng(seed)
-    n = 24
     cells = rng.choice(8 * 6, n, replace=False)
     pos = np.stack([cells % 8 * 20.0, cells // 8 * 20.0], 1) + rng.uniform(0, 5, (n, 2))
     sizes = rng.choice([4.0, 8.0, 12.0], (n, 2))
     round_ = rng.random(n) < 0.3
     static = rng.random(n) < 0.1
-    bodies = shapes(
+    return shapes(
         np.where(round_, KIND_CIRCLE, KIND_BOX),
         pos,
         np.where(round_[:, None], sizes[:, :1], sizes),
@@ -786,18 +779,34 @@ def test_predicting_only_what_an_event_touched_gives_the_same_events(seed):
         mass=rng.uniform(0.5, 5, n),
         static=static,
     )
-    world = WorldSpec(170, 130, 10)
+
+
+def _same_bytes_both_ways(bodies, world, ticks):
     touched = make("exact", world, bodies)
     everyone = make("exact", world, bodies, repredict="all")
-    a, b = touched.advance(30), everyone.advance(30)
-    fields = ["tick", "type", "a", "b", "code"]
-    assert [tuple(e[fields]) for e in a] == [tuple(e[fields]) for e in b]
-    assert np.allclose(a["t"], b["t"], rtol=0, atol=1e-9)
-    # The state after ~100 contacts carries those last-bit differences, grown by each contact
-    # (curved contacts most): over seeds 0..299 and 604 the largest gaps were 3.2e-7 px and
-    # 1.4e-6 px/s; a real difference in the physics would be of the order of the speeds.
-    assert np.allclose(touched.positions(), everyone.positions(), rtol=0, atol=1e-5)
-    assert np.allclose(touched.velocities(), everyone.velocities(), rtol=0, atol=1e-5)
+    a, b = touched.advance(ticks), everyone.advance(ticks)
+    assert len(a) > 0
+    assert a.tobytes() == b.tobytes()
+    assert touched.positions().tobytes() == everyone.positions().tobytes()
+    assert touched.velocities().tobytes() == everyone.velocities().tobytes()
+
+
+@settings(max_examples=12, deadline=None)
+@given(st.integers(0, 10_000))
+def test_predicting_only_what_an_event_touched_gives_the_same_bytes(seed):
+    # Without the skip every moving object is predicted again after each event. A prediction
+    # reads only the pair's state and only an event changes it (a pair that turns out not to
+    # approach moves no clock, a static object's clock never moves), so the events, their
+    # times and the final state are the same to the bit.
+    _same_bytes_both_ways(_skip_scene(seed), WorldSpec(170, 130, 10), 30)
+
+
+@pytest.mark.parametrize("seed", [142, 163])
+def test_the_skip_stays_bit_identical_where_clocks_once_drifted(seed):
+    # Seeds whose runs once ended a few ulps apart: a static object's clock moved at each hit
+    # (its other pairs' entries, still valid, were swept from an older clock than a new
+    # prediction would use), and non-approaching pairs moved their objects by a rounded step.
+    _same_bytes_both_ways(_skip_scene(seed), WorldSpec(170, 130, 10), 60)
 
 
 def test_repredict_is_checked():

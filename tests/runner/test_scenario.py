@@ -333,7 +333,7 @@ def test_keys_must_be_names():
             "geometry 'exact' is not available with the paper model",
         ),
         (BASE + "model: {kind: stepped, geometry: round}\n", "round", "unknown geometry 'round'"),
-        (BASE + "objects: {shape: box}\n", "{", "objects must be a list, not a mapping"),
+        (BASE + "objects: {shape: box}\n", "{", "or {file: NAME} naming a table, not a mapping"),
         (BASE + "objects:\n  - 3\n", "3", "object must be a mapping"),
         (BASE + "output: {gif: 1}\n", "1}", "output.gif must be true or false"),
         (BASE + "output: {events: 'yes'}\n", "'yes'", "output.events must be true or false"),

@@ -1,0 +1,68 @@
+"""How many threads the kernels may use, and from what size a stage splits its work among them.
+
+The stages that split their work (the stepped model's move and narrow phase, the rasteriser's full
+redraw) cut it into a fixed number of contiguous chunks, run the chunks on numba's threads
+(`prange`), and join the chunks' results in chunk order: every chunk does exactly the arithmetic
+one thread would do on its share, so results are the same bytes with one thread or many. A stage
+splits only for scenes of at least PARALLEL_MIN_OBJECTS objects (below that, starting the threads
+costs more than they save) and only when more than one thread is allowed.
+
+`set_threads(n)` is the one switch (the command line's `--threads N`; a configuration layer calls
+the same function): it sets numba's thread count for the kernels and the number of chunks the
+models and the renderer made after it use. With `NUMBA_DISABLE_JIT=1` prange is range and the
+chunks run one after another, with the same results.
+"""
+
+from __future__ import annotations
+
+import os
+
+# Threads waiting at the end of a split stage sleep instead of spinning (OpenMP's default spins):
+# on a machine shared with other work a spinning thread holds a core another thread needs, and a
+# split stage then took ten times as long as one thread (measured on 2 cores at load 9). Set before
+# numba starts its threads; a value the user set is kept.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
+# Objects from which a stage splits its work among threads (tuned on the standard scene of
+# `collide2d bench`: 2 cores pay from about 20,000 boxes).
+PARALLEL_MIN_OBJECTS = 20_000
+
+_threads: int | None = None  # None: every core numba may use
+
+
+def available() -> int:
+    """The most threads numba may run here (its NUMBA_NUM_THREADS, every core by default)."""
+    from numba import config
+
+    return max(1, int(config.NUMBA_NUM_THREADS))
+
+
+def set_threads(n: int | None) -> int:
+    """Let the kernels use n threads (None: all cores); returns the number in force (n clipped to
+    what numba may run). ValueError for n < 1."""
+    global _threads
+    if n is not None and (int(n) != n or n < 1):
+        raise ValueError(f"threads must be a whole number >= 1, got {n!r}")
+    count = available() if n is None else min(int(n), available())
+    _threads = count
+    if not _jit_disabled():
+        import numba
+
+        numba.set_num_threads(count)
+    return count
+
+
+def threads() -> int:
+    """Threads the kernels may use now."""
+    return available() if _threads is None else _threads
+
+
+def chunks_for(n_objects: int) -> int:
+    """How many chunks a stage over n_objects objects splits into: the thread count for a scene of
+    PARALLEL_MIN_OBJECTS objects or more, else 1 (no split)."""
+    t = threads()
+    return t if t > 1 and n_objects >= PARALLEL_MIN_OBJECTS else 1
+
+
+def _jit_disabled() -> bool:
+    return os.environ.get("NUMBA_DISABLE_JIT", "0") not in ("", "0")

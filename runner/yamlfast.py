@@ -1,0 +1,278 @@
+"""The fast lane for long object lists in YAML: one flow mapping per line, read by column.
+
+A scenario that lists thousands of objects usually writes one per line,
+
+    objects:
+      - {shape: box, size: [10, 10], position: [40, 60], velocity: [12.5, -3], color: red}
+
+and reading that through the general path (an event pass, a node tree, a reader per object) costs
+tens of microseconds per value. When every line of the `objects` list has that form, with only
+plain values of the simplest kinds (decimal numbers, [x, y] pairs of them, and words), this lane
+takes the values of each key from the lines with one regular expression each, converts and checks
+them a column at a time with numpy, and hands the result on as a `runner.table.Table`; the rest of
+the file, with the list's lines blanked (so every line keeps its number), goes through the general
+path as before.
+
+The lane only ever accepts: a file it would read differently from the general path, or one with
+anything wrong in its objects (a value out of range, an overlap, a rule of the model), goes through
+the general path whole (`FallBack`), which reads it, or refuses it at its place with its usual
+message. So the lane changes how long a file takes, never what it means. What it leaves to the
+general path: block-style or multi-line mappings, quoted or tagged values, anchors and aliases,
+comments or blank lines inside the list, polygons, numbers with leading zeros (YAML 1.1 octal),
+exponents, underscores, or other YAML 1.1 forms, words YAML reads as booleans or null where a text
+is asked for, and lists shorter than FAST_MIN_OBJECTS.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+from collide2d.engine import motion
+from collide2d.engine.world import KIND_BOX, KIND_CIRCLE
+from collide2d.runner import colors
+from collide2d.runner import generate as gen
+
+FAST_MIN_OBJECTS = 1000  # shorter lists take the general path (it is fast enough there)
+
+_NUM = r"-?(?:0|[1-9][0-9]{0,29})(?:\.[0-9]{1,30})?"
+_WORD = r"[A-Za-z_][A-Za-z0-9_.-]{0,99}"
+_VALUE = rf"(?:{_NUM}|\[ *{_NUM} *, *{_NUM} *\]|{_WORD})"
+_ITEM_RE = re.compile(rf" *- \{{ *[a-z]+: {_VALUE}(?: *, *[a-z]+: {_VALUE})* *\}} *")
+_FIELD_RE = re.compile(rf"([a-z]+): (?:\[ *({_NUM}) *, *({_NUM}) *\]|({_NUM}|{_WORD}))")
+_HEAD_RE = re.compile(r"objects: *\n")
+KEYS = (
+    "shape",
+    "size",
+    "diameter",
+    "position",
+    "velocity",
+    "color",
+    "mass",
+    "static",
+    "fill",
+    "name",
+)
+# Plain words YAML 1.1 reads as something other than text (booleans, null).
+_NOT_TEXT = {
+    w
+    for base in ("y", "n", "yes", "no", "on", "off", "true", "false", "null")
+    for w in (base, base.capitalize(), base.upper())
+}
+
+
+class FallBack(Exception):
+    """The fast lane declines: read the whole file through the general path."""
+
+
+@dataclass
+class Split:
+    """A file whose object list the fast lane takes: the rest of its text (the list's lines
+    blanked), and the list's lines with their 0-based line numbers."""
+
+    rest: str
+    lines: list[str]
+    first_line: int
+
+    @property
+    def n(self) -> int:
+        return len(self.lines)
+
+
+def split(text: str) -> Split | None:
+    """The Split of `text` when its top-level `objects:` list has FAST_MIN_OBJECTS lines or more,
+    each one flow mapping of plain simple values; None otherwise."""
+    m = None
+    for m in _HEAD_RE.finditer(text):
+        if m.start() == 0 or text[m.start() - 1] == "\n":
+            break
+    else:
+        return None
+    if m is None:
+        return None
+    start = m.end()
+    lines = []
+    pos = start
+    while pos < len(text):
+        end = text.find("\n", pos)
+        end = len(text) if end < 0 else end
+        line = text[pos:end]
+        if not line.lstrip().startswith("- "):
+            break
+        lines.append(line)
+        pos = end + 1
+    if len(lines) < FAST_MIN_OBJECTS:
+        return None
+    if pos < len(text) and not (text[pos].isalpha() or text[pos] == "#"):
+        return None  # the list must end at the next top-level key (or a comment, or the end)
+    indent = len(lines[0]) - len(lines[0].lstrip())
+    if any(not _ITEM_RE.fullmatch(line) for line in lines) or any(
+        len(line) - len(line.lstrip()) != indent for line in lines
+    ):
+        return None
+    head_line = text.count("\n", 0, m.start())
+    rest = text[: m.start()] + "objects: []\n" + "\n" * len(lines) + text[pos:]
+    if pos >= len(text) and not text.endswith("\n"):
+        rest = rest[:-1]
+    return Split(rest, lines, head_line + 1)
+
+
+def nodes(split_: Split) -> int:
+    """YAML values the list holds (as the general path counts them): the mapping, each key and
+    value, and two more for each pair."""
+    n = 0
+    for line in split_.lines:
+        n += 1 + 2 * line.count(":") + 2 * line.count("[")
+    return n
+
+
+def _number(values: list[str]) -> np.ndarray:
+    """Decimal texts (checked by the item pattern) to float64, parsed by numpy in one call."""
+    if not values:
+        return np.zeros(0)
+    try:
+        v = np.array(" ".join(values).split(" "), dtype=np.float64)
+    except ValueError:
+        raise FallBack from None  # a word where a number belongs
+    return v + 0.0  # -0.0 is read as 0.0
+
+
+def table(split_: Split, world, paper: bool, max_objects: int):
+    """The objects of the list as a runner.table.Table, every check of the general path run by
+    column; FallBack when anything would make the general path refuse or read it otherwise."""
+    from collide2d.runner.objects import DEFAULT_COLOR, DEFAULT_MASS, MAX_MASS, MAX_SPEED, MIN_MASS
+    from collide2d.runner.table import Table
+
+    n = split_.n
+    if n > max_objects:
+        raise FallBack
+    # each key's values by line: a text, or a (x, y) pair of texts; None where absent
+    cols: dict[str, list] = {k: [None] * n for k in KEYS}
+    for i, line in enumerate(split_.lines):
+        fields = _FIELD_RE.findall(line)
+        if len(fields) != line.count(":"):
+            raise FallBack
+        for key, x, y, one in fields:
+            col = cols.get(key)
+            if col is None or col[i] is not None:
+                raise FallBack  # an unknown or repeated key: the general path says so
+            col[i] = one if one else (x, y)
+
+    def present(key) -> np.ndarray:
+        return np.array([v is not None for v in cols[key]], bool)
+
+    def words(key) -> np.ndarray:
+        raw = cols[key]
+        if any(isinstance(v, tuple) for v in raw):
+            raise FallBack
+        return np.array(["" if v is None else v for v in raw])
+
+    def pairs(key, default) -> np.ndarray:
+        out = np.full((n, 2), default, np.float64)
+        raw = [v for v in cols[key] if v is not None]
+        if any(not isinstance(v, tuple) for v in raw):
+            raise FallBack
+        out[present(key)] = _number([c for v in raw for c in v]).reshape(-1, 2)
+        return out
+
+    shape = words("shape")
+    if not np.all((shape == "box") | (shape == "circle")):
+        raise FallBack  # missing, a polygon, or not a shape
+    circle = shape == "circle"
+    # sizes: a box takes size (one number or [w, h]), a circle diameter (one number)
+    if np.any(present("size") == circle) or np.any(present("diameter") != circle):
+        raise FallBack
+    size_raw = [
+        d if c else b
+        for b, d, c in zip(cols["size"], cols["diameter"], circle.tolist(), strict=True)
+    ]
+    single = np.array([not isinstance(v, tuple) for v in size_raw], bool)
+    if np.any(circle & ~single):
+        raise FallBack
+    size = np.empty((n, 2))
+    size[single] = _number([v for v in size_raw if not isinstance(v, tuple)])[:, None]
+    size[~single] = _number([c for v in size_raw if isinstance(v, tuple) for c in v]).reshape(-1, 2)
+    if not np.all((size >= 1) & (size == np.floor(size)) & (size <= 2.0**53)):
+        raise FallBack
+    if not present("position").all():
+        raise FallBack
+    pos = pairs("position", 0.0)
+    if paper and not np.all(pos == np.floor(pos)):
+        raise FallBack
+    vel = pairs("velocity", 0.0)
+    if not np.all(np.abs(vel) <= MAX_SPEED):
+        raise FallBack
+    static = _flag(words("static"))
+    fill = _flag(words("fill"))
+    if np.any(static[:, None] & (vel != 0)):
+        raise FallBack
+    if paper:
+        for v in np.unique(vel[~static]):
+            try:
+                motion.paper_rate(float(v), world.fps)
+            except ValueError:
+                raise FallBack from None
+    mass = np.full(n, DEFAULT_MASS)
+    has_mass = present("mass")
+    if has_mass.any():
+        raw = [v for v in cols["mass"] if v is not None]
+        if any(isinstance(v, tuple) or not v[-1:].isdigit() for v in raw):
+            raise FallBack
+        mass[has_mass] = _number(raw)
+        if np.any(has_mass & static) or not np.all((mass >= MIN_MASS) & (mass <= MAX_MASS)):
+            raise FallBack
+    color_word = words("color")
+    unique, first, of = np.unique(color_word, return_index=True, return_inverse=True)
+    order = np.argsort(first, kind="stable")
+    rank = np.empty_like(order)
+    rank[order] = np.arange(order.shape[0])
+    rgb = []
+    for u in order.tolist():
+        word = str(unique[u])
+        if word in _NOT_TEXT or word[:1].isdigit() or word.startswith("-"):
+            raise FallBack
+        try:
+            rgb.append(colors.parse_color_text(word) if word else DEFAULT_COLOR)
+        except ValueError:
+            raise FallBack from None
+    names = tuple(cols["name"])
+    for name in set(names) - {None}:
+        if isinstance(name, tuple) or name in _NOT_TEXT or name[:1].isdigit() or name[0] == "-":
+            raise FallBack
+    # inside the world and apart, as runner.assemble checks listed objects
+    if np.any((pos < 0) | (pos + size > np.array([world.width, world.height]))):
+        raise FallBack
+    if not np.all(np.isfinite(pos)) or gen.first_overlap(pos, size) is not None:
+        raise FallBack
+    if math.isinf(float(np.max(np.abs(pos), initial=0.0))):
+        raise FallBack
+    return Table(
+        path="",
+        kind=np.where(circle, KIND_CIRCLE, KIND_BOX).astype(np.int8),
+        pos=pos,
+        size=size,
+        vel=np.where(static[:, None], 0.0, vel),
+        mass=np.where(static, np.inf, mass),
+        static=static,
+        fill=fill,
+        colors=rgb,
+        color_of=rank[of.reshape(-1)],
+        names=names,
+        where=_fall_back,
+        lines=tuple(range(split_.first_line + 1, split_.first_line + 1 + n)),
+    )
+
+
+def _flag(word: np.ndarray) -> np.ndarray:
+    if not np.all((word == "") | (word == "true") | (word == "false")):
+        raise FallBack
+    return word == "true"
+
+
+def _fall_back(row, column, message):
+    """A later check (the exact model's room to move) refused an object of the fast lane: the
+    general path reads the file again and refuses it at the object's line, in its own words."""
+    raise FallBack
