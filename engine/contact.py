@@ -172,31 +172,36 @@ def box_step_contact(qx, qy, ux, uy, wa, ha, wb, hb, dt):
     3.2): (push, push_y, code, nx, ny); push 0 when there is none.
 
     The pair is swept back along its relative velocity u to where it was dt ago (box_sweep). When
-    its boxes started overlapping during the step (they overlap now, or passed through each
-    other's corner within the step), the normal is the axis whose overlap started last, its sign
-    the side B came in from (AXIS_XY when both started within TIE_PX of travel), and push is
-    twice the depth gone in along it since that instant: pushed apart that far (shared by inverse
-    mass), each object ends where a bounce at the contact instant would have put it, as a wall
-    reflects. For AXIS_XY push is along x and push_y along y. When the motion cannot tell (the
-    boxes overlapped already when the step began, or do not move), box_overlap_axis decides: the
-    smaller overlap width, pushed apart by its depth once.
+    its boxes started overlapping during this step or the one before (they overlap now, or cut a
+    corner of each other within the step, box_clip), the normal is the axis whose overlap
+    started last, its sign the side B came in from (AXIS_XY when both started within TIE_PX of
+    travel), and push is twice the depth gone in along it since that instant: pushed apart that far
+    (shared by inverse mass), each object ends where a bounce at the contact instant would have put
+    it, as a wall reflects. For AXIS_XY push is along x and push_y along y. (A corner cut went in,
+    and came out again, for the time since its contact: the push is twice that travel.) When the
+    motion cannot tell (the overlap began before the previous step, or they do not move),
+    box_overlap_axis decides: the smaller overlap width, pushed apart by its depth once.
     """
     xdiff = min(wa, qx + wb) - max(0.0, qx)
     ydiff = min(ha, qy + hb) - max(0.0, qy)
     now = xdiff > 0.0 and ydiff > 0.0
-    t_enter, t_exit, code, nx, ny = box_sweep(qx - ux * dt, qy - uy * dt, ux, uy, wa, ha, wb, hb)
-    told = t_enter >= -dt - TIE_PX / max(abs(ux), abs(uy), 1e-300) and t_enter < dt
-    if not now:
-        if not (told and t_exit > t_enter):
-            return 0.0, 0.0, AXIS_X, 1.0, 0.0
-    elif not told:
+    if not now and not box_clip(qx, qy, ux, uy, wa, ha, wb, hb, dt):
+        return 0.0, 0.0, AXIS_X, 1.0, 0.0
+    t_enter, _, code, nx, ny = box_sweep(qx - ux * dt, qy - uy * dt, ux, uy, wa, ha, wb, hb)
+    if not t_enter >= -dt - TIE_PX / max(abs(ux), abs(uy), 1e-300):  # -inf too
         return box_overlap_axis(qx, qy, wa, ha, wb, hb)
-    ago = dt - max(t_enter, -dt)
+    if now:  # the depth on the side it came in by
+        dx = wa - qx if nx > 0.0 else qx + wb
+        dy = ha - qy if ny > 0.0 else qy + hb
+    else:  # a corner cut: how far it went in before it came out
+        ago = dt - t_enter
+        dx = abs(ux) * ago
+        dy = abs(uy) * ago
     if code == AXIS_XY:
-        return 2.0 * abs(ux) * ago, 2.0 * abs(uy) * ago, code, nx, ny
+        return 2.0 * dx, 2.0 * dy, code, nx, ny
     if code == AXIS_X:
-        return 2.0 * abs(ux) * ago, 0.0, code, nx, ny
-    return 2.0 * abs(uy) * ago, 0.0, code, nx, ny
+        return 2.0 * dx, 0.0, code, nx, ny
+    return 2.0 * dy, 0.0, code, nx, ny
 
 
 # --- classifying a normal ---------------------------------------------------------------------

@@ -425,3 +425,48 @@ def test_profile_runs_the_same_ticks_as_advance():
     assert a.velocities().tobytes() == b.velocities().tobytes()
     assert a.event_counts() == b.event_counts() and min(a.event_counts()) > 0
     assert a.advance(20).tobytes() == b.advance(20).tobytes()
+
+
+# --- the normal sees the motion: no tunnelling below one box size per step (SPEC 3.2)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.tuples(st.integers(2, 20), st.integers(2, 20)),
+    st.tuples(st.integers(2, 20), st.integers(2, 20)),
+    st.floats(0.0, 1.0, exclude_max=True),  # where B's side lies along A's (0: flush, glancing)
+    st.floats(0.01, 0.999),  # relative displacement per step, in the smaller box's size
+    st.floats(0.0, 1.0),  # how the closing speed is shared between the two
+    st.floats(-30.0, 30.0),  # a common sideways speed: the pair glides together
+    st.sampled_from([1, 5, 60]),
+    st.booleans(),  # along y instead of x
+    st.floats(0.1, 10.0),
+)
+def test_no_tunnelling_below_one_box_size_per_step(sa, sb, offset, frac, share, drift, fps, on_y,
+                                                   mass_b):  # fmt: skip
+    # B comes at A along one axis, its other axis overlapping A's anywhere from a sliver (a
+    # glancing contact) to full; the relative displacement per step is below the smaller box's
+    # size. They must collide and B must never end a tick past A's near face.
+    side = min(*sa, *sb)
+    speed = frac * side * fps  # closing speed, px/s
+    (wa, ha), (wb, hb) = sa, sb
+    # along x: B left of A with a gap, y offset so that the y intervals overlap by > 0
+    lateral = -hb + (ha + hb) * (0.5 * offset + 0.25) if offset else -hb + 0.01
+    gap = 2.5 * speed / fps  # they meet in the third step
+    pa = np.array([200.0, 200.0])
+    pb = np.array([200.0 - wb - gap, 200.0 + lateral])
+    va = np.array([-speed * (1 - share), drift])
+    vb = np.array([speed * share, drift])
+    size = np.array([[wa, ha], [wb, hb]], float)
+    if on_y:
+        pa, pb, va, vb, size = pa[::-1], pb[::-1], va[::-1], vb[::-1], size[:, ::-1]
+    world = WorldSpec(400, 400, fps)
+    bodies = Bodies.boxes([pa, pb], size, [va, vb], mass=[1.0, mass_b])
+    model = make("stepped", world, bodies)
+    axis = 1 if on_y else 0
+    pairs = 0
+    for _ in range(8):
+        pairs += int((model.advance(1)["type"] == EV_PAIR).sum())
+        p = model.positions()
+        assert p[1, axis] + size[1, axis] <= p[0, axis] + 1e-9  # B never past A's near face
+    assert pairs >= 1
