@@ -22,14 +22,25 @@ def test_csv_has_the_columns_and_blanks_where_they_do_not_apply():
     assert parsed[1]["note"] == "a, b"
 
 
-def test_headline_gives_the_ratios_the_issue_asks_for():
+def test_headline_gives_the_ratios_the_issue_asks_for_with_target_and_mark():
     rows = [
         {"part": "scaling", "model": "stepped", "n": 1_000, "ns_per_body_step": 20.0},
         {"part": "scaling", "model": "stepped", "n": 100_000, "ns_per_body_step": 30.0},
-        {"part": "peers", "model": "pymunk", "n": 1_000, "ratio": 6.5},
-        {"part": "targets", "value": 1_200_000.0, "note": "section IV demo headless"},
-    ]
-    head = dict(report.headline(rows))
-    assert head["stepped / pymunk steps/s, N = 1,000 (target >= 5)"] == "6.50"
-    assert head["stepped cost per body-step, N = 100,000 / N = 1,000 (target <= 2)"] == "1.50"
-    assert head["section IV demo headless"] == "1,200,000"
+        {"part": "peers", "model": "pymunk", "n": 1_000, "ratio": 4.5},
+        {"part": "targets", "value": 1_200_000.0, "note": "section IV demo headless",
+         "target": ">= 1,000,000", "met": True, "noisy": "no", "spread": 0.05},
+        {"part": "skips", "noisy": "yes", "spread": 0.35},
+        {"part": "error", "model": "stepped", "scene": "bench_dense_gas", "fps": 60,
+         "substeps": 64, "long_s": 10.0, "error_long_px": 0.5},
+        {"part": "glancing", "value": None},
+    ]  # fmt: skip
+    head = {what: (figure, target, met) for what, figure, target, met in report.headline(rows)}
+    assert head["stepped / pymunk steps/s, N = 1,000"] == ("4.50", ">= 5", "✗")
+    assert head["stepped cost per body-step, N = 100,000 / N = 1,000"] == ("1.50", "<= 2", "✓")
+    assert head["section IV demo headless"] == ("1,200,000", ">= 1,000,000", "✓")
+    assert head["stepped error at 10 s, bench_dense_gas, 64 substeps"] == ("0.5 px", "< 1 px", "✓")
+    assert head["glancing tunnelling at 1 substep below one box size per step"][2] == "✓"
+    assert head["timings marked noisy (spread > 20 %)"] == ("1 of 2", "0", "✗")
+    assert head["largest repeat spread (max - min) / median"][0] == "35%"
+    md = report.markdown(rows, "collide2d bench", 1.0)
+    assert "| what | figure | target | met |" in md and "| 4.50 | >= 5 | ✗ |" in md
