@@ -92,11 +92,13 @@ def position_errors(name, substeps, horizons):
 
 @pytest.mark.parametrize("name", ["bench_dense_gas", "bench_fast_small"])
 def test_stepped_error_against_exact_falls_as_substeps_grow(name):
-    # at 1 s and at 10 s, over 1, 4, 16 and 64 substeps: never rising, and falling overall; on
-    # the dense gas, below 1 px at 10 s with 64 substeps (the issue's goal)
+    # at 1 s and at 10 s, over 1, 4, 16 and 64 substeps: never rising, and falling overall from
+    # above 1 px to below it (on the dense gas at 10 s with 64 substeps: the issue's goal)
     horizons = (1.0, 10.0)
     for horizon, errs in zip(
         horizons, position_errors(name, (1, 4, 16, 64), horizons), strict=True
     ):
-        assert list(errs) == sorted(errs, reverse=True), (horizon, errs)
+        # never rising by more than the models' own resolution (TIE_PX, 1e-9 px: past the
+        # step where the error stops shrinking, what is left differs only in float rounding)
+        assert all(b <= a + error.ERROR_FLOOR_PX for a, b in zip(errs[:-1], errs[1:], strict=True))
         assert errs[0] > 1.0 > errs[-1], (horizon, errs)
