@@ -9,8 +9,9 @@ under `stepped` and `exact`, so each row's reference is the exact model on that 
 The measures of a row:
 - position error at each of HORIZONS_S (quick: QUICK_HORIZONS_S): the mean distance to the
   reference's positions then, px;
-- first divergence: the time of the first pair event where the run's sequence of pair events
-  (ids, in order) leaves the reference's, s (blank: none within the long horizon);
+- first divergence: the time of the first pair event of either run with no partner in the
+  other, the same pair within two of the row's ticks (`first_divergence`), s (blank: none within
+  the long horizon);
 - missed collisions (per pair, collisions of the reference the run does not have), collision-count
   error (pair events of the run minus the reference's), kinetic energy drift (relative) and the
   largest penetration (the deepest box overlap at a tick's end, px,
@@ -84,17 +85,33 @@ def _pair_counts(events) -> Counter:
     return Counter(zip(pairs["a"].tolist(), pairs["b"].tolist(), strict=True))
 
 
-def first_divergence(ref_events, events) -> float | None:
-    """The time of the first pair event where the two sequences of pair events (ids, in order)
-    part: the earlier of the two events there, s; None when they never part."""
+def first_divergence(ref_events, events, window: float) -> float | None:
+    """When the two sequences of pair events first part, s; None when they never do.
+
+    Each pair event of either run must have a partner in the other: an event of the same pair
+    within `window` seconds (a fixed-step run logs a contact at the end of the tick it saw it in,
+    the reference at its instant; events at one instant may come in any order), each taken once,
+    in order. The first event without one, on either side, is where they part."""
     ref, run = _pair_events(ref_events), _pair_events(events)
-    for k in range(min(len(ref), len(run))):
-        if (ref["a"][k], ref["b"][k]) != (run["a"][k], run["b"][k]):
-            return float(min(ref["t"][k], run["t"][k]))
-    if len(ref) != len(run):
-        longer = ref if len(ref) > len(run) else run
-        return float(longer["t"][min(len(ref), len(run))])
-    return None
+    waiting: dict[tuple[int, int], list[float]] = {}
+    for a, b, t in zip(run["a"].tolist(), run["b"].tolist(), run["t"].tolist(), strict=True):
+        waiting.setdefault((a, b), []).append(t)
+    used: dict[tuple[int, int], int] = {}
+    unmatched = []
+    for a, b, t in zip(ref["a"].tolist(), ref["b"].tolist(), ref["t"].tolist(), strict=True):
+        times = waiting.get((a, b), [])
+        k = used.get((a, b), 0)
+        while k < len(times) and times[k] < t - window:  # run events left without a partner
+            unmatched.append(times[k])
+            k += 1
+        if k < len(times) and abs(times[k] - t) <= window:
+            k += 1
+        else:
+            unmatched.append(t)
+        used[(a, b)] = k
+    for pair, times in waiting.items():  # run events after the reference's last of their pair
+        unmatched.extend(times[used.get(pair, 0) :])
+    return min(unmatched) if unmatched else None
 
 
 def positions_at(model, fps: int, horizons) -> list[np.ndarray]:
@@ -177,7 +194,7 @@ def _error_row(scenario, model, fps, substeps, horizons, ref) -> tuple[dict, obj
     energy1 = kinetic_energy(bodies.mass, bodies.static, m.velocities())
     missed = sum(max(0, c - counts.get(p, 0)) for p, c in ref["pairs"].items())
     err = [float(np.linalg.norm(a - r, axis=1).mean()) for a, r in zip(at, ref["at"], strict=True)]
-    diverges = first_divergence(ref["events"], events)
+    diverges = first_divergence(ref["events"], events, 2.0 / fps)
     row = {
         "part": "error",
         "scene": scenario.name,
@@ -235,7 +252,7 @@ def sensitivity(name: str, loaded: dict, horizons) -> list[dict]:
                 "long_s": horizons[-1],
                 "error_short_px": float(err[0]),
                 "error_long_px": float(err[-1]),
-                "diverges_s": first_divergence(ref["events"], events),
+                "diverges_s": first_divergence(ref["events"], events, 2.0 / fps),
                 "note": f"velocities nudged by {NUDGE_PX_S:g} px/s; bodies as loaded under "
                 f"{model} ({whole})",
             }

@@ -102,3 +102,24 @@ def test_stepped_error_against_exact_falls_as_substeps_grow(name):
         # step where the error stops shrinking, what is left differs only in float rounding)
         assert all(b <= a + error.ERROR_FLOOR_PX for a, b in zip(errs[:-1], errs[1:], strict=True))
         assert errs[0] > 1.0 > errs[-1], (horizon, errs)
+
+
+def events(*rows):
+    from collide2d.engine.events import EV_PAIR, EV_WALL
+
+    dtype = [("t", float), ("type", "i1"), ("a", "i4"), ("b", "i4")]
+    return np.array([(t, EV_WALL if b < 0 else EV_PAIR, a, b) for t, a, b in rows], dtype=dtype)
+
+
+def test_first_divergence_matches_each_pair_event_within_the_window_in_any_order():
+    ref = events((0.10, 0, 1), (0.10, 1, 2), (0.31, 0, 1), (0.5, 3, -1), (0.90, 2, 3))
+    # the same contacts, logged at tick ends, the two at one instant the other way round
+    same = events((0.15, 1, 2), (0.15, 0, 1), (0.35, 0, 1), (0.95, 2, 3))
+    assert error.first_divergence(ref, same, 0.1) is None
+    # one contact late by more than the window: they part at the earlier of the two
+    late = events((0.15, 1, 2), (0.15, 0, 1), (0.45, 0, 1), (0.95, 2, 3))
+    assert error.first_divergence(ref, late, 0.1) == pytest.approx(0.31)
+    # an extra contact in the run, and a missing one at the end
+    extra = events((0.15, 1, 2), (0.15, 0, 1), (0.2, 4, 5), (0.35, 0, 1))
+    assert error.first_divergence(ref, extra, 0.1) == pytest.approx(0.2)
+    assert error.first_divergence(ref, same[:3], 0.1) == pytest.approx(0.9)
