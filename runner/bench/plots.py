@@ -92,7 +92,7 @@ def _pareto_figure(plt, ticker, err, sens, folder, atomic_path) -> None:
         ax.set_xlabel(f"run time for {long_s:g} s of simulation (s)")
         ax.set_ylabel(f"mean position error at {long_s:g} s vs exact (px)")
         ax.yaxis.set_major_locator(ticker.LogLocator(numticks=12))
-        ax.legend(fontsize="small", loc="upper right")
+        ax.legend(fontsize="x-small", loc="best")
     for ax in axes.ravel()[len(scenes) :]:
         ax.axis("off")
     fig.suptitle("Run time against error (labels: fps, or fps x substeps; floor: 1e-9 px)")
