@@ -109,6 +109,13 @@ def _fmt(value, digits: int = 3) -> str:
     return f"{value:.{digits}g}"
 
 
+def _range(r) -> str:
+    """A timing's median and (min-max), s, or a blank."""
+    if r.get("run_time_s") is None or r.get("run_time_min_s") is None:
+        return "—"
+    return f"{r['run_time_s']:.3g} ({r['run_time_min_s']:.3g}-{r['run_time_max_s']:.3g})"
+
+
 def _table(header: list[str], lines: list[list]) -> list[str]:
     out = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     out += ["| " + " | ".join(_fmt(v) for v in line) + " |" for line in lines]
@@ -185,10 +192,14 @@ def markdown(rows: list[dict], args_line: str, seconds: float) -> str:
         lines.append("")
         header = ["model", "N", "steps/s", "body-steps/s", "ns/body-step", "events/s"]
         header += ["move ms", "broad ms", "narrow ms", "response ms", "render ms", "timed by"]
+        header += ["run s (min-max)", "noisy"]
         keys = ["model", "n", "steps_per_s", "body_steps_per_s", "ns_per_body_step"]
         keys += ["events_per_s", "move_ms", "broad_ms", "narrow_ms", "response_ms", "render_ms"]
         keys += ["note"]
-        lines += _table(header, [[r.get(k) for k in keys] for r in part]) + [""]
+        lines += _table(
+            header,
+            [[r.get(k) for k in keys] + [_range(r), r.get("noisy")] for r in part],
+        ) + [""]
     part = [r for r in rows if r["part"] == "peers"]
     if part:
         lines += ["## Peers", ""]
