@@ -2,7 +2,8 @@
 
 `sort_order` keeps an order of objects sorted by a key from call to call, mending it by insertion
 sort (objects move a little between calls) or sorting it afresh by heap sort when it is far off;
-`sort_keys` sorts a short list of pair keys in place; `heap_argsort` gives the order of a key
+`sort_keys` sorts a short list of pair keys in place, `sort_by_time` a list of pair keys by the
+times beside them; `heap_argsort` gives the order of a key
 array (heap sort: O(n log n), compiles quickly, allocates only the result). All numba kernels.
 """
 
@@ -112,5 +113,50 @@ def _sift_keys(keys, root, n):
             c += 1
         if keys[root] >= keys[c]:
             return
+        keys[root], keys[c] = keys[c], keys[root]
+        root = c
+
+
+@njit(cache=True, inline="always")
+def _before(when, keys, i, j):
+    """Whether entry i comes before entry j: earlier time, then smaller key."""
+    return when[i] < when[j] or (when[i] == when[j] and keys[i] < keys[j])
+
+
+@njit(cache=True)
+def sort_by_time(when, keys, n):
+    """Sort when[:n] and keys[:n] together in place by (time, key), allocating nothing: insertion
+    sort for the usual handful, a heap sort past INSERTION_SORT_MAX."""
+    if n > INSERTION_SORT_MAX:
+        for root in range(n // 2 - 1, -1, -1):
+            _sift_timed(when, keys, root, n)
+        for end in range(n - 1, 0, -1):
+            when[0], when[end] = when[end], when[0]
+            keys[0], keys[end] = keys[end], keys[0]
+            _sift_timed(when, keys, 0, end)
+        return
+    for i in range(1, n):
+        t = when[i]
+        key = keys[i]
+        j = i - 1
+        while j >= 0 and (when[j] > t or (when[j] == t and keys[j] > key)):
+            when[j + 1] = when[j]
+            keys[j + 1] = keys[j]
+            j -= 1
+        when[j + 1] = t
+        keys[j + 1] = key
+
+
+@njit(cache=True)
+def _sift_timed(when, keys, root, n):
+    while True:
+        c = 2 * root + 1
+        if c >= n:
+            return
+        if c + 1 < n and _before(when, keys, c, c + 1):
+            c += 1
+        if not _before(when, keys, root, c):
+            return
+        when[root], when[c] = when[c], when[root]
         keys[root], keys[c] = keys[c], keys[root]
         root = c

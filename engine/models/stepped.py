@@ -7,19 +7,28 @@ Output, per `advance`: the events of the ticks run, walls and responding pairs, 
 end.
 
 Each step runs move -> walls -> pairs. Walls reflect exactly as a wall would (response.fold).
-Pairs: the candidates are the pairs whose boxes overlap after the walls, taken in ascending (a, b)
-order, each tested again on the current state so that it sees what the pairs before it changed (a
-pair that only comes to overlap through such a push waits for the next step). A pair that overlaps
-and approaches along the contact normal gets the elastic exchange and is pushed apart along the
-normal, shared by inverse mass, never out of the world.
+Pairs: the candidates are the pairs whose boxes overlap after the walls, or overlapped during the
+step (a corner passed through within it, found by sweeping the pair back along its relative
+velocity), taken in the order their contacts began (swept back the same way; ties and pairs whose
+overlap began before the step, first, in ascending (a, b) order), each tested again on the
+current state so that it sees what the pairs before it changed (a pair that only comes to
+overlap through such a push waits for the next step). A pair in contact that approaches along
+the contact normal gets the elastic exchange. The normal is the axis along which the pair
+started overlapping, found from its relative velocity (contact.box_step_contact; for exact shapes
+the direction of approach, contact.step_contact), and the pair is pushed apart along it, shared
+by inverse mass, never out of the world, by twice the depth it went in since that instant: each
+object ends where a bounce at the contact instant would have put it, as the walls reflect. Only
+when the motion cannot tell (the overlap began before the previous step, or nothing moves) the
+axis of the smaller overlap decides, and the push is that depth once.
 
 Finding the overlapping pairs without testing them all (a Verlet list): the broad phase
 (broadphase.py, sort-and-sweep or a grid chosen by the scene) lists the pairs whose boxes, each
 grown by a margin of MARGIN_STEPS of the fastest step, overlap, and the list is kept until some
 object has drifted that margin from where it was when the list was made. While no object has, any
 pair overlapping now was on the list (each box moved less than the margin), so each step only
-tests the listed pairs on the current boxes, sorts the few that overlap by (a, b), and takes them
-in that order: exactly the pairs, in exactly the order, of testing every pair. Pairs of two static
+tests the listed pairs on the current boxes (and their sweeps over the step: each box's path lies
+within its margin too), sorts the few in contact, and takes them in that order: exactly the
+pairs, in exactly the order, of testing every pair. Pairs of two static
 objects are never listed, and with no movable object (or fewer than two objects) the pair stage is
 skipped; the `skip=False` option turns both skips off, and `broadphase` ("sweep", "grid",
 "cells") forces a method instead of the scene's choice (for tests and `collide2d bench`).
@@ -49,7 +58,13 @@ from collide2d.engine.broadphase import (
     choose,
     workspace,
 )
-from collide2d.engine.contact import box_overlap_axis, penetration
+from collide2d.engine.contact import (
+    box_clip,
+    box_reach,
+    box_step_contact,
+    box_sweep,
+    step_contact,
+)
 from collide2d.engine.events import (
     EV_PAIR,
     EV_WALL,
@@ -63,7 +78,7 @@ from collide2d.engine.events import (
 )
 from collide2d.engine.response import exchange, fold, separate
 from collide2d.engine.shapes import GEOMETRIES, build_cores
-from collide2d.engine.sort import heap_argsort, sort_keys
+from collide2d.engine.sort import heap_argsort, sort_by_time
 from collide2d.engine.threads import chunks_for
 from collide2d.engine.world import Bodies, WorldSpec
 
@@ -248,20 +263,24 @@ def _reorder(S, order):
 
 
 @njit(cache=True)
-def _relist(S, margin, method, cell, bp):
-    """Make the candidate list anew from the boxes grown by `margin` px and anchor every object
+def _relist(S, dt, margin, method, cell, bp):
+    """Make the candidate list anew from the boxes grown by `margin` px, each over the step of dt
+    s just taken (so that a pair that cut a corner within it is listed), and anchor every object
     where it is; first put the objects inside in the broad phase's order when they have strayed
     from it (on average more than REORDER_ROWS rows of the grid). Returns (the key buffer, possibly
     grown; how many keys)."""
     pos, vel, size, inv_mass, static, movable, span, ext, rank, anchor = S
-    keys, near, order, lo, hi, folds, state, params, ws = bp
+    keys, near, order, lo, hi, folds, state, params, ws, when = bp
     n = pos.shape[0]
     for _ in range(2):
         for i in range(n):
-            lo[i, 0] = pos[i, 0] - margin
-            lo[i, 1] = pos[i, 1] - margin
-            hi[i, 0] = pos[i, 0] + size[i, 0] + margin
-            hi[i, 1] = pos[i, 1] + size[i, 1] + margin
+            # the box over the step just taken (swept back on a straight line), grown by margin
+            bx = pos[i, 0] - vel[i, 0] * dt
+            by = pos[i, 1] - vel[i, 1] * dt
+            lo[i, 0] = min(pos[i, 0], bx) - margin
+            lo[i, 1] = min(pos[i, 1], by) - margin
+            hi[i, 0] = max(pos[i, 0], bx) + size[i, 0] + margin
+            hi[i, 1] = max(pos[i, 1], by) + size[i, 1] + margin
             anchor[i, 0] = pos[i, 0]
             anchor[i, 1] = pos[i, 1]
         k = _candidates(method, lo, hi, movable, cell, order, keys, ws, state[ST_CHUNKS])
@@ -279,6 +298,15 @@ def _relist(S, margin, method, cell, bp):
     return keys, k
 
 
+@njit(cache=True, inline="always")
+def _swept_back(pos, vel, span, i, dt):
+    """Whether object i, moved back dt seconds on a straight line, is where it started the step:
+    inside the world (an object that folded at a wall this step is not, SPEC 3.2)."""
+    x = pos[i, 0] - vel[i, 0] * dt
+    y = pos[i, 1] - vel[i, 1] * dt
+    return 0.0 <= x <= max(span[i, 0], 0.0) and 0.0 <= y <= max(span[i, 1], 0.0)
+
+
 @njit(cache=True)
 def _candidates(method, lo, hi, movable, cell, order, keys, ws, chunks):
     """broadphase.candidates, its pair tests split among `chunks` threads for the cells method
@@ -289,51 +317,67 @@ def _candidates(method, lo, hi, movable, cell, order, keys, ws, chunks):
 
 
 @njit(cache=True)
-def _overlap_range(pos, size, ext, keys, first, last, near, base, room):
-    """The listed pairs keys[first:last] whose boxes overlap now with positive area, as keys of
-    object ids ascending, written to near[base:base + room] while they fit; returns how many."""
+def _contact_range(pos, vel, size, span, ext, keys, first, last, near, when, base, room, dt):
+    """The listed pairs keys[first:last] in contact during the step of dt s just taken: their
+    boxes overlap now with positive area, or overlapped during the step (swept back on straight
+    lines, both objects clear of the walls this step: a corner passed through within the step).
+    Written to near[base:base + room] as keys of object ids ascending, with the time each contact
+    began in `when` (s from the step's start, swept back along the relative velocity; -inf when
+    the motion cannot tell), while they fit; returns how many."""
     k = 0
     for c in range(first, last):
         a = keys[c] >> KEY_SHIFT
         b = keys[c] & KEY_MASK
-        if (
-            pos[b, 0] < pos[a, 0] + size[a, 0]
-            and pos[a, 0] < pos[b, 0] + size[b, 0]
-            and pos[b, 1] < pos[a, 1] + size[a, 1]
-            and pos[a, 1] < pos[b, 1] + size[b, 1]
+        qx = pos[b, 0] - pos[a, 0]
+        qy = pos[b, 1] - pos[a, 1]
+        wa, ha, wb, hb = size[a, 0], size[a, 1], size[b, 0], size[b, 1]
+        now = -wb < qx < wa and -hb < qy < ha
+        ux = vel[b, 0] - vel[a, 0]
+        uy = vel[b, 1] - vel[a, 1]
+        if not (now or box_reach(qx - ux * dt, qy - uy * dt, ux, uy, wa, ha, wb, hb, dt)):
+            continue
+        t_enter, _, _, _, _ = box_sweep(qx - ux * dt, qy - uy * dt, ux, uy, wa, ha, wb, hb)
+        if not now and not (
+            box_clip(qx, qy, ux, uy, wa, ha, wb, hb, dt)
+            and _swept_back(pos, vel, span, a, dt)
+            and _swept_back(pos, vel, span, b, dt)
         ):
-            if k < room:
-                ea = ext[a]
-                eb = ext[b]
-                near[base + k] = (min(ea, eb) << KEY_SHIFT) | max(ea, eb)
-            k += 1
+            continue
+        if k < room:
+            ea = ext[a]
+            eb = ext[b]
+            near[base + k] = (min(ea, eb) << KEY_SHIFT) | max(ea, eb)
+            when[base + k] = t_enter if -dt <= t_enter < dt else -math.inf
+        k += 1
     return k
 
 
 @njit(cache=True)
-def _overlapping(pos, size, ext, keys, n_keys, near):
-    """The listed pairs whose boxes overlap now with positive area, as keys of object ids
-    ascending, written to `near` when they fit; returns how many (the caller grows `near` and
-    asks again)."""
-    k = _overlap_range(pos, size, ext, keys, 0, n_keys, near, 0, near.shape[0])
-    if k <= near.shape[0]:
-        sort_keys(near, k)
+def _overlapping(pos, vel, size, span, ext, keys, n_keys, near, when, dt):
+    """The listed pairs in contact during the step (`_contact_range` over the whole list), in the
+    order their contacts began: sorted by the time in `when`, then by key, when they fit; returns
+    how many (the caller grows `near` and `when` and asks again)."""
+    room = near.shape[0]
+    k = _contact_range(pos, vel, size, span, ext, keys, 0, n_keys, near, when, 0, room, dt)
+    if k <= room:
+        sort_by_time(when, near, k)
     return k
 
 
 @njit(cache=True, parallel=True)
-def _overlapping_split(pos, size, ext, keys, n_keys, near, chunks):
+def _overlapping_split(pos, vel, size, span, ext, keys, n_keys, near, when, dt, chunks):
     """`_overlapping` with the listed pairs cut into `chunks` contiguous runs, one per thread: run
-    c writes its keys into its own share of `near`, then the shares are moved together in run
-    order and sorted. The same keys as `_overlapping`; when a share is too small the count
-    returned is more than `near` holds, and the caller grows it and asks again."""
+    c writes its pairs into its own share of `near` and `when`, then the shares are moved
+    together in run order and sorted by (time, key), a total order, so the result is the same as
+    `_overlapping`'s. When a share is too small the count returned is more than `near` holds, and
+    the caller grows it and asks again."""
     room = near.shape[0]
     share = room // chunks
     found = np.zeros(chunks, np.int64)
     for c in prange(chunks):
-        found[c] = _overlap_range(
-            pos, size, ext, keys, c * n_keys // chunks, (c + 1) * n_keys // chunks, near,
-            c * share, share
+        found[c] = _contact_range(
+            pos, vel, size, span, ext, keys, c * n_keys // chunks, (c + 1) * n_keys // chunks,
+            near, when, c * share, share, dt
         )
     total = 0
     fits = True
@@ -346,22 +390,29 @@ def _overlapping_split(pos, size, ext, keys, n_keys, near, chunks):
     for c in range(chunks):
         for r in range(found[c]):
             near[k + r] = near[c * share + r]
+            when[k + r] = when[c * share + r]
         k += found[c]
-    sort_keys(near, k)
+    sort_by_time(when, near, k)
     return k
 
 
 @njit(cache=True)
-def _contact(a, b, ea, eb, pos, size, exact, shape, radius, start, verts, normals):
-    """(depth, depth_y, code, nx, ny) of a pair now (a, b inside; ea, eb their ids); depth <= 0
-    when they do not overlap."""
+def _contact(a, b, ea, eb, pos, vel, size, dt, exact, shape, radius, start, verts, normals):
+    """(push, push_y, code, nx, ny) of a pair after a step of dt s (a, b inside; ea, eb their
+    ids): the normal from the direction of approach, contact.box_step_contact / step_contact;
+    push <= 0 when they do not overlap."""
     qx = pos[b, 0] - pos[a, 0]
     qy = pos[b, 1] - pos[a, 1]
+    ux = vel[b, 0] - vel[a, 0]
+    uy = vel[b, 1] - vel[a, 1]
     if not exact:
-        return box_overlap_axis(qx, qy, size[a, 0], size[a, 1], size[b, 0], size[b, 1])
-    depth, code, nx, ny = penetration(
+        return box_step_contact(qx, qy, ux, uy, size[a, 0], size[a, 1], size[b, 0], size[b, 1], dt)
+    return step_contact(
         qx,
         qy,
+        ux,
+        uy,
+        dt,
         shape[ea],
         size[a, 0],
         size[a, 1],
@@ -375,13 +426,14 @@ def _contact(a, b, ea, eb, pos, size, exact, shape, radius, start, verts, normal
         verts[start[eb] : start[eb + 1]],
         normals[start[eb] : start[eb + 1]],
     )
-    return depth, depth, code, nx, ny
 
 
 @njit(cache=True)
-def _pairs(S, width, height, exact, cores, near, n_near, tick, t, log, rows, times, n_ev, state):
-    """Respond to every overlapping, approaching pair of `near` (ascending keys of ids) in order;
-    count each in state[ST_PAIRS], log it when `log`."""
+def _pairs(
+    S, dt, width, height, exact, cores, near, n_near, tick, t, log, rows, times, n_ev, state
+):
+    """Respond to every overlapping, approaching pair of `near` (ascending keys of ids) in order,
+    after a step of dt s; count each in state[ST_PAIRS], log it when `log`."""
     pos, vel, size, inv_mass, static, movable, span, ext, rank, anchor = S
     shape, radius, start, verts, normals = cores
     for m in range(n_near):
@@ -390,7 +442,7 @@ def _pairs(S, width, height, exact, cores, near, n_near, tick, t, log, rows, tim
         a = rank[ea]
         b = rank[eb]
         depth, depth_y, code, nx, ny = _contact(
-            a, b, ea, eb, pos, size, exact, shape, radius, start, verts, normals
+            a, b, ea, eb, pos, vel, size, dt, exact, shape, radius, start, verts, normals
         )
         if depth <= 0.0:
             continue
@@ -411,11 +463,13 @@ def _pairs(S, width, height, exact, cores, near, n_near, tick, t, log, rows, tim
 
 
 @njit(cache=True)
-def _narrow(S, keys, n_keys, near, chunks):
+def _narrow(S, keys, n_keys, near, when, dt, chunks):
     """The narrow phase: `_overlapping`, split among `chunks` threads when more than one."""
     if chunks > 1:
-        return _overlapping_split(S.pos, S.size, S.ext, keys, n_keys, near, chunks)
-    return _overlapping(S.pos, S.size, S.ext, keys, n_keys, near)
+        return _overlapping_split(
+            S.pos, S.vel, S.size, S.span, S.ext, keys, n_keys, near, when, dt, chunks
+        )
+    return _overlapping(S.pos, S.vel, S.size, S.span, S.ext, keys, n_keys, near, when, dt)
 
 
 # The stages of one step, in the order `_step` runs them; `Model.profile` times each by name
@@ -429,7 +483,7 @@ def _step(first, last, S, dt, width, height, exact, cores, tick, t, log, rows, t
     """Run the stages first ... last-1 (of STAGES) of one step; returns (event buffers, how many
     events, bp): the buffers that grew replace the caller's. What a stage hands the next waits
     in bp between calls: the drift in params[P_DRIFT], the overlapping pairs in state[ST_NEAR]."""
-    keys, near, order, lo, hi, folds, state, params, ws = bp
+    keys, near, order, lo, hi, folds, state, params, ws, when = bp
     if first <= _MOVE < last:
         # move, walls: every object; the walls' events in id order; how far anything drifted
         # from where the candidate list was made
@@ -447,18 +501,20 @@ def _step(first, last, S, dt, width, height, exact, cores, tick, t, log, rows, t
     if first <= _BROAD < last:
         # the candidate list made anew once an object drifted its margin
         if state[0] < 0 or params[P_DRIFT] >= params[0] - params[2]:
-            keys, state[0] = _relist(S, params[0], state[1], params[1], bp)
-            bp = (keys, near, order, lo, hi, folds, state, params, ws)
+            keys, state[0] = _relist(S, dt, params[0], state[1], params[1], bp)
+            bp = (keys, near, order, lo, hi, folds, state, params, ws, when)
     if first <= _NARROW < last:
-        # the listed pairs that overlap, in (a, b) order
-        state[ST_NEAR] = _narrow(S, keys, state[0], near, state[ST_CHUNKS])
+        # the listed pairs in contact this step, in the order their contacts began
+        state[ST_NEAR] = _narrow(S, keys, state[0], near, when, dt, state[ST_CHUNKS])
         while state[ST_NEAR] > near.shape[0]:
             near = np.empty(2 * state[ST_NEAR], np.int64)
-            bp = (keys, near, order, lo, hi, folds, state, params, ws)
-            state[ST_NEAR] = _narrow(S, keys, state[0], near, state[ST_CHUNKS])
+            when = np.empty(2 * state[ST_NEAR])
+            bp = (keys, near, order, lo, hi, folds, state, params, ws, when)
+            state[ST_NEAR] = _narrow(S, keys, state[0], near, when, dt, state[ST_CHUNKS])
     if first <= _RESPONSE < last:
         rows, times, n_ev = _pairs(
             S,
+            dt,
             width,
             height,
             exact,
@@ -481,8 +537,9 @@ def _run(world, substeps, tick0, ticks, log, S, exact, cores, rows, times, bp):
     """Run ticks tick0+1 ... tick0+ticks, every step all of `_step`; returns (event buffers, how
     many events, bp): the buffers that grew replace the caller's.
 
-    S: the state arrays (a `State`). bp = (keys, near, order, lo, hi, folds, state, params, ws):
-    the candidate list kept between calls (see the module docstring) and scratch; state = [keys
+    S: the state arrays (a `State`). bp = (keys, near, order, lo, hi, folds, state, params, ws,
+    when): the candidate list kept between calls (see the module docstring) and scratch (`when`:
+    the times the pairs of `near` began their contacts); state = [keys
     listed (-1: no list yet), method, whether pairs can happen at all, wall events and pair events
     so far, logged or not (ST_WALLS, ST_PAIRS), overlapping pairs of this step (ST_NEAR), chunks
     the move and narrow stages split into among threads (ST_CHUNKS, engine.threads)]; params
@@ -679,4 +736,5 @@ def _broad_phase(world, pos, vel, size, movable, substeps, skip, broadphase):
         np.array([-1, method, int(possible), 0, 0, 0, chunks_for(n)], np.int64),  # see _run
         np.array([margin, cell, slack, 0.0]),
         workspace(n),
+        np.empty(max(16, n)),  # when
     )

@@ -15,18 +15,18 @@ The parts, each selectable with `--part`:
   per tick of a logged run times steps/s); the time per step of each stage (move, broad phase,
   narrow phase, response, from `Model.profile`, where the model has stages) and the time to
   render one frame.
-- error: each benchmark scenario under each model at a ladder of fps and substeps, against the
-  exact model at the scenario's fps: run time, missed collisions (per pair, collisions of the
-  reference the run does not have), collision-count error (pair events of the run minus the
-  reference's), kinetic energy drift (relative), largest penetration (the deepest box overlap at a
-  tick's end, px) and position error over a short horizon (mean distance to the reference
-  HORIZON_S seconds after the reference's first collision, px; long horizons are chaotic). A row
-  is on the Pareto front when no other row of its scenario is both faster and closer.
+- error: each benchmark scenario under each model at a full ladder (fps 1 to 240; stepped also at
+  1 to 64 substeps), each run on the bodies its model loads and against the exact model on those
+  bodies: position error at 1 s and 10 s (quick: 1 s and 2 s), the time the pair events first
+  part from the reference's, missed collisions, collision-count error, energy drift, deepest
+  penetration and run time; a Pareto chart per scene. Then how sensitive each scene is (the exact
+  model against itself with velocities nudged by 1e-9 px/s) and a scan of glancing contacts of two
+  boxes at one substep (the largest speed that tunnels).
 - peers: with `--peers` and pymunk installed (the optional `bench` extra), pymunk steps the same
   standard scene in the same run (`pymunk_steps_per_second`), and the stepped model's ratio to it
   is printed.
 - skips: for each thing a run skips when a scene does not need it, the same work with and
-  without the skip, and the saving (time without / time with).
+  without the skip, and the saving (time without / time with), with its range.
 - targets: the paper's section IV demo headless (ticks/s through the model's `advance`) and the
   wall time of `collide2d run` on a small scenario once kernels are cached.
 - paper, exact, raster (only when asked for with `--part`): the paper model on the section IV demo
@@ -39,6 +39,9 @@ One module per concept: `scenes` (the standard scene and where the benchmark sce
 `targets`, `paper`, `exact`, `raster`), `report` (bench.csv and bench.md), `plots` (the PNG plots)
 and `cli` (the subcommand; it loads the parts only when `collide2d bench` runs).
 
-Quote ratios from one run: absolute times move with the machine and its load. `--quick` shrinks
-every part (small N, short runs, one repeat, in-process timing) to a few seconds, for tests.
+Timings that are compared (error, skips, targets) go through `timing.measure`: calibrated so
+that each measure lasts at least 0.5 s, medians of 5 interleaved repeats (A/B/A) with min-max,
+noisy past a 20 % spread; the headline rows give each target and whether it was met. Quote ratios
+from one run: absolute times move with the machine and its load. `--quick` shrinks every part
+(small N, short runs and measures, in-process timing) to seconds, for tests.
 """

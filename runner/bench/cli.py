@@ -110,8 +110,9 @@ def cmd_bench(args: argparse.Namespace) -> int:
     outputs.atomic_write_text(target / "bench.md", report.markdown(rows, args_line, seconds))
     written = ["bench.csv", "bench.md"] + plots.plots(rows, target)
     if not args.quiet:
-        for what, figure in report.headline(rows):
-            print(f"{figure:>14}  {what}")
+        for what, figure, goal, met in report.headline(rows):
+            goal = f"  (target {goal}) {met}" if goal else ""
+            print(f"{figure:>14}  {what}{goal}")
         print(f"bench: {len(rows)} rows in {seconds:.1f}s -> {target} ({', '.join(written)})")
     return EXIT_OK
 

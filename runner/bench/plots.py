@@ -1,6 +1,9 @@
 """The plots of `collide2d bench`, when matplotlib is installed (the `plot` extra): scaling.png
-(steps/s against N, per model and peer) and runtime_vs_error.png (one panel per benchmark scenario,
-the Pareto front drawn as a step line).
+(steps/s against N, per model and peer) and runtime_vs_error.png, the Pareto chart: one panel per
+benchmark scenario, run time against the error at the long horizon, every point labelled with its
+settings ("60" fps, "60x16" fps x substeps), min-max bars on the run time, the Pareto front drawn
+as a step line through its points, and the scene's own floor (the sensitivity row) as a dotted
+line. Errors below ERROR_FLOOR_PX (float rounding) are drawn on the floor's line.
 """
 
 from __future__ import annotations
@@ -38,37 +41,66 @@ def plots(rows: list[dict], folder: Path) -> list[str]:
         written.append("scaling.png")
     err = [r for r in rows if r["part"] == "error"]
     if err:
-        scenes = list(dict.fromkeys(r["scene"] for r in err))
-        cols = 2
-        rows_ = math.ceil(len(scenes) / cols)
-        fig, axes = plt.subplots(rows_, cols, figsize=(10, 4 * rows_), squeeze=False)
-        for ax, scene in zip(axes.ravel(), scenes, strict=False):
-            mine = [r for r in err if r["scene"] == scene]
-            for name in dict.fromkeys(r["model"] for r in mine):
-                pts = [r for r in mine if r["model"] == name]
-                ax.scatter(
-                    [1e3 * r["run_time_s"] for r in pts],
-                    [r["position_error_px"] + 1e-3 for r in pts],
-                    label=name,
-                )
-            front = sorted(
-                (1e3 * r["run_time_s"], r["position_error_px"] + 1e-3)
-                for r in mine
-                if r["pareto"] == "yes"
-            )
-            if front:
-                ax.step(*zip(*front, strict=True), where="post", color="grey", linewidth=0.8)
-            ax.set(xscale="log", yscale="log", xlabel="run time (ms)")
-            for axis in (ax.xaxis, ax.yaxis):
-                axis.set_major_formatter(ticker.FormatStrFormatter("%g"))
-                axis.set_minor_formatter(ticker.NullFormatter())
-            ax.set(ylabel="position error at the horizon (px, +0.001)", title=scene)
-            ax.legend(fontsize="small")
-        for ax in axes.ravel()[len(scenes) :]:
-            ax.axis("off")
-        fig.tight_layout()
-        with atomic_path(folder / "runtime_vs_error.png") as tmp:
-            fig.savefig(tmp, format="png")
-        plt.close(fig)
+        sens = [r for r in rows if r["part"] == "sensitivity"]
+        _pareto_figure(plt, ticker, err, sens, folder, atomic_path)
         written.append("runtime_vs_error.png")
     return written
+
+
+MODEL_COLOURS = {"paper": "tab:orange", "stepped": "tab:blue", "exact": "tab:green"}
+
+
+def _label(r) -> str:
+    """A point's settings: its own label (a sweep's swept values), else fps or fps x substeps."""
+    if "label" in r:
+        return r["label"]
+    return f"{r['fps']}x{r['substeps']}" if r["substeps"] > 1 else f"{r['fps']}"
+
+
+def _pareto_figure(plt, ticker, err, sens, folder, atomic_path) -> None:
+    from collide2d.runner.bench.error import ERROR_FLOOR_PX
+
+    scenes = list(dict.fromkeys(r["scene"] for r in err))
+    cols = 2 if len(scenes) > 1 else 1
+    nrows = math.ceil(len(scenes) / cols)
+    fig, axes = plt.subplots(nrows, cols, figsize=(7 * cols, 5.5 * nrows), squeeze=False)
+    long_s = err[0].get("long_s")  # None: each point at its own run's end (a sweep)
+    for ax, scene in zip(axes.ravel(), scenes, strict=False):
+        mine = [r for r in err if r["scene"] == scene]
+        for name in dict.fromkeys(r["model"] for r in mine):
+            pts = [r for r in mine if r["model"] == name]
+            x = [r["run_time_s"] for r in pts]
+            y = [max(r["error_long_px"], ERROR_FLOOR_PX) for r in pts]
+            lo = [r["run_time_s"] - r.get("run_time_min_s", r["run_time_s"]) for r in pts]
+            hi = [r.get("run_time_max_s", r["run_time_s"]) - r["run_time_s"] for r in pts]
+            ax.errorbar(x, y, xerr=[lo, hi], fmt="o", ms=4, capsize=2, label=name,
+                        color=MODEL_COLOURS.get(name))  # fmt: skip
+            for r, xi, yi in zip(pts, x, y, strict=True):
+                ax.annotate(_label(r), (xi, yi), textcoords="offset points", xytext=(3, 3),
+                            fontsize=6, color=MODEL_COLOURS.get(name))  # fmt: skip
+        front = sorted(
+            (r["run_time_s"], max(r["error_long_px"], ERROR_FLOOR_PX))
+            for r in mine
+            if r.get("pareto") == "yes"
+        )
+        if front:
+            ax.step(*zip(*front, strict=True), where="post", color="black", linewidth=1.0,
+                    label="Pareto front")  # fmt: skip
+        ax.axhline(ERROR_FLOOR_PX, color="grey", linewidth=0.6, linestyle=":")
+        for r in sens:
+            if r["scene"] == scene:
+                ax.axhline(max(r["error_long_px"], ERROR_FLOOR_PX), color="red", linewidth=0.8,
+                           linestyle=":", label="exact, velocities nudged 1e-9 px/s")  # fmt: skip
+        ax.set(xscale="log", yscale="log", title=scene)
+        span = f"{long_s:g} s" if long_s is not None else "the run's end"
+        ax.set_xlabel(f"run time to {span} of simulation (s)")
+        ax.set_ylabel(f"mean position error at {span} vs exact (px)")
+        ax.yaxis.set_major_locator(ticker.LogLocator(numticks=12))
+        ax.legend(fontsize="x-small", loc="best")
+    for ax in axes.ravel()[len(scenes) :]:
+        ax.axis("off")
+    fig.suptitle("Run time against error (labels: fps, or fps x substeps; floor: 1e-9 px)")
+    fig.tight_layout()
+    with atomic_path(folder / "runtime_vs_error.png") as tmp:
+        fig.savefig(tmp, format="png", dpi=110)
+    plt.close(fig)

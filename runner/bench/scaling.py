@@ -1,7 +1,8 @@
 """The scaling part of `collide2d bench`: the standard scene under each model at each N.
 
 One row per model and N: steps/s through `collide2d run` in a subprocess (or `runner.run.drive`
-in process), start-up excluded by subtracting a 1-tick run; body-steps/s; events/s (events per
+in process), start-up excluded by subtracting a 1-tick run (the two interleaved, medians of
+REPEATS, the run's min-max, spread and noisy flag kept); body-steps/s; events/s (events per
 tick of a logged run times steps/s); the time per step of each stage (`Model.profile`, where the
 model has stages); and the time to render one frame.
 """
@@ -14,6 +15,7 @@ from pathlib import Path
 from collide2d.engine import models
 from collide2d.runner.bench.scenes import STANDARD_FPS, standard_scene
 from collide2d.runner.bench.timing import (
+    NOISY_SPREAD,
     PROBE_S,
     QUICK_PROBE_S,
     QUICK_TARGET_S,
@@ -38,7 +40,7 @@ def scaling(models_: list[str], ns: list[int], quick: bool, in_process: bool, ec
     rows = []
     target = QUICK_TARGET_S if quick else TARGET_S
     probe = QUICK_PROBE_S if quick else PROBE_S
-    repeats = 1 if quick else REPEATS
+    repeats = 3 if quick else REPEATS
     with tempfile.TemporaryDirectory(prefix="collide2d-bench-") as tmp:
         tmp = Path(tmp)
         for model in models_:
@@ -59,17 +61,21 @@ def _scaling_row(model, n, target, probe_s, repeats, in_process, tmp: Path, echo
     rate = probe_rate(probe, probe_s)
     ticks = max(2, int(target * rate))
     if in_process:
-        t1 = median(drive_seconds(text, 1) for _ in range(repeats))
-        tt = median(drive_seconds(text, ticks) for _ in range(repeats))
+        short, full = (lambda: drive_seconds(text, 1)), (lambda: drive_seconds(text, ticks))
         how = "in process (drive)"
     else:
         path = tmp / f"standard_{model}_{n}.yaml"
         path.write_text(text)
         out = tmp / "out"
         cli_seconds(path, 1, out)  # warm the file cache and the kernels
-        t1 = median(cli_seconds(path, 1, out) for _ in range(repeats))
-        tt = median(cli_seconds(path, ticks, out) for _ in range(repeats))
+        short, full = (lambda: cli_seconds(path, 1, out)), (lambda: cli_seconds(path, ticks, out))
         how = "collide2d run"
+    # interleaved: 1 tick, the run, the run, 1 tick, ... so that a drift shows in both alike
+    t1s, tts = [], []
+    for r in range(repeats):
+        for which in ((t1s, short), (tts, full)) if r % 2 == 0 else ((tts, full), (t1s, short)):
+            which[0].append(which[1]())
+    t1, tt = median(t1s), median(tts)
     if not tt > 1.5 * t1:  # too short to stand out of the start-up's noise: say so
         how += ", noisy (the run was not much longer than the 1-tick run)"
     per_step = max(tt - t1, 1e-12) / (ticks - 1)
@@ -91,6 +97,13 @@ def _scaling_row(model, n, target, probe_s, repeats, in_process, tmp: Path, echo
         "ns_per_body_step": 1e9 * per_step / n,
         "events_per_s": events * steps,
         "note": how,
+        # the run's seconds, its repeats' range and spread
+        "run_time_s": tt,
+        "run_time_min_s": min(tts),
+        "run_time_max_s": max(tts),
+        "repeats": repeats,
+        "spread": (max(tts) - min(tts)) / max(tt, 1e-12),
+        "noisy": "yes" if max(tts) - min(tts) > NOISY_SPREAD * tt else "no",
     }
     # time per stage, where the model has stages (state as after the logged run)
     if hasattr(logged, "profile"):

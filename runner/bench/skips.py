@@ -1,5 +1,6 @@
 """The skips part of `collide2d bench`: for each thing a run skips when a scene does not need it,
-the same work with and without the skip, and the saving (time without / time with).
+the same work with and without the skip, and the saving (time without / time with): medians of
+interleaved measures (timing.measure), with the range and the noisy flag.
 
 The scenes: the section IV demo (frame skips, erase only what moved), one mover among
 SKIP_STATICS static boxes (no pair work between statics), the dense gas (no event records without a
@@ -16,7 +17,7 @@ import numpy as np
 from collide2d.engine import models
 from collide2d.engine.world import WorldSpec
 from collide2d.runner.bench.scenes import DEMO_SCENARIO, PROJECT_SCENARIOS, STANDARD_SEED
-from collide2d.runner.bench.timing import REPEATS, best_of
+from collide2d.runner.bench.timing import measure
 
 SKIP_TICKS = 600
 SKIP_STATICS = 4000
@@ -30,7 +31,6 @@ def skips(quick: bool, echo, folder: Path = PROJECT_SCENARIOS) -> list[dict]:
     from collide2d.runner.run import drive
     from collide2d.runner.scenario import load
 
-    repeats = 1 if quick else REPEATS
     ticks = 60 if quick else SKIP_TICKS
     demo = load(folder / f"{DEMO_SCENARIO}.yaml", overrides={"ticks": ticks})
     every = list(range(0, ticks + 1, 10))
@@ -107,21 +107,29 @@ def skips(quick: bool, echo, folder: Path = PROJECT_SCENARIOS) -> list[dict]:
         )
     rows = []
     for name, with_skip, without_skip, scene in cases:
-        with_skip()  # warm-up: load the kernels
-        without_skip()
-        t_with = best_of(with_skip, repeats)
-        t_without = best_of(without_skip, repeats)
+        t_with, t_without = measure([with_skip, without_skip], quick)
+        saving = t_without.median / max(t_with.median, 1e-12)
+        # the saving's range: the extremes of the two ranges against each other
+        low = t_without.low / max(t_with.high, 1e-12)
+        high = t_without.high / max(t_with.low, 1e-12)
+        noisy = t_with.noisy or t_without.noisy
         rows.append(
             {
                 "part": "skips",
                 "scene": scene,
-                "with_s": t_with,
-                "without_s": t_without,
-                "saving": t_without / max(t_with, 1e-12),
+                "with_s": t_with.median,
+                "without_s": t_without.median,
+                "saving": saving,
+                "saving_min": low,
+                "saving_max": high,
+                "repeats": t_with.repeats,
+                "spread": max(t_with.spread, t_without.spread),
+                "noisy": "yes" if noisy else "no",
                 "note": name,
             }
         )
-        echo(f"skips    {name:52s} x{rows[-1]['saving']:.1f}")
+        flag = "  noisy" if noisy else ""
+        echo(f"skips    {name:52s} x{saving:.1f} (x{low:.1f}-x{high:.1f}){flag}")
     return rows
 
 

@@ -121,7 +121,7 @@ def markdown(columns: list[str], table: list[dict], total: int, complete: bool) 
     return "\n".join(lines) + "\n"
 
 
-def _plot(table: list[dict], folder: Path) -> list[str]:
+def _plot(columns: list[str], table: list[dict], folder: Path) -> list[str]:
     """runtime_vs_error.png through the benchmark's plot, when there are position errors."""
     from collide2d.runner.bench import plots
 
@@ -130,8 +130,9 @@ def _plot(table: list[dict], folder: Path) -> list[str]:
             "part": "error",
             "scene": r["scenario"],
             "model": r["model"],
+            "label": ",".join(_text(r[c], 4) for c in columns if c not in ("scenario", "model")),
             "run_time_s": r["run_time_s"],
-            "position_error_px": r["position_error_px"],
+            "error_long_px": r["position_error_px"],
         }
         for r in table
         if r["position_error_px"] != "" and r["run_time_s"] != ""
@@ -153,7 +154,7 @@ def write(
     status = {"runs": total, "done": len(table), "complete": complete}
     outputs.atomic_write_text(folder / "sweep.json", json.dumps(status, indent=2) + "\n")
     written = ["results.csv", "results.md", "sweep.json"]
-    plotted = _plot(table, folder)
+    plotted = _plot(columns, table, folder)
     if not plotted and (folder / PLOT).is_file():
         (folder / PLOT).unlink()  # a previous sweep's plot would not match these rows
     return written + plotted

@@ -14,10 +14,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from collide2d.engine.contact import (
+    box_clip,
     box_next_contact,
     box_overlap_axis,
     box_penetration,
     box_reach,
+    box_step_contact,
     box_sweep,
     disc_roots,
     next_contact,
@@ -134,7 +136,7 @@ def test_box_penetration_is_the_smallest_push_apart():
     assert box_penetration(10.0, 0.0, 10.0, 10.0, 10.0, 10.0)[0] == 0.0  # touching
 
 
-def test_stepped_axis_follows_the_smaller_overlap_width():
+def test_stepped_axis_follows_the_smaller_overlap_width_when_the_motion_cannot_tell():
     # B (2 x 20) sits inside A's x-range: overlap widths 2 (x) and 8 (y) -> axis x (SPEC 3.2),
     # and the push along x that parts them is the distance to A's nearer side face.
     depth, depth_y, code, nx, ny = box_overlap_axis(40.0, 2.0, 100.0, 10.0, 2.0, 20.0)
@@ -345,3 +347,40 @@ def test_a_polygon_meeting_a_box_face_gets_that_axis(u):
         *q, *u, KIND_BOX, 10.0, 10.0, 0.0, va, edge_normals(va), KIND_POLYGON, 5.0, 4.0, 0.0, vb, nb
     )
     assert t == 2.0 and code == (AXIS_X if u[0] else AXIS_Y)
+
+
+def test_the_stepped_normal_is_the_axis_the_pair_came_in_by():
+    # the glancing pass: 10x10 boxes offset by 5 px, B coming in from A's left at 26
+    # px/s over a 1 s step; it went 6 px deep in x, deeper than the 5 px of y overlap, yet the
+    # normal is x (the smaller overlap would say y), pointing back the way B came, and the push
+    # is twice the 6 px: B ends where a bounce at the contact instant would put it.
+    push, push_y, code, nx, ny = box_step_contact(-4.0, 5.0, 26.0, 0.0, 10, 10, 10, 10, 1.0)
+    assert (push, push_y, code, nx, ny) == (12.0, 0.0, AXIS_X, -1.0, 0.0)
+    assert box_overlap_axis(-4.0, 5.0, 10, 10, 10, 10)[2] == AXIS_Y  # the old rule
+    # deeper than half way through along x: still the side it came in by
+    push, _, code, nx, _ = box_step_contact(-1.0, 9.5, 9.5, 0.0, 10, 10, 10, 10, 1.0)
+    assert (code, nx, push) == (AXIS_X, -1.0, 18.0)
+    # coming down onto A's top face: y, pointing up
+    _, _, code, nx, ny = box_step_contact(3.0, -7.0, 0.0, 5.0, 10, 10, 10, 10, 1.0)
+    assert (code, nx, ny) == (AXIS_Y, 0.0, -1.0)
+    # corner to corner within TIE_PX: both axes, each pushed twice its own depth
+    assert box_step_contact(-8.0, -8.0, 4.0, 4.0, 10, 10, 10, 10, 1.0) == (
+        4.0, 4.0, AXIS_XY, -1.0, -1.0,
+    )  # fmt: skip
+    # overlapping since before the previous step, or not moving: the smaller overlap decides
+    assert box_step_contact(-4.0, 5.0, 1.0, 0.0, 10, 10, 10, 10, 1.0)[:3] == (5.0, 0.0, AXIS_Y)
+    assert box_step_contact(-4.0, 5.0, 0.0, 0.0, 10, 10, 10, 10, 1.0)[:3] == (5.0, 0.0, AXIS_Y)
+    # apart, and no corner cut within the step: no contact
+    assert box_step_contact(-11.0, 0.0, 5.0, 0.0, 10, 10, 10, 10, 1.0)[0] == 0.0
+
+
+def test_a_corner_cut_within_a_step_is_a_clip_and_a_pass_through_is_not():
+    # B's corner cuts A's top-left corner between two step ends where the boxes are apart
+    assert box_clip(-5.0, -10.5, 5.5, -5.5, 10, 10, 10, 10, 1.0)
+    push, _, code, nx, ny = box_step_contact(-5.0, -10.5, 5.5, -5.5, 10, 10, 10, 10, 1.0)
+    assert code in (AXIS_X, AXIS_Y, AXIS_XY) and push > 0.0
+    # B passes wholly through A along x within one step: tunnelling, the stepped model's own
+    assert not box_clip(15.0, 0.0, 40.0, 0.0, 10, 10, 10, 10, 1.0)
+    assert box_step_contact(15.0, 0.0, 40.0, 0.0, 10, 10, 10, 10, 1.0)[0] == 0.0
+    # a corner cut that is still overlapping at the step's end is an overlap, not a clip
+    assert not box_clip(-9.0, -9.0, 2.0, 2.0, 10, 10, 10, 10, 1.0)

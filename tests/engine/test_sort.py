@@ -1,4 +1,5 @@
-"""engine/sort.py: each sort gives numpy's order, for nearly sorted and reshuffled input alike."""
+"""engine/sort.py: each sort gives numpy's order (or sorted()'s, for pairs of time and key), for
+nearly sorted and reshuffled input alike."""
 
 from __future__ import annotations
 
@@ -6,7 +7,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from collide2d.engine.sort import heap_argsort, sort_keys, sort_order
+from collide2d.engine.sort import heap_argsort, sort_by_time, sort_keys, sort_order
 
 keys = st.lists(st.integers(-50, 50), max_size=200).map(lambda v: np.array(v, np.int64))
 
@@ -42,3 +43,20 @@ def test_heap_argsort_orders_the_keys(key):
     idx = heap_argsort(key)
     assert sorted(idx.tolist()) == list(range(len(key)))
     assert np.array_equal(key[idx], np.sort(key))
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.lists(
+        st.tuples(st.sampled_from([-np.inf, 0.0, 0.25, 0.5, 1.0]), st.integers(0, 40)),
+        max_size=150,
+    )
+)
+def test_sort_by_time_orders_by_time_then_key(entries):
+    when = np.array([t for t, _ in entries], np.float64)
+    keys = np.array([k for _, k in entries], np.int64)
+    n = len(entries) - len(entries) // 3
+    w, k = when.copy(), keys.copy()
+    sort_by_time(w, k, n)
+    assert list(zip(w[:n].tolist(), k[:n].tolist(), strict=True)) == sorted(entries[:n])
+    assert np.array_equal(w[n:], when[n:]) and np.array_equal(k[n:], keys[n:])

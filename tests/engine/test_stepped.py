@@ -7,7 +7,7 @@ from engine_refs import random_boxes
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from collide2d.engine.contact import box_overlap_axis
+from collide2d.engine.contact import box_clip, box_step_contact, box_sweep
 from collide2d.engine.events import AXIS_NAMES, EV_PAIR, EV_WALL, SIDE_LEFT, SIDE_RIGHT
 from collide2d.engine.invariants import kinetic_energy, momentum
 from collide2d.engine.models import make
@@ -263,7 +263,9 @@ def test_bad_options_are_refused():
 
 
 def reference(world, bodies, ticks, substeps=1):
-    """The stepped model written plainly: every pair tested every step, objects in id order.
+    """The stepped model written plainly: every pair tested every step (overlapping at the step's
+    end, or having cut a corner of each other within it), taken in the order their contacts
+    began.
     Returns (events as (tick, type, a, b, code) tuples, positions, velocities)."""
     static = bodies.static
     pos = bodies.pos.astype(float)
@@ -285,12 +287,23 @@ def reference(world, bodies, ticks, substeps=1):
                     for _ in range(low + high):
                         log.append((tick, EV_WALL, i, -1, sides[0] if at_low else sides[1]))
                         at_low = not at_low
-            lo, hi = pos.copy(), pos + size
-            over = ((lo[None, :, :] < hi[:, None, :]) & (lo[:, None, :] < hi[None, :, :])).all(2)
-            over &= ~(static[:, None] & static[None, :])
-            for a, b in zip(*np.nonzero(np.triu(over, 1)), strict=True):
-                q = pos[b] - pos[a]
-                depth, depth_y, code, nx, ny = box_overlap_axis(q[0], q[1], *size[a], *size[b])
+            span = np.array([width, height]) - size
+            back = pos - vel * dt
+            clear = ((back >= 0) & (back <= np.maximum(span, 0))).all(1)
+            contacts = []
+            for a in range(len(pos)):
+                for b in range(a + 1, len(pos)):
+                    if static[a] and static[b]:
+                        continue
+                    q, u = pos[b] - pos[a], vel[b] - vel[a]
+                    now = -size[b, 0] < q[0] < size[a, 0] and -size[b, 1] < q[1] < size[a, 1]
+                    t_in = box_sweep(*(q - u * dt), *u, *size[a], *size[b])[0]
+                    clip = box_clip(*q, *u, *size[a], *size[b], dt) and clear[a] and clear[b]
+                    if now or clip:
+                        contacts.append((t_in if -dt <= t_in < dt else -np.inf, a, b))
+            for _, a, b in sorted(contacts):
+                q, u = pos[b] - pos[a], vel[b] - vel[a]
+                depth, depth_y, code, nx, ny = box_step_contact(*q, *u, *size[a], *size[b], dt)
                 if depth <= 0.0:
                     continue
                 *v, changed = exchange(*vel[a], *vel[b], inv[a], inv[b], code, nx, ny)
@@ -412,3 +425,48 @@ def test_profile_runs_the_same_ticks_as_advance():
     assert a.velocities().tobytes() == b.velocities().tobytes()
     assert a.event_counts() == b.event_counts() and min(a.event_counts()) > 0
     assert a.advance(20).tobytes() == b.advance(20).tobytes()
+
+
+# --- the normal sees the motion: no tunnelling below one box size per step (SPEC 3.2)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.tuples(st.integers(2, 20), st.integers(2, 20)),
+    st.tuples(st.integers(2, 20), st.integers(2, 20)),
+    st.floats(0.0, 1.0, exclude_max=True),  # where B's side lies along A's (0: flush, glancing)
+    st.floats(0.01, 0.999),  # relative displacement per step, in the smaller box's size
+    st.floats(0.0, 1.0),  # how the closing speed is shared between the two
+    st.floats(-30.0, 30.0),  # a common sideways speed: the pair glides together
+    st.sampled_from([1, 5, 60]),
+    st.booleans(),  # along y instead of x
+    st.floats(0.1, 10.0),
+)
+def test_no_tunnelling_below_one_box_size_per_step(sa, sb, offset, frac, share, drift, fps, on_y,
+                                                   mass_b):  # fmt: skip
+    # B comes at A along one axis, its other axis overlapping A's anywhere from a sliver (a
+    # glancing contact) to full; the relative displacement per step is below the smaller box's
+    # size. They must collide and B must never end a tick past A's near face.
+    side = min(*sa, *sb)
+    speed = frac * side * fps  # closing speed, px/s
+    (wa, ha), (wb, hb) = sa, sb
+    # along x: B left of A with a gap, y offset so that the y intervals overlap by > 0
+    lateral = -hb + (ha + hb) * (0.5 * offset + 0.25) if offset else -hb + 0.01
+    gap = 2.5 * speed / fps  # they meet in the third step
+    pa = np.array([200.0, 200.0])
+    pb = np.array([200.0 - wb - gap, 200.0 + lateral])
+    va = np.array([-speed * (1 - share), drift])
+    vb = np.array([speed * share, drift])
+    size = np.array([[wa, ha], [wb, hb]], float)
+    if on_y:
+        pa, pb, va, vb, size = pa[::-1], pb[::-1], va[::-1], vb[::-1], size[:, ::-1]
+    world = WorldSpec(400, 400, fps)
+    bodies = Bodies.boxes([pa, pb], size, [va, vb], mass=[1.0, mass_b])
+    model = make("stepped", world, bodies)
+    axis = 1 if on_y else 0
+    pairs = 0
+    for _ in range(8):
+        pairs += int((model.advance(1)["type"] == EV_PAIR).sum())
+        p = model.positions()
+        assert p[1, axis] + size[1, axis] <= p[0, axis] + 1e-9  # B never past A's near face
+    assert pairs >= 1

@@ -21,10 +21,13 @@ def test_plots_are_written_with_matplotlib(tmp_path):
     rows = [
         {"part": "scaling", "model": "stepped", "n": 50, "steps_per_s": 100.0},
         {"part": "scaling", "model": "stepped", "n": 500, "steps_per_s": 10.0},
-        {"part": "error", "scene": "s", "model": "exact", "run_time_s": 0.1,
-         "position_error_px": 0.0, "pareto": "yes"},
-        {"part": "error", "scene": "s", "model": "paper", "run_time_s": 0.01,
-         "position_error_px": 3.0, "pareto": "yes"},
+        {"part": "error", "scene": "s", "model": "exact", "fps": 60, "substeps": 1,
+         "run_time_s": 0.1, "run_time_min_s": 0.09, "run_time_max_s": 0.12, "long_s": 10.0,
+         "error_long_px": 0.0, "pareto": "yes"},
+        {"part": "error", "scene": "s", "model": "stepped", "fps": 60, "substeps": 16,
+         "run_time_s": 0.01, "run_time_min_s": 0.01, "run_time_max_s": 0.01, "long_s": 10.0,
+         "error_long_px": 3.0, "pareto": "yes"},
+        {"part": "sensitivity", "scene": "s", "error_long_px": 1e-6},
     ]  # fmt: skip
     assert plots.plots(rows, tmp_path) == ["scaling.png", "runtime_vs_error.png"]
     assert (tmp_path / "runtime_vs_error.png").read_bytes()[:4] == b"\x89PNG"

@@ -22,14 +22,29 @@ def test_csv_has_the_columns_and_blanks_where_they_do_not_apply():
     assert parsed[1]["note"] == "a, b"
 
 
-def test_headline_gives_the_ratios_the_issue_asks_for():
+def test_headline_gives_the_ratios_the_issue_asks_for_with_target_and_mark():
     rows = [
         {"part": "scaling", "model": "stepped", "n": 1_000, "ns_per_body_step": 20.0},
         {"part": "scaling", "model": "stepped", "n": 100_000, "ns_per_body_step": 30.0},
-        {"part": "peers", "model": "pymunk", "n": 1_000, "ratio": 6.5},
-        {"part": "targets", "value": 1_200_000.0, "note": "section IV demo headless"},
-    ]
-    head = dict(report.headline(rows))
-    assert head["stepped / pymunk steps/s, N = 1,000 (target >= 5)"] == "6.50"
-    assert head["stepped cost per body-step, N = 100,000 / N = 1,000 (target <= 2)"] == "1.50"
-    assert head["section IV demo headless"] == "1,200,000"
+        {"part": "peers", "model": "pymunk", "n": 1_000, "ratio": 4.5},
+        {"part": "targets", "value": 1_200_000.0, "note": "section IV demo headless",
+         "target": ">= 1,000,000", "met": True, "noisy": "no", "spread": 0.05},
+        {"part": "skips", "noisy": "yes", "spread": 0.35},
+        {"part": "error", "model": "stepped", "scene": "bench_dense_gas", "fps": 60,
+         "substeps": 64, "short_s": 1.0, "long_s": 10.0, "error_short_px": 0.1,
+         "error_long_px": 0.5, "run_time_s": 0.2, "run_time_min_s": 0.19, "run_time_max_s": 0.22,
+         "noisy": "no", "spread": 0.15, "diverges_s": None, "pairs": 10, "missed": 0,
+         "count_error": 0, "energy_drift": 0.0, "max_penetration_px": 0.0, "pareto": "yes"},
+        {"part": "glancing", "value": None, "scene": "two boxes", "fps": 60, "note": "none"},
+    ]  # fmt: skip
+    head = {what: (figure, target, met) for what, figure, target, met in report.headline(rows)}
+    assert head["stepped / pymunk steps/s, N = 1,000"] == ("4.50", ">= 5", "✗")
+    assert head["stepped cost per body-step, N = 100,000 / N = 1,000"] == ("1.50", "<= 2", "✓")
+    assert head["section IV demo headless"] == ("1,200,000", ">= 1,000,000", "✓")
+    assert head["stepped error at 10 s, bench_dense_gas, 64 substeps"] == ("0.5 px", "< 1 px", "✓")
+    assert head["glancing tunnelling at 1 substep below one box size per step"][2] == "✓"
+    assert head["timings marked noisy (spread > 20 %)"] == ("1 of 3", "0", "✗")
+    assert head["largest repeat spread (max - min) / median"][0] == "35%"
+    md = report.markdown(rows, "collide2d bench", 1.0)
+    assert "| what | figure | target | met |" in md and "| 4.50 | >= 5 | ✗ |" in md
+    assert "| bench_dense_gas | stepped | 60 | 64 | 200 | 190-220 | no | 0.1 | 0.5 |" in md
