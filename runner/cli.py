@@ -2,34 +2,34 @@
 
 Each subcommand lives with what it drives (`run` here; `validate`/`schema` in runner.validate;
 `check`/`bless` in runner.golden.cli; `stress` and `bench` in runner.stress.cli and
-runner.bench.cli, which load the rest of their packages only when their command runs) and registers
-itself on the parser. Exit status: 0 fine, 1 a check found a difference, 2 bad input or usage, 3 an
-unexpected error (one line naming the scenario; the traceback too with `--debug`). A refused
-scenario prints `FILE:LINE:COL: error: MESSAGE` on stderr and writes nothing.
+runner.bench.cli; `init` in runner.init, `config` in runner.configcli) and registers itself on the
+parser. A command line imports only the module of its command (`REGISTRARS`), so a run starts
+without loading the golden, stress or bench code; `--help` and an unknown command load them all.
+Exit status: 0 fine, 1 a check found a difference, 2 bad input or usage, 3 an unexpected error (one
+line naming the scenario; the traceback too with `--debug`). A refused scenario prints
+`FILE:LINE:COL: error: MESSAGE` on stderr and writes nothing.
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib
 import sys
 import traceback
 from importlib import resources
 
-from collide2d.runner import validate
-from collide2d.runner.bench import cli as bench_cli
 from collide2d.runner.exitcodes import EXIT_BAD_INPUT, EXIT_OK, EXIT_UNEXPECTED
-from collide2d.runner.golden import cli as golden_cli
-from collide2d.runner.options import (
-    add_cap_argument,
-    add_limit_arguments,
-    add_override_arguments,
-    limits_from_args,
-    overrides_from_args,
-    positive_int,
+
+# (module, its function that adds subcommands, the commands it adds), in `--help` order.
+REGISTRARS = (
+    ("collide2d.runner.cli", "register_run", ("run",)),
+    ("collide2d.runner.golden.cli", "register", ("check", "bless")),
+    ("collide2d.runner.validate", "register", ("validate", "schema")),
+    ("collide2d.runner.stress.cli", "register", ("stress",)),
+    ("collide2d.runner.bench.cli", "register", ("bench",)),
+    ("collide2d.runner.init", "register", ("init",)),
+    ("collide2d.runner.configcli", "register", ("config",)),
 )
-from collide2d.runner.run import RunOptions, RunStopped, run_to_dir
-from collide2d.runner.scenario import ScenarioError, load
-from collide2d.runner.stress import cli as stress_cli
 
 
 def demo_path() -> str:
@@ -38,6 +38,13 @@ def demo_path() -> str:
 
 
 def register_run(subparsers) -> None:
+    from collide2d.runner.options import (
+        add_cap_argument,
+        add_limit_arguments,
+        add_override_arguments,
+        positive_int,
+    )
+
     p = subparsers.add_parser(
         "run",
         help="run a scenario and write its frames, GIF and event log",
@@ -46,7 +53,11 @@ def register_run(subparsers) -> None:
         "Flags override the scenario's output and settings.",
     )
     p.add_argument("scenario", nargs="?", help="scenario YAML file (default: the bundled demo)")
-    p.add_argument("--out", default="out", metavar="DIR", help="output folder (default: out)")
+    p.add_argument(
+        "--out",
+        metavar="DIR",
+        help="output folder (default: the project's [tool.collide2d] out, else out)",
+    )
     p.add_argument(
         "--gif",
         action=argparse.BooleanOptionalAction,
@@ -81,9 +92,20 @@ def register_run(subparsers) -> None:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
+    from collide2d.runner import config
+    from collide2d.runner.options import limits_from_args, overrides_from_args
+    from collide2d.runner.run import RunOptions, run_to_dir
+    from collide2d.runner.scenario import load
+
+    project = config.find()
     path = args.scenario or demo_path()
-    limits = limits_from_args(args)
-    scenario = load(path, overrides=overrides_from_args(args), limits=limits)
+    limits = limits_from_args(args, project)
+    scenario = load(
+        path,
+        overrides=overrides_from_args(args),
+        limits=limits,
+        defaults=project.model_defaults(),
+    )
     out = scenario.output
     options = RunOptions(
         png=bool(out.frames) if args.png is None else args.png,
@@ -92,28 +114,48 @@ def cmd_run(args: argparse.Namespace) -> int:
         scale=args.scale,
         quiet=args.quiet,
     )
-    target, summary = run_to_dir(scenario, args.out, options, limits)
+    out_root = args.out or (project.folder("out") if project.file else "out")
+    target, summary = run_to_dir(scenario, out_root, options, limits)
     if not args.quiet:
         counts = summary["events"]
+        compiled = summary.get("compile_time_s", 0.0)
+        also = f" (+{compiled:.1f}s compiling kernels)" if compiled >= 0.05 else ""
         print(
-            f"{scenario.name}: {scenario.ticks} ticks under {scenario.model}, "
-            f"{counts['wall']:,} wall and {counts['pair']:,} pair events "
-            f"in {summary['run_time_s']:.3f}s -> {target}"
+            f"{scenario.name}: {plural(scenario.ticks, 'tick')} under {scenario.model}, "
+            f"{counts['wall']:,} wall and {plural(counts['pair'], 'pair event')} "
+            f"in {summary['run_time_s']:.3f}s{also} -> {target}"
         )
     return EXIT_OK
 
 
-def build_parser() -> argparse.ArgumentParser:
+def plural(count: int, noun: str) -> str:
+    """`1 tick`, `2 ticks`, `1,000 ticks` (nouns that take an s)."""
+    return f"{count:,} {noun}{'' if count == 1 else 's'}"
+
+
+def command_of(argv: list[str]) -> str | None:
+    """The subcommand named in argv (the first word that is not an option), or None."""
+    for word in argv:
+        if not word.startswith("-"):
+            return word
+        if word == "--":
+            return None
+    return None
+
+
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The parser; with `command`, one of REGISTRARS' commands, only its module is loaded."""
+    from collide2d import __version__
+
     parser = argparse.ArgumentParser(
         prog="collide2d",
         description="Declarative 2D collision scenarios: run them, see them, keep them honest.",
     )
+    parser.add_argument("--version", action="version", version=f"collide2d {__version__}")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    register_run(subparsers)
-    golden_cli.register(subparsers)
-    validate.register(subparsers)
-    stress_cli.register(subparsers)
-    bench_cli.register(subparsers)
+    for module, function, commands in REGISTRARS:
+        if command is None or command in commands:
+            getattr(importlib.import_module(module), function)(subparsers)
     for sub in subparsers.choices.values():
         sub.add_argument(
             "--debug", action="store_true", help="print the traceback of an unexpected error"
@@ -122,25 +164,30 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    command = command_of(argv)
+    known = any(command in commands for _m, _f, commands in REGISTRARS)
+    parser = build_parser(command if known else None)
     args = parser.parse_args(argv)
+    from collide2d.runner.yamlsafe import ScenarioError
+
     try:
         return args.func(args)
-    except ScenarioError as err:
+    except ScenarioError as err:  # a refused scenario, or a refused [tool.collide2d] table
         print(str(err), file=sys.stderr)
         return EXIT_BAD_INPUT
-    except RunStopped as err:
-        print(str(err), file=sys.stderr)
-        return EXIT_BAD_INPUT
-    except OSError as err:
-        where = f"{err.filename}: " if err.filename else ""
-        print(f"collide2d: error: {where}{err.strerror or err}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+    except Exception as err:
+        if type(err).__name__ == "RunStopped":  # runner.run's, not imported unless a run ran
+            print(str(err), file=sys.stderr)
+            return EXIT_BAD_INPUT
+        if isinstance(err, OSError):
+            where = f"{err.filename}: " if err.filename else ""
+            print(f"collide2d: error: {where}{err.strerror or err}", file=sys.stderr)
+            return EXIT_BAD_INPUT
+        return unexpected(err, args)
     except KeyboardInterrupt:
         print("collide2d: interrupted; outputs already written are whole", file=sys.stderr)
         return 130
-    except Exception as err:  # a bug, not the user's input: say so in one line, exit 3
-        return unexpected(err, args)
 
 
 def unexpected(err: Exception, args: argparse.Namespace) -> int:

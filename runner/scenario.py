@@ -207,15 +207,22 @@ class Scenario:
     max_events_per_tick: int = DEFAULT_MAX_EVENTS_PER_TICK
 
 
-def load(path, *, overrides: dict | None = None, limits: Limits | None = None) -> Scenario:
-    """Read and check the scenario file at `path` (str or os.PathLike); ScenarioError if bad."""
+def load(
+    path, *, overrides: dict | None = None, limits: Limits | None = None, defaults=None
+) -> Scenario:
+    """Read and check the scenario file at `path` (str or os.PathLike); ScenarioError if bad.
+
+    `defaults`: model settings a project gives where the file gives none (`kind`, `substeps`,
+    `geometry`, `max_events_per_tick`; runner.config), below the file and the overrides."""
     shown = os.fspath(path)
     limits = limits if limits is not None else Limits()
     text, digest = ys.read_file(path, limits)
-    return _Reader(shown, shown, overrides, limits).scenario(text, digest)
+    return _Reader(shown, shown, overrides, limits, defaults).scenario(text, digest)
 
 
-def loads(text: str, path: str = "<string>", *, overrides=None, limits=None) -> Scenario:
+def loads(
+    text: str, path: str = "<string>", *, overrides=None, limits=None, defaults=None
+) -> Scenario:
     """Check scenario text; `path` only names it in errors (and gives the default name).
 
     Without a `name`, text read under the default path is named NAME_FOR_TEXT.
@@ -223,14 +230,15 @@ def loads(text: str, path: str = "<string>", *, overrides=None, limits=None) -> 
     limits = limits if limits is not None else Limits()
     ys.check_length(len(text), path, limits)  # characters: never more than the UTF-8 bytes
     digest = hashlib.sha256(text.encode("utf-8", "surrogatepass")).hexdigest()
-    return _Reader(path, None, overrides, limits).scenario(text, digest)
+    return _Reader(path, None, overrides, limits, defaults).scenario(text, digest)
 
 
 class _Reader(Nodes):
     """One reading of one scenario: its path, limits and overrides, and the top-level sections."""
 
-    def __init__(self, path: str, file_path: str | None, overrides, limits):
+    def __init__(self, path: str, file_path: str | None, overrides, limits, defaults=None):
         super().__init__(path)
+        self.defaults = dict(defaults or {})
         self.file_path = file_path
         self.limits = limits if limits is not None else Limits()
         self.overrides = {}
@@ -363,7 +371,9 @@ class _Reader(Nodes):
     def model(self, top: dict) -> tuple[str, int, str, int]:
         """(kind, substeps, geometry, max_events_per_tick) from `model` and the overrides."""
         kind, substeps, geometry, cap = "paper", 1, None, DEFAULT_MAX_EVENTS_PER_TICK
-        sub_node = geo_node = None
+        sub_node = geo_node = cap_node = None
+        if "model" not in top:
+            kind = self.defaults.get("kind", kind)
         if "model" in top:
             node = top["model"][1]
             if isinstance(node, yaml.MappingNode):
@@ -420,9 +430,31 @@ class _Reader(Nodes):
                     f"--max-events-per-tick {v}: must be a whole number from 1 to {MAX_EVENT_CAP}",
                 )
             cap = v
+        if self.model_from:  # the file's settings went with its model
+            sub_node = cap_node = None
+        substeps, geometry, cap = self.model_defaults(
+            kind, sub_node, geometry, cap_node, substeps, cap
+        )
         if geometry is None:
             geometry = "exact" if kind == "exact" else "box"
         return kind, substeps, geometry, cap
+
+    def model_defaults(self, kind, sub_node, geometry, cap_node, substeps, cap):
+        """The project's model defaults (runner.config) where neither the file nor the command
+        line set a value and the model takes it."""
+        d = self.defaults
+        if kind == "stepped" and sub_node is None and "substeps" in d:
+            substeps = d["substeps"]
+        if geometry is None and kind != "paper" and "geometry" in d:
+            geometry = d["geometry"]
+        if (
+            kind == "exact"
+            and cap_node is None
+            and "max_events_per_tick" in d
+            and "max_events_per_tick" not in self.overrides
+        ):
+            cap = d["max_events_per_tick"]
+        return substeps, geometry, cap
 
     def room(self, world, bodies, geometry, names, listed, lines) -> None:
         """Refuse, at the object, a moving object with no room on an axis it moves on (the exact
