@@ -18,7 +18,12 @@ import sys
 import traceback
 from importlib import resources
 
-from collide2d.runner.exitcodes import EXIT_BAD_INPUT, EXIT_OK, EXIT_UNEXPECTED
+from collide2d.runner.exitcodes import (
+    EXIT_BAD_INPUT,
+    EXIT_INTERRUPTED,
+    EXIT_OK,
+    EXIT_UNEXPECTED,
+)
 
 # (module, its function that adds subcommands, the commands it adds), in `--help` order.
 REGISTRARS = (
@@ -125,12 +130,32 @@ def cmd_run(args: argparse.Namespace) -> int:
             f"{counts['wall']:,} wall and {plural(counts['pair'], 'pair event')} "
             f"in {summary['run_time_s']:.3f}s{also} -> {target}"
         )
+    if "interrupted_at_tick" in summary:
+        print(
+            f"collide2d: interrupted at tick {summary['interrupted_at_tick']:,} of "
+            f"{scenario.ticks:,}; {target} holds the run so far (no GIF)",
+            file=sys.stderr,
+        )
+        return EXIT_INTERRUPTED
     return EXIT_OK
 
 
 def plural(count: int, noun: str) -> str:
     """`1 tick`, `2 ticks`, `1,000 ticks` (nouns that take an s)."""
     return f"{count:,} {noun}{'' if count == 1 else 's'}"
+
+
+# The commands that run kernels: they time compilation apart and say when it starts.
+COMPILING_COMMANDS = ("run", "check", "bless", "validate", "stress", "bench")
+
+
+def compile_notice() -> None:
+    """The one line a terminal shows when kernels start compiling."""
+    print(
+        "compiling kernels, first run only (numba caches them for later runs) …",
+        file=sys.stderr,
+        flush=True,
+    )
 
 
 def command_of(argv: list[str]) -> str | None:
@@ -171,6 +196,12 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     from collide2d.runner.yamlsafe import ScenarioError
 
+    if args.command in COMPILING_COMMANDS:
+        from collide2d.runner import compiling
+
+        quiet = getattr(args, "quiet", False) or not sys.stderr.isatty()
+        compiling.install(None if quiet else compile_notice)
+
     try:
         return args.func(args)
     except ScenarioError as err:  # a refused scenario, or a refused [tool.collide2d] table
@@ -187,7 +218,7 @@ def main(argv: list[str] | None = None) -> int:
         return unexpected(err, args)
     except KeyboardInterrupt:
         print("collide2d: interrupted; outputs already written are whole", file=sys.stderr)
-        return 130
+        return EXIT_INTERRUPTED
 
 
 def unexpected(err: Exception, args: argparse.Namespace) -> int:
