@@ -293,7 +293,7 @@ def _write_run(scenario: Scenario, folder: Path, options: RunOptions, plan) -> d
         )
         if gif.note and not options.quiet and sys.stderr.isatty():
             print(f"{scenario.name}: {gif.note}", file=sys.stderr)
-    log = outputs.EventsWriter(folder / "events.jsonl") if options.events else None
+    log = outputs.EventsWriter(folder / "events.jsonl", scenario.names) if options.events else None
     digits = max(6, len(str(scenario.ticks)))
 
     def on_frame(k: int, idx: np.ndarray) -> None:
@@ -325,7 +325,9 @@ def _write_run(scenario: Scenario, folder: Path, options: RunOptions, plan) -> d
         for writer in writers:
             writer.abort()
         raise
-    outputs.write_final_csv(folder / "final.csv", model.positions(), model.velocities())
+    outputs.write_final_csv(
+        folder / "final.csv", model.positions(), model.velocities(), scenario.names
+    )
     outputs.write_json(folder / "summary.json", summary)
     return summary
 

@@ -73,7 +73,7 @@ from collide2d.runner import assemble
 from collide2d.runner import yamlsafe as ys
 from collide2d.runner.assemble import PALETTE_SIZE
 from collide2d.runner.limits import Limits
-from collide2d.runner.nodes import MAX_INTEGER, Nodes, fmt, is_number
+from collide2d.runner.nodes import FAILED, MAX_INTEGER, Errors, Nodes, fmt, is_number
 from collide2d.runner.objects import (
     BLOCK_KEYS,
     BLOCK_SHAPES,
@@ -255,25 +255,42 @@ class _Reader(Nodes):
     # -- the document
 
     def scenario(self, text: str, digest: str) -> Scenario:
+        """Read the whole document, collecting the errors of its parts (up to MAX_ERRORS, in
+        line order: a part that depends on a refused one is not read, so that no error follows
+        from another); raise them all, or return the Scenario."""
         root = ys.compose(text, self.path, self.limits)
         self.root = root
-        top = self.mapping(root, "the scenario", TOP_KEYS)
-        self.version(top, root)
-        name = self.name(top)
-        description = ""
-        if "description" in top:
-            description = self.string(top["description"][1], "description")
-        world, background = self.world(top)
-        model, substeps, geometry, cap = self.model(top)
-        ticks = self.ticks(top, world.fps)
-        rules = ModelRules.of(model, geometry, self.model_from)
-        objects = ObjectReader(self.path, self.limits, world, rules, self.fps_from)
-        listed = objects.objects(top)
-        blocks = objects.blocks(top, len(listed))
-        outputs = OutputReader(self.path, self.limits, self.ticks_from)
-        output = outputs.output(top, ticks)
-        golden = outputs.golden(top, ticks)
-        bodies, names, lines, palette = assemble.bodies(self, listed, blocks, world, background)
+        self.errors = Errors()
+        top = self.mapping(root, "the scenario", TOP_KEYS, go_on=True)
+        self.attempt(self.version, top, root)
+        name = self.attempt(self.name, top)
+        description = self.attempt(self.description, top)
+        world_background = self.attempt(self.world, top)
+        settings = self.attempt(self.model, top)
+        ticks = FAILED
+        if world_background is not FAILED:
+            world, background = world_background
+            ticks = self.attempt(self.ticks, top, world.fps)
+        if world_background is not FAILED and settings is not FAILED:
+            model, substeps, geometry, cap = settings
+            rules = ModelRules.of(model, geometry, self.model_from)
+            objects = ObjectReader(self.path, self.limits, world, rules, self.fps_from)
+            objects.errors = self.errors
+            listed = self.attempt(objects.objects, top)
+            if listed is not FAILED:
+                blocks = self.attempt(objects.blocks, top, len(listed))
+        if ticks is not FAILED:
+            outputs = OutputReader(self.path, self.limits, self.ticks_from)
+            outputs.errors = self.errors
+            output = self.attempt(outputs.output, top, ticks)
+            golden = self.attempt(outputs.golden, top, ticks)
+        found = self.errors.error()
+        self.errors = None
+        if found is not None:
+            raise found
+        bodies, names, lines, palette = assemble.bodies(
+            self, listed, blocks, world, background, geometry
+        )
         if model == "exact":
             self.room(world, bodies, geometry, names, listed, lines)
         return Scenario(
@@ -295,6 +312,11 @@ class _Reader(Nodes):
             text_sha256=digest,
             max_events_per_tick=cap,
         )
+
+    def description(self, top: dict) -> str:
+        if "description" in top:
+            return self.string(top["description"][1], "description")
+        return ""
 
     def version(self, top: dict, root) -> None:
         if "version" not in top:
