@@ -180,7 +180,8 @@ def _table(pyproject: Path) -> dict | None:
     except (OSError, UnicodeDecodeError) as exc:
         raise ConfigError(str(pyproject), 1, 1, f"cannot read the file: {exc}") from None
     except tomllib.TOMLDecodeError as exc:
-        line, col = getattr(exc, "lineno", 1) or 1, getattr(exc, "colno", 1) or 1
+        at = re.search(r"\(at line (\d+), column (\d+)\)", str(exc))
+        line, col = (int(at[1]), int(at[2])) if at else (1, 1)
         text = str(exc).split(" (at line")[0]
         raise ConfigError(str(pyproject), line, col, f"not valid TOML: {text}") from None
     table = data.get("tool", {}).get("collide2d") if isinstance(data.get("tool"), dict) else None

@@ -87,7 +87,7 @@ def init(root: Path) -> list[str]:
     if has:
         said.append(f"kept      {pyproject} (it has a [tool.collide2d] table)")
     else:
-        said.append(_append(pyproject, TABLE_TEXT))
+        said.append(_append(pyproject, TABLE_TEXT, blank_line=True))
     gitignore = root / ".gitignore"
     lines = gitignore.read_text(encoding="utf-8").splitlines() if gitignore.is_file() else []
     if IGNORE in lines or IGNORE.rstrip("/") in lines or "/" + IGNORE in lines:
@@ -97,11 +97,14 @@ def init(root: Path) -> list[str]:
     return said
 
 
-def _append(path: Path, text: str) -> str:
-    """Append `text` to `path` (created if missing) on a line of its own; the line to print."""
+def _append(path: Path, text: str, blank_line: bool = False) -> str:
+    """Append `text` to `path` (created if missing) from a line of its own (after a blank line
+    with `blank_line`); the line to print."""
     if path.is_file():
         old = path.read_text(encoding="utf-8")
-        sep = "" if not old or old.endswith("\n\n") else ("\n" if old.endswith("\n") else "\n\n")
+        sep = "" if not old or old.endswith("\n") else "\n"
+        if blank_line and old and not (old + sep).endswith("\n\n"):
+            sep += "\n"
         with open(path, "a", encoding="utf-8") as f:
             f.write(sep + text)
         return f"extended  {path}"

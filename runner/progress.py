@@ -25,7 +25,6 @@ class Progress:
             total=max(int(total), 1),
             desc=label,
             unit=" ticks",
-            unit_scale=True,
             file=stream if stream is not None else sys.stderr,
             dynamic_ncols=True,
             leave=False,
