@@ -46,6 +46,7 @@ class Errors:
 
     def __init__(self):
         self.found: list[ScenarioError] = []
+        self.stopped: ScenarioError | None = None  # raised once MAX_ERRORS were found
 
     def add(self, exc: ScenarioError) -> None:
         self.found.extend(exc.errors if isinstance(exc, ys.ScenarioErrors) else [exc])
@@ -93,9 +94,12 @@ class Nodes:
         try:
             return read(*args)
         except ScenarioError as exc:
+            if exc is self.errors.stopped:  # on its way out through the enclosing parts
+                raise
             self.errors.add(exc)
             if self.errors.full():
-                raise self.errors.error() from None
+                self.errors.stopped = self.errors.error()
+                raise self.errors.stopped from None
             return FAILED
 
     def each(self, read, items) -> list:

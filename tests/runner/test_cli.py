@@ -80,7 +80,9 @@ def test_events_and_no_events(tmp_path):
         "t": 5.1,
         "type": "pair",
         "a": 0,
+        "a_name": "left",  # the scenario names its objects
         "b": 1,
+        "b_name": "right",
         "axis": "x",
         "xdiff": 2,
         "ydiff": 10,
