@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
+from numba.extending import overload
 
 from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON
 
@@ -315,6 +316,122 @@ def _draw_one(buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, c
             cx1,
             cy1,
         )
+
+
+# A renderer's *shapes marker*: a zero-length array whose dtype says which kinds besides boxes the
+# scene has. Kernels call `draw_shape(marker, ...)`, which numba compiles to the drawing code of
+# those kinds only (the dtype is part of the kernel's signature, so each set is its own cached
+# specialisation): a scene of boxes never compiles the circle and polygon rasterisers.
+_SHAPES_DTYPES = (np.uint8, np.uint16, np.uint32, np.uint64)  # boxes; +circles; +polygons; +both
+
+
+def shapes_marker(kind: np.ndarray) -> np.ndarray:
+    """The marker of the kinds in `kind` (n,) for `draw_shape`."""
+    kind = np.asarray(kind)
+    circles = bool((kind == KIND_CIRCLE).any())
+    polygons = bool((kind == KIND_POLYGON).any())
+    return np.zeros(0, _SHAPES_DTYPES[circles + 2 * polygons])
+
+
+def draw_shape(
+    shapes, buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, cx0, cy0, cx1, cy1
+):
+    """`_draw_one` for a scene whose kinds `shapes` names (this body runs only without the JIT)."""
+    _draw_one(buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, cx0, cy0, cx1, cy1)
+
+
+@overload(draw_shape)
+def _draw_shape(
+    shapes, buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, cx0, cy0, cx1, cy1
+):
+    bits = shapes.dtype.bitwidth
+    if bits == 64:  # every kind
+
+        def every(
+            shapes,
+            buf,
+            i,
+            x,
+            y,
+            kind,
+            wh,
+            color,
+            fill,
+            vert_start,
+            verts,
+            scratch,
+            cx0,
+            cy0,
+            cx1,
+            cy1,
+        ):
+            _draw_one(
+                buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, cx0, cy0, cx1, cy1
+            )
+
+        return every
+    if bits == 16:  # boxes and circles
+
+        def rounds(
+            shapes,
+            buf,
+            i,
+            x,
+            y,
+            kind,
+            wh,
+            color,
+            fill,
+            vert_start,
+            verts,
+            scratch,
+            cx0,
+            cy0,
+            cx1,
+            cy1,
+        ):
+            if kind[i] == KIND_CIRCLE:
+                _circle(buf, x, y, wh[i, 0], color[i], fill[i], scratch, cx0, cy0, cx1, cy1)
+            else:
+                _box(buf, x, y, wh[i, 0], wh[i, 1], color[i], fill[i], cx0, cy0, cx1, cy1)
+
+        return rounds
+    if bits == 32:  # boxes and polygons
+
+        def flat(
+            shapes,
+            buf,
+            i,
+            x,
+            y,
+            kind,
+            wh,
+            color,
+            fill,
+            vert_start,
+            verts,
+            scratch,
+            cx0,
+            cy0,
+            cx1,
+            cy1,
+        ):
+            if kind[i] == KIND_POLYGON:
+                _polygon(
+                    buf, x, y, verts, vert_start[i], vert_start[i + 1], color[i], fill[i],
+                    scratch, cx0, cy0, cx1, cy1,
+                )  # fmt: skip
+            else:
+                _box(buf, x, y, wh[i, 0], wh[i, 1], color[i], fill[i], cx0, cy0, cx1, cy1)
+
+        return flat
+
+    def boxes(
+        shapes, buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, cx0, cy0, cx1, cy1
+    ):
+        _box(buf, x, y, wh[i, 0], wh[i, 1], color[i], fill[i], cx0, cy0, cx1, cy1)
+
+    return boxes
 
 
 def dda_line(x0: int, y0: int, x1: int, y1: int) -> np.ndarray:

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from collide2d.engine.draw import _draw_one, _fill_rect
+from collide2d.engine.draw import _fill_rect, draw_shape, shapes_marker
 from collide2d.engine.world import KIND_CIRCLE, KIND_POLYGON, Bodies, WorldSpec
 
 # Rounded positions are clamped to +-POSITION_LIMIT_PX (px) so that pixel arithmetic on an object
@@ -61,7 +61,7 @@ def _round_into(pos, out):
 @njit(cache=True)
 def _redraw_all(buf, ipos, art, scratch):
     """Clear the frame and draw every object in id order (`art`: see `Renderer`)."""
-    kind, wh, color, fill, vert_start, verts, ext = art
+    kind, wh, color, fill, vert_start, verts, ext, shapes = art
     h, w = buf.shape
     buf[:, :] = 0
     for i in range(kind.shape[0]):
@@ -72,9 +72,10 @@ def _redraw_all(buf, ipos, art, scratch):
         cx1 = min(x + ext[i, 2], w - 1)
         cy1 = min(y + ext[i, 3], h - 1)
         if cx0 <= cx1 and cy0 <= cy1:
-            _draw_one(
-                buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, cx0, cy0, cx1, cy1
-            )
+            draw_shape(
+                shapes, buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch,
+                cx0, cy0, cx1, cy1,
+            )  # fmt: skip
 
 
 @njit(cache=True)
@@ -89,7 +90,7 @@ def _redraw_dirty(buf, old, new, art, scratch, rects, max_area):
     frame is cleared and every object meeting one is drawn, clipped to it, in id order, so each of
     those pixels ends up with the colour of the last object covering it, as in a full redraw.
     """
-    kind, wh, color, fill, vert_start, verts, ext = art
+    kind, wh, color, fill, vert_start, verts, ext, shapes = art
     h, w = buf.shape
     n = kind.shape[0]
     count = 0
@@ -143,7 +144,8 @@ def _redraw_dirty(buf, old, new, art, scratch, rects, max_area):
             cx1 = min(ox1, rects[r, 2])
             cy1 = min(oy1, rects[r, 3])
             if cx0 <= cx1 and cy0 <= cy1:
-                _draw_one(
+                draw_shape(
+                    shapes,
                     buf,
                     i,
                     x,
@@ -213,6 +215,7 @@ class Renderer:
             self._vert_start,
             self._verts,
             self._ext,
+            shapes_marker(self._kind),  # which drawing code the kernels compile
         )
         counts = np.diff(self._vert_start) if n else np.zeros(0, np.int64)
         diam = self._wh[self._kind == KIND_CIRCLE, 0]
