@@ -169,7 +169,8 @@ def command_of(argv: list[str]) -> str | None:
 
 
 def build_parser(command: str | None = None) -> argparse.ArgumentParser:
-    """The parser; with `command`, one of REGISTRARS' commands, only its module is loaded."""
+    """The parser; with `command`, one of REGISTRARS' commands, only its module is loaded ("":
+    none)."""
     from collide2d import __version__
 
     parser = argparse.ArgumentParser(
@@ -192,6 +193,8 @@ def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     command = command_of(argv)
     known = any(command in commands for _m, _f, commands in REGISTRARS)
+    if command is None and "--version" in argv and "-h" not in argv and "--help" not in argv:
+        known, command = True, ""  # the version alone: no command's module is needed
     parser = build_parser(command if known else None)
     args = parser.parse_args(argv)
     from collide2d.runner.yamlsafe import ScenarioError
