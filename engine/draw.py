@@ -318,19 +318,19 @@ def _draw_one(buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, c
         )
 
 
-# A renderer's *shapes marker*: a zero-length array whose dtype says which kinds besides boxes the
-# scene has. Kernels call `draw_shape(marker, ...)`, which numba compiles to the drawing code of
-# those kinds only (the dtype is part of the kernel's signature, so each set is its own cached
-# specialisation): a scene of boxes never compiles the circle and polygon rasterisers.
-_SHAPES_DTYPES = (np.uint8, np.uint16, np.uint32, np.uint64)  # boxes; +circles; +polygons; +both
+# A renderer's *shapes marker*: a zero-length array whose dtype says whether the scene has only
+# boxes (uint8) or other kinds too (uint64). Kernels call `draw_shape(marker, ...)`, which numba
+# compiles to the box code alone or to every kind's (the dtype is part of the kernel's signature,
+# so each is its own cached specialisation): a scene of boxes never compiles the circle and polygon
+# rasterisers. Two variants, not one per set of kinds, so that a corpus of mixed scenes compiles
+# the rasteriser at most twice.
+_BOXES_ONLY, _EVERY_KIND = np.uint8, np.uint64
 
 
 def shapes_marker(kind: np.ndarray) -> np.ndarray:
     """The marker of the kinds in `kind` (n,) for `draw_shape`."""
-    kind = np.asarray(kind)
-    circles = bool((kind == KIND_CIRCLE).any())
-    polygons = bool((kind == KIND_POLYGON).any())
-    return np.zeros(0, _SHAPES_DTYPES[circles + 2 * polygons])
+    boxes_only = bool((np.asarray(kind) == KIND_BOX).all())
+    return np.zeros(0, _BOXES_ONLY if boxes_only else _EVERY_KIND)
 
 
 def draw_shape(
@@ -344,94 +344,25 @@ def draw_shape(
 def _draw_shape(
     shapes, buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, cx0, cy0, cx1, cy1
 ):
-    bits = shapes.dtype.bitwidth
-    if bits == 64:  # every kind
+    if shapes.dtype.bitwidth == 8:
 
-        def every(
-            shapes,
-            buf,
-            i,
-            x,
-            y,
-            kind,
-            wh,
-            color,
-            fill,
-            vert_start,
-            verts,
-            scratch,
-            cx0,
-            cy0,
-            cx1,
-            cy1,
-        ):
-            _draw_one(
-                buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, cx0, cy0, cx1, cy1
-            )
+        def boxes(
+            shapes, buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, cx0, cy0,
+            cx1, cy1,
+        ):  # fmt: skip
+            _box(buf, x, y, wh[i, 0], wh[i, 1], color[i], fill[i], cx0, cy0, cx1, cy1)
 
-        return every
-    if bits == 16:  # boxes and circles
+        return boxes
 
-        def rounds(
-            shapes,
-            buf,
-            i,
-            x,
-            y,
-            kind,
-            wh,
-            color,
-            fill,
-            vert_start,
-            verts,
-            scratch,
-            cx0,
-            cy0,
-            cx1,
-            cy1,
-        ):
-            if kind[i] == KIND_CIRCLE:
-                _circle(buf, x, y, wh[i, 0], color[i], fill[i], scratch, cx0, cy0, cx1, cy1)
-            else:
-                _box(buf, x, y, wh[i, 0], wh[i, 1], color[i], fill[i], cx0, cy0, cx1, cy1)
+    def every(
+        shapes, buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, cx0, cy0, cx1,
+        cy1,
+    ):  # fmt: skip
+        _draw_one(
+            buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, cx0, cy0, cx1, cy1
+        )
 
-        return rounds
-    if bits == 32:  # boxes and polygons
-
-        def flat(
-            shapes,
-            buf,
-            i,
-            x,
-            y,
-            kind,
-            wh,
-            color,
-            fill,
-            vert_start,
-            verts,
-            scratch,
-            cx0,
-            cy0,
-            cx1,
-            cy1,
-        ):
-            if kind[i] == KIND_POLYGON:
-                _polygon(
-                    buf, x, y, verts, vert_start[i], vert_start[i + 1], color[i], fill[i],
-                    scratch, cx0, cy0, cx1, cy1,
-                )  # fmt: skip
-            else:
-                _box(buf, x, y, wh[i, 0], wh[i, 1], color[i], fill[i], cx0, cy0, cx1, cy1)
-
-        return flat
-
-    def boxes(
-        shapes, buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, cx0, cy0, cx1, cy1
-    ):
-        _box(buf, x, y, wh[i, 0], wh[i, 1], color[i], fill[i], cx0, cy0, cx1, cy1)
-
-    return boxes
+    return every
 
 
 def dda_line(x0: int, y0: int, x1: int, y1: int) -> np.ndarray:

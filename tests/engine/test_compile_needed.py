@@ -43,8 +43,9 @@ def test_the_marker_finds_the_pairs_its_method_finds(method):
     "kinds, dtype",
     [
         ([KIND_BOX], np.uint8),
-        ([KIND_BOX, KIND_CIRCLE], np.uint16),
-        ([KIND_POLYGON], np.uint32),
+        ([KIND_BOX, KIND_BOX], np.uint8),
+        ([KIND_BOX, KIND_CIRCLE], np.uint64),
+        ([KIND_POLYGON], np.uint64),
         ([KIND_CIRCLE, KIND_POLYGON, KIND_BOX], np.uint64),
     ],
 )
@@ -64,8 +65,8 @@ objects:
 """
 
 
-@pytest.mark.parametrize("keep", ["box|circle", "box|polygon", "box"])
-def test_a_scene_of_some_kinds_draws_as_the_code_with_every_kind(keep):
+def test_a_scene_of_boxes_draws_as_the_code_with_every_kind():
+    keep = "box"
     full = loads(SHOWCASE)
     lines = SHOWCASE.splitlines()
     kept = [
@@ -79,7 +80,7 @@ def test_a_scene_of_some_kinds_draws_as_the_code_with_every_kind(keep):
     some = Renderer(sc.world, sc.bodies)
     every = Renderer(sc.world, sc.bodies)
     every._art = every._art[:-1] + (np.zeros(0, np.uint64),)  # the code with every kind
-    assert some._art[-1].dtype != np.uint64
+    assert some._art[-1].dtype == np.uint8
     first = some.draw_full(pos).copy()
     np.testing.assert_array_equal(first, every.draw_full(pos))
     assert first.any()
