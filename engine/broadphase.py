@@ -39,6 +39,7 @@ import math
 
 import numpy as np
 from numba import njit, prange
+from numba.extending import overload
 
 from collide2d.engine.sort import heap_argsort, sort_order
 
@@ -439,6 +440,46 @@ def candidates(method, lo, hi, movable, cell, order, out, ws):
     if method == METHOD_CELLS:
         return cell_candidates(lo, hi, movable, cell, order, out, ws)
     return sweep_candidates(lo, hi, movable, order, out, ws)
+
+
+# A kernel that takes its finder's *marker*, a zero-length array whose dtype names the method,
+# calls `find(marker, ...)`: numba compiles that to the one finder the dtype names (the dtype is
+# part of the kernel's signature, so each method is its own cached specialisation), where
+# `candidates(method, ...)` compiles all three into every kernel that calls it.
+_MARKER_DTYPES = (np.int8, np.int16, np.int32)  # METHOD_SWEEP, METHOD_GRID, METHOD_CELLS
+
+
+def marker(method: int) -> np.ndarray:
+    """The marker of `method` (METHOD_SWEEP, METHOD_GRID or METHOD_CELLS) for `find`."""
+    return np.zeros(0, _MARKER_DTYPES[method])
+
+
+def find(marker, lo, hi, movable, cell, order, out, ws):
+    """`candidates` by the method `marker` names (this body runs only without the JIT)."""
+    method = [np.dtype(d) for d in _MARKER_DTYPES].index(marker.dtype)
+    return candidates(method, lo, hi, movable, cell, order, out, ws)
+
+
+@overload(find)
+def _find(marker, lo, hi, movable, cell, order, out, ws):
+    bits = marker.dtype.bitwidth
+    if bits == 8:
+
+        def sweep(marker, lo, hi, movable, cell, order, out, ws):
+            return sweep_candidates(lo, hi, movable, order, out, ws)
+
+        return sweep
+    if bits == 16:
+
+        def grid(marker, lo, hi, movable, cell, order, out, ws):
+            return grid_candidates(lo, hi, movable, cell, out, ws)
+
+        return grid
+
+    def cells(marker, lo, hi, movable, cell, order, out, ws):
+        return cell_candidates(lo, hi, movable, cell, order, out, ws)
+
+    return cells
 
 
 def keys_to_pairs(keys: np.ndarray) -> np.ndarray:

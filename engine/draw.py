@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
+from numba.extending import overload
 
 from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON
 
@@ -315,6 +316,53 @@ def _draw_one(buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, c
             cx1,
             cy1,
         )
+
+
+# A renderer's *shapes marker*: a zero-length array whose dtype says whether the scene has only
+# boxes (uint8) or other kinds too (uint64). Kernels call `draw_shape(marker, ...)`, which numba
+# compiles to the box code alone or to every kind's (the dtype is part of the kernel's signature,
+# so each is its own cached specialisation): a scene of boxes never compiles the circle and polygon
+# rasterisers. Two variants, not one per set of kinds, so that a corpus of mixed scenes compiles
+# the rasteriser at most twice.
+_BOXES_ONLY, _EVERY_KIND = np.uint8, np.uint64
+
+
+def shapes_marker(kind: np.ndarray) -> np.ndarray:
+    """The marker of the kinds in `kind` (n,) for `draw_shape`."""
+    boxes_only = bool((np.asarray(kind) == KIND_BOX).all())
+    return np.zeros(0, _BOXES_ONLY if boxes_only else _EVERY_KIND)
+
+
+def draw_shape(
+    shapes, buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, cx0, cy0, cx1, cy1
+):
+    """`_draw_one` for a scene whose kinds `shapes` names (this body runs only without the JIT)."""
+    _draw_one(buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, cx0, cy0, cx1, cy1)
+
+
+@overload(draw_shape)
+def _draw_shape(
+    shapes, buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, cx0, cy0, cx1, cy1
+):
+    if shapes.dtype.bitwidth == 8:
+
+        def boxes(
+            shapes, buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, cx0, cy0,
+            cx1, cy1,
+        ):  # fmt: skip
+            _box(buf, x, y, wh[i, 0], wh[i, 1], color[i], fill[i], cx0, cy0, cx1, cy1)
+
+        return boxes
+
+    def every(
+        shapes, buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, cx0, cy0, cx1,
+        cy1,
+    ):  # fmt: skip
+        _draw_one(
+            buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, cx0, cy0, cx1, cy1
+        )
+
+    return every
 
 
 def dda_line(x0: int, y0: int, x1: int, y1: int) -> np.ndarray:

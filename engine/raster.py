@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from collide2d.engine.draw import _draw_one, _fill_rect
+from collide2d.engine.draw import _fill_rect, draw_shape, shapes_marker
 from collide2d.engine.threads import chunks_for
 from collide2d.engine.world import KIND_CIRCLE, KIND_POLYGON, Bodies, WorldSpec
 
@@ -66,7 +66,7 @@ def _round_into(pos, out):
 @njit(cache=True)
 def _redraw_all(buf, ipos, art, scratch):
     """Clear the frame and draw every object in id order (`art`: see `Renderer`)."""
-    kind, wh, color, fill, vert_start, verts, ext = art
+    kind, wh, color, fill, vert_start, verts, ext, shapes = art
     h, w = buf.shape
     buf[:, :] = 0
     for i in range(kind.shape[0]):
@@ -77,13 +77,14 @@ def _redraw_all(buf, ipos, art, scratch):
         cx1 = min(x + ext[i, 2], w - 1)
         cy1 = min(y + ext[i, 3], h - 1)
         if cx0 <= cx1 and cy0 <= cy1:
-            _draw_one(
-                buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, cx0, cy0, cx1, cy1
-            )
+            draw_shape(
+                shapes, buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch,
+                cx0, cy0, cx1, cy1,
+            )  # fmt: skip
 
 
 @njit(cache=True)
-def _draw_band(buf, y0, y1, ipos, kind, wh, color, fill, vert_start, verts, ext, scratch):
+def _draw_band(buf, y0, y1, ipos, kind, wh, color, fill, vert_start, verts, ext, shapes, scratch):
     """Clear rows y0 ... y1-1 of the frame and draw every object in id order, clipped to them."""
     h, w = buf.shape
     for y in range(y0, y1):
@@ -97,13 +98,14 @@ def _draw_band(buf, y0, y1, ipos, kind, wh, color, fill, vert_start, verts, ext,
         cx1 = min(x + ext[i, 2], w - 1)
         cy1 = min(y + ext[i, 3], y1 - 1)
         if cx0 <= cx1 and cy0 <= cy1:
-            _draw_one(
-                buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, cx0, cy0, cx1, cy1
-            )
+            draw_shape(
+                shapes, buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch,
+                cx0, cy0, cx1, cy1,
+            )  # fmt: skip
 
 
 @njit(cache=True, parallel=True)
-def _draw_bands(buf, ipos, kind, wh, color, fill, vert_start, verts, ext, scratch, bands):
+def _draw_bands(buf, ipos, kind, wh, color, fill, vert_start, verts, ext, shapes, scratch, bands):
     """The frame cut into `bands` bands of rows, one per thread; each band cleared and every
     object drawn clipped to it, in id order. Clipping keeps each pixel's colour (the dirty-region
     redraw relies on the same), so the frame equals `_redraw_all`'s, to the byte."""
@@ -111,15 +113,15 @@ def _draw_bands(buf, ipos, kind, wh, color, fill, vert_start, verts, ext, scratc
     for b in prange(bands):
         _draw_band(
             buf, b * h // bands, (b + 1) * h // bands, ipos, kind, wh, color, fill, vert_start,
-            verts, ext, scratch[b],
+            verts, ext, shapes, scratch[b],
         )
 
 
 @njit(cache=True)
 def _redraw_split(buf, ipos, art, scratch, bands):
     """`_redraw_all` split among threads by bands of rows (`_draw_bands`); scratch (bands, k)."""
-    kind, wh, color, fill, vert_start, verts, ext = art
-    _draw_bands(buf, ipos, kind, wh, color, fill, vert_start, verts, ext, scratch, bands)
+    kind, wh, color, fill, vert_start, verts, ext, shapes = art
+    _draw_bands(buf, ipos, kind, wh, color, fill, vert_start, verts, ext, shapes, scratch, bands)
 
 
 @njit(cache=True)
@@ -134,7 +136,7 @@ def _redraw_dirty(buf, old, new, art, scratch, rects, max_area):
     frame is cleared and every object meeting one is drawn, clipped to it, in id order, so each of
     those pixels ends up with the colour of the last object covering it, as in a full redraw.
     """
-    kind, wh, color, fill, vert_start, verts, ext = art
+    kind, wh, color, fill, vert_start, verts, ext, shapes = art
     h, w = buf.shape
     n = kind.shape[0]
     count = 0
@@ -188,7 +190,8 @@ def _redraw_dirty(buf, old, new, art, scratch, rects, max_area):
             cx1 = min(ox1, rects[r, 2])
             cy1 = min(oy1, rects[r, 3])
             if cx0 <= cx1 and cy0 <= cy1:
-                _draw_one(
+                draw_shape(
+                    shapes,
                     buf,
                     i,
                     x,
@@ -258,6 +261,7 @@ class Renderer:
             self._vert_start,
             self._verts,
             self._ext,
+            shapes_marker(self._kind),  # which drawing code the kernels compile
         )
         counts = np.diff(self._vert_start) if n else np.zeros(0, np.int64)
         diam = self._wh[self._kind == KIND_CIRCLE, 0]

@@ -1,6 +1,8 @@
 """Objects to arrays: the checked objects and blocks of a scenario become `Bodies` and a palette.
 
-Listed objects are checked first (each inside the world, no two overlapping; touching is fine), then
+Listed objects are checked first (each inside the world, no two overlapping; touching is fine;
+under `geometry: exact` overlap is judged by the real shapes, so circles racked tightly in touching
+boxes are legal), then
 each generate block is drawn by `runner.generate` around them; the per-object arrays hold the listed
 objects first, then each block's objects, in id order. Colours are indexed into a palette of at most
 PALETTE_SIZE rows: row 0 the background, then each distinct object colour in order of first use.
@@ -8,12 +10,15 @@ PALETTE_SIZE rows: row 0 the background, then each distinct object colour in ord
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 
 from collide2d.engine.world import Bodies, Looks, WorldSpec
 from collide2d.runner import generate as gen
 from collide2d.runner.nodes import Nodes, fmt
 from collide2d.runner.objects import Block, Listed
+from collide2d.runner.yamlsafe import ScenarioError
 
 PALETTE_SIZE = 256  # palette rows: the background and up to 255 object colours
 
@@ -24,10 +29,12 @@ def bodies(
     blocks: list[Block],
     world: WorldSpec,
     background,
+    geometry: str = "box",
     table=None,
 ):
     """(Bodies, names, lines, palette) of the listed objects, or the rows of a `table`
-    (runner.table, checked already but for overlaps), then the generate blocks."""
+    (runner.table, checked already but for overlaps), then the generate blocks; starting
+    overlap judged by the real shapes under `geometry` exact."""
     if table is not None:
         listed = _TableRows(table, reader)
     n_listed = len(listed)
@@ -37,7 +44,7 @@ def bodies(
     else:
         pos = np.array([o.pos for o in listed], np.float64).reshape(-1, 2)
         size = np.array([o.size for o in listed], np.float64).reshape(-1, 2)
-        check_placement(reader, listed, pos, size, world)
+        check_placement(reader, listed, pos, size, world, geometry)
 
     palette = [background]
     index: dict[tuple[int, int, int], int] = {}
@@ -67,8 +74,16 @@ def bodies(
         listed_colors = [color_index(o.color, o.color_node or o.node) for o in listed]
     block_colors = [color_index(b.color, b.color_node or b.node) for b in blocks]
 
+    if blocks and geometry == "exact" and (pair := gen.first_overlap(pos, size)) is not None:
+        raise reader.error(
+            blocks[0].node,
+            f"generate places objects around the listed objects' boxes, which must not overlap "
+            f"here: objects[{pair[1]}] and objects[{pair[0]}] (shapes that only touch are legal "
+            "without generate)",
+        )
     try:
-        drawn = gen.generate(world.width, world.height, pos, size, [b.spec for b in blocks])
+        specs = [b.spec for b in blocks]
+        drawn = gen.generate(world.width, world.height, pos, size, specs) if blocks else []
     except gen.PlacementError as exc:
         raise reader.error(blocks[exc.block].node, f"generate[{exc.block}]: {exc}") from None
 
@@ -131,11 +146,15 @@ def bodies(
     for b, c in zip(blocks, counts, strict=True):
         names.extend([f"{b.name}-{j}" for j in range(c)] if b.name is not None else [None] * c)
         lines.extend([b.node.start_mark.line + 1] * c)
+    check_names(reader, names, listed, blocks, lines)
     return bodies, tuple(names), tuple(lines), np.array(palette, np.uint8).reshape(-1, 3)
 
 
-def check_placement(reader: Nodes, listed: list[Listed], pos, size, world: WorldSpec) -> None:
-    """Every listed box inside the world, no two overlapping (touching is fine)."""
+def check_placement(
+    reader: Nodes, listed: list[Listed], pos, size, world: WorldSpec, geometry: str = "box"
+) -> None:
+    """Every listed box inside the world, no two overlapping (touching is fine): no two boxes,
+    or under `geometry` "exact" no two real shapes."""
     if not listed:
         return
     end = pos + size
@@ -149,6 +168,8 @@ def check_placement(reader: Nodes, listed: list[Listed], pos, size, world: World
             f"[0, {world.height})",
         )
     found = gen.first_overlap(pos, size)
+    if found is not None and geometry == "exact":
+        found = _first_shape_overlap(listed, pos, size)
     if found is not None:
         a, b = found
         la = listed[a].node.start_mark.line + 1
@@ -156,9 +177,67 @@ def check_placement(reader: Nodes, listed: list[Listed], pos, size, world: World
         raise reader.error(
             listed[b].node,
             f"objects[{b}] (line {lb}) overlaps objects[{a}] "
-            f"(line {la}) at the start: boxes {_box_text(pos[b], size[b])} and "
+            f"(line {la}) at the start: "
+            f"{'shapes in boxes' if geometry == 'exact' else 'boxes'} "
+            f"{_box_text(pos[b], size[b])} and "
             f"{_box_text(pos[a], size[a])}",
         )
+
+
+def _first_shape_overlap(listed: list[Listed], pos, size) -> tuple[int, int] | None:
+    """The first pair (a, b) in (b, a) order whose exact shapes overlap with positive area."""
+    from collide2d.engine.broadphase import METHOD_SWEEP, find_pairs
+    from collide2d.engine.contact import penetration
+    from collide2d.engine.shapes import build_cores
+
+    n = len(listed)
+    polys = [o.verts for o in listed if o.verts is not None]
+    nverts = [0 if o.verts is None else o.verts.shape[0] for o in listed]
+    shapes = SimpleNamespace(
+        kind=np.array([o.kind for o in listed], np.int8),
+        size=size,
+        vert_start=np.concatenate([[0], np.cumsum(nverts)]).astype(np.int64),
+        verts=np.concatenate(polys).astype(np.int64) if polys else np.zeros((0, 2), np.int64),
+    )
+    cores = build_cores(shapes, "exact")
+    pairs = find_pairs(METHOD_SWEEP, pos, pos + size, np.ones(n, bool))
+
+    def shape(i):
+        core = slice(cores.start[i], cores.start[i + 1])
+        return (
+            cores.shape[i],
+            size[i, 0],
+            size[i, 1],
+            cores.radius[i],
+            cores.verts[core],
+            cores.normals[core],
+        )
+
+    for a, b in sorted(pairs.tolist(), key=lambda p: (p[1], p[0])):
+        q = pos[b] - pos[a]
+        if penetration(q[0], q[1], *shape(a), *shape(b))[0] > 0:
+            return a, b
+    return None
+
+
+def check_names(reader: Nodes, names, listed, blocks, lines) -> None:
+    """No two objects share a name (a generate block's `name` names its objects NAME-0, ...)."""
+    seen: dict[str, int] = {}
+    for i, name in enumerate(names):
+        if name is None:
+            continue
+        if name in seen:
+            j = seen[name]
+            node = listed[i].node if i < len(listed) else None
+            where = f"objects[{i}]" if i < len(listed) else "a generated object"
+            message = (
+                f"{where} is named {name!r}, like object {j} (line {lines[j]}); "
+                "names must differ, they name the objects in events.jsonl and final.csv"
+            )
+            if node is None:
+                raise ScenarioError(reader.path, lines[i], 1, message)
+            raise reader.error(node, message)
+        seen[name] = i
 
 
 def _box_text(p, s) -> str:

@@ -1,39 +1,42 @@
 """The `collide2d` command line (also `python -m collide2d`): parse, dispatch, map errors to exits.
 
 Each subcommand lives with what it drives (`run` here; `validate`/`schema` in runner.validate;
-`check`/`bless` in runner.golden.cli; `stress` and `bench` in runner.stress.cli and
-runner.bench.cli, which load the rest of their packages only when their command runs) and registers
-itself on the parser. Exit status: 0 fine, 1 a check found a difference, 2 bad input or usage, 3 an
-unexpected error (one line naming the scenario; the traceback too with `--debug`). A refused
-scenario prints `FILE:LINE:COL: error: MESSAGE` on stderr and writes nothing.
+`check`/`bless` in runner.golden.cli; `stress`, `bench` and `sweep` in runner.stress.cli,
+runner.bench.cli and runner.sweep.cli; `init` in runner.init, `config` in runner.configcli) and
+registers itself on the parser. A command line imports only the module of its command
+(`REGISTRARS`), so a run starts without loading the golden, stress, bench or sweep code; `--help`
+and an unknown command load them all.
+Exit status: 0 fine, 1 a check found a difference, 2 bad input or usage, 3 an unexpected error (one
+line naming the scenario; the traceback too with `--debug`). A refused scenario prints
+`FILE:LINE:COL: error: MESSAGE` on stderr and writes nothing.
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib
 import sys
 import traceback
 from importlib import resources
 
-from collide2d.runner import validate
-from collide2d.runner.bench import cli as bench_cli
-from collide2d.runner.exitcodes import EXIT_BAD_INPUT, EXIT_OK, EXIT_UNEXPECTED
-from collide2d.runner.golden import cli as golden_cli
-from collide2d.runner.options import (
-    add_cap_argument,
-    add_limit_arguments,
-    add_override_arguments,
-    add_threads_argument,
-    apply_threads,
-    limits_from_args,
-    overrides_from_args,
-    positive_int,
+from collide2d.runner.exitcodes import (
+    EXIT_BAD_INPUT,
+    EXIT_INTERRUPTED,
+    EXIT_OK,
+    EXIT_UNEXPECTED,
 )
-from collide2d.runner.outputspec import OVERLAY_NAMES
-from collide2d.runner.run import RunOptions, RunStopped, run_to_dir
-from collide2d.runner.scenario import ScenarioError, load
-from collide2d.runner.stress import cli as stress_cli
-from collide2d.runner.sweep import cli as sweep_cli
+
+# (module, its function that adds subcommands, the commands it adds), in `--help` order.
+REGISTRARS = (
+    ("collide2d.runner.cli", "register_run", ("run",)),
+    ("collide2d.runner.golden.cli", "register", ("check", "bless")),
+    ("collide2d.runner.validate", "register", ("validate", "schema")),
+    ("collide2d.runner.stress.cli", "register", ("stress",)),
+    ("collide2d.runner.bench.cli", "register", ("bench",)),
+    ("collide2d.runner.sweep.cli", "register", ("sweep",)),
+    ("collide2d.runner.init", "register", ("init",)),
+    ("collide2d.runner.configcli", "register", ("config",)),
+)
 
 
 def demo_path() -> str:
@@ -42,6 +45,15 @@ def demo_path() -> str:
 
 
 def register_run(subparsers) -> None:
+    from collide2d.runner.options import (
+        add_cap_argument,
+        add_limit_arguments,
+        add_override_arguments,
+        add_threads_argument,
+        positive_int,
+    )
+    from collide2d.runner.outputspec import OVERLAY_NAMES
+
     p = subparsers.add_parser(
         "run",
         help="run a scenario and write its frames, GIF and event log",
@@ -50,7 +62,11 @@ def register_run(subparsers) -> None:
         "Flags override the scenario's output and settings.",
     )
     p.add_argument("scenario", nargs="?", help="scenario YAML file (default: the bundled demo)")
-    p.add_argument("--out", default="out", metavar="DIR", help="output folder (default: out)")
+    p.add_argument(
+        "--out",
+        metavar="DIR",
+        help="output folder (default: the project's [tool.collide2d] out, else out)",
+    )
     p.add_argument(
         "--gif",
         action=argparse.BooleanOptionalAction,
@@ -101,6 +117,8 @@ def register_run(subparsers) -> None:
 
 def overlay_names(text: str) -> tuple[str, ...]:
     """`--overlay a,b`: the overlay names in their fixed order; `none` for none."""
+    from collide2d.runner.outputspec import OVERLAY_NAMES
+
     names = [n.strip() for n in text.split(",") if n.strip()]
     if names == ["none"]:
         return ()
@@ -114,10 +132,21 @@ def overlay_names(text: str) -> tuple[str, ...]:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    apply_threads(args)
+    from collide2d.runner import config
+    from collide2d.runner.options import apply_threads, limits_from_args, overrides_from_args
+    from collide2d.runner.run import RunOptions, run_to_dir
+    from collide2d.runner.scenario import load
+
+    project = config.find()
+    apply_threads(args, project)
     path = args.scenario or demo_path()
-    limits = limits_from_args(args)
-    scenario = load(path, overrides=overrides_from_args(args), limits=limits)
+    limits = limits_from_args(args, project)
+    scenario = load(
+        path,
+        overrides=overrides_from_args(args),
+        limits=limits,
+        defaults=project.model_defaults(),
+    )
     out = scenario.output
     options = RunOptions(
         png=bool(out.frames) if args.png is None else args.png,
@@ -128,29 +157,69 @@ def cmd_run(args: argparse.Namespace) -> int:
         viewer=out.viewer if args.viewer is None else args.viewer,
         overlay=out.overlay if args.overlay is None else args.overlay,
     )
-    target, summary = run_to_dir(scenario, args.out, options, limits)
+    out_root = args.out or (project.folder("out") if project.file else "out")
+    target, summary = run_to_dir(scenario, out_root, options, limits)
     if not args.quiet:
         counts = summary["events"]
+        compiled = summary.get("compile_time_s", 0.0)
+        also = f" (+{compiled:.1f}s compiling kernels)" if compiled >= 0.05 else ""
         print(
-            f"{scenario.name}: {scenario.ticks} ticks under {scenario.model}, "
-            f"{counts['wall']:,} wall and {counts['pair']:,} pair events "
-            f"in {summary['run_time_s']:.3f}s -> {target}"
+            f"{scenario.name}: {plural(scenario.ticks, 'tick')} under {scenario.model}, "
+            f"{counts['wall']:,} wall and {plural(counts['pair'], 'pair event')} "
+            f"in {summary['run_time_s']:.3f}s{also} -> {target}"
         )
+    if "interrupted_at_tick" in summary:
+        print(
+            f"collide2d: interrupted at tick {summary['interrupted_at_tick']:,} of "
+            f"{scenario.ticks:,}; {target} holds the run so far (no GIF)",
+            file=sys.stderr,
+        )
+        return EXIT_INTERRUPTED
     return EXIT_OK
 
 
-def build_parser() -> argparse.ArgumentParser:
+def plural(count: int, noun: str) -> str:
+    """`1 tick`, `2 ticks`, `1,000 ticks` (nouns that take an s)."""
+    return f"{count:,} {noun}{'' if count == 1 else 's'}"
+
+
+# The commands that run kernels: they time compilation apart and say when it starts.
+COMPILING_COMMANDS = ("run", "check", "bless", "validate", "stress", "bench")
+
+
+def compile_notice() -> None:
+    """The one line a terminal shows when kernels start compiling."""
+    print(
+        "compiling kernels, first run only (numba caches them for later runs) …",
+        file=sys.stderr,
+        flush=True,
+    )
+
+
+def command_of(argv: list[str]) -> str | None:
+    """The subcommand named in argv (the first word that is not an option), or None."""
+    for word in argv:
+        if not word.startswith("-"):
+            return word
+        if word == "--":
+            return None
+    return None
+
+
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The parser; with `command`, one of REGISTRARS' commands, only its module is loaded ("":
+    none)."""
+    from collide2d import __version__
+
     parser = argparse.ArgumentParser(
         prog="collide2d",
         description="Declarative 2D collision scenarios: run them, see them, keep them honest.",
     )
+    parser.add_argument("--version", action="version", version=f"collide2d {__version__}")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    register_run(subparsers)
-    golden_cli.register(subparsers)
-    validate.register(subparsers)
-    stress_cli.register(subparsers)
-    bench_cli.register(subparsers)
-    sweep_cli.register(subparsers)
+    for module, function, commands in REGISTRARS:
+        if command is None or command in commands:
+            getattr(importlib.import_module(module), function)(subparsers)
     for sub in subparsers.choices.values():
         sub.add_argument(
             "--debug", action="store_true", help="print the traceback of an unexpected error"
@@ -159,25 +228,38 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    command = command_of(argv)
+    known = any(command in commands for _m, _f, commands in REGISTRARS)
+    if command is None and "--version" in argv and "-h" not in argv and "--help" not in argv:
+        known, command = True, ""  # the version alone: no command's module is needed
+    parser = build_parser(command if known else None)
     args = parser.parse_args(argv)
+    from collide2d.runner.yamlsafe import ScenarioError
+
+    if args.command in COMPILING_COMMANDS:
+        from collide2d.runner import compiling
+
+        quiet = getattr(args, "quiet", False) or not sys.stderr.isatty()
+        compiling.install(None if quiet else compile_notice)
+
     try:
         return args.func(args)
-    except ScenarioError as err:
+    except ScenarioError as err:  # a refused scenario, or a refused [tool.collide2d] table
         print(str(err), file=sys.stderr)
         return EXIT_BAD_INPUT
-    except RunStopped as err:
-        print(str(err), file=sys.stderr)
-        return EXIT_BAD_INPUT
-    except OSError as err:
-        where = f"{err.filename}: " if err.filename else ""
-        print(f"collide2d: error: {where}{err.strerror or err}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+    except Exception as err:
+        if type(err).__name__ == "RunStopped":  # runner.run's, not imported unless a run ran
+            print(str(err), file=sys.stderr)
+            return EXIT_BAD_INPUT
+        if isinstance(err, OSError):
+            where = f"{err.filename}: " if err.filename else ""
+            print(f"collide2d: error: {where}{err.strerror or err}", file=sys.stderr)
+            return EXIT_BAD_INPUT
+        return unexpected(err, args)
     except KeyboardInterrupt:
         print("collide2d: interrupted; outputs already written are whole", file=sys.stderr)
-        return 130
-    except Exception as err:  # a bug, not the user's input: say so in one line, exit 3
-        return unexpected(err, args)
+        return EXIT_INTERRUPTED
 
 
 def unexpected(err: Exception, args: argparse.Namespace) -> int:

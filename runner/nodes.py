@@ -22,6 +22,9 @@ from collide2d.runner import yamlsafe as ys
 from collide2d.runner.yamlsafe import ScenarioError
 
 MAX_INTEGER = 2**63 - 1  # the largest whole number a field takes unless it has its own bound
+MAX_ERRORS = 20  # errors of one file reported at once
+# Keys users write for a key of the format, and why: said with the did-you-mean.
+KEY_HINTS = {"radius": ("diameter", "a circle is given by its diameter in px, twice the radius")}
 
 
 def is_number(v) -> bool:
@@ -38,15 +41,71 @@ def fmt(v) -> str:
     return repr(v) if isinstance(v, float) else str(v)
 
 
+class Errors:
+    """The errors found so far in one file, reported together (up to MAX_ERRORS, in line order)."""
+
+    def __init__(self):
+        self.found: list[ScenarioError] = []
+        self.stopped: ScenarioError | None = None  # raised once MAX_ERRORS were found
+
+    def add(self, exc: ScenarioError) -> None:
+        self.found.extend(exc.errors if isinstance(exc, ys.ScenarioErrors) else [exc])
+
+    def full(self) -> bool:
+        return len(self.found) >= MAX_ERRORS
+
+    def error(self) -> ScenarioError | None:
+        """The error to raise for what was found: the one, or all of them; None if none."""
+        if not self.found:
+            return None
+        found = sorted(self.found, key=lambda e: (e.line, e.col))[:MAX_ERRORS]
+        return found[0] if len(found) == 1 else ys.ScenarioErrors(found)
+
+
+FAILED = object()  # what `Nodes.attempt` returns for a part that was refused
+
+
+def _raise(exc: Exception):
+    raise exc
+
+
 class Nodes:
-    """Located reading of the nodes of one file: `path` names it in every error."""
+    """Located reading of the nodes of one file: `path` names it in every error.
+
+    `errors`, when set to an Errors collector, makes `attempt` record a refused part and go on
+    (so that one reading reports every error of a file); otherwise the first error is raised."""
+
+    errors: Errors | None = None
 
     def __init__(self, path: str):
         self.path = str(path)
 
     def error(self, node, message: str) -> ScenarioError:
+        if node is None and message.startswith("--"):  # caused by a command-line option
+            return ys.OptionError(self.path, message)
         mark = node.start_mark if node is not None else None
         return ys.mark_error(self.path, mark, message)
+
+    def attempt(self, read, *args):
+        """read(*args), or FAILED after recording its error when collecting errors (raising all
+        found so far once there are MAX_ERRORS)."""
+        if self.errors is None:
+            return read(*args)
+        try:
+            return read(*args)
+        except ScenarioError as exc:
+            if exc is self.errors.stopped:  # on its way out through the enclosing parts
+                raise
+            self.errors.add(exc)
+            if self.errors.full():
+                self.errors.stopped = self.errors.error()
+                raise self.errors.stopped from None
+            return FAILED
+
+    def each(self, read, items) -> list:
+        """[read(i, item) for each item], the refused ones left out when collecting errors."""
+        out = [self.attempt(read, i, item) for i, item in enumerate(items)]
+        return [x for x in out if x is not FAILED]
 
     @staticmethod
     def prefix(*origins) -> str:
@@ -54,14 +113,16 @@ class Nodes:
         given = [o for o in origins if o]
         return " ".join(given) + ": " if given else ""
 
-    def mapping(self, node, where: str, keys: tuple[str, ...]) -> dict:
-        """{key: (key node, value node)} of a mapping; unknown and repeated keys refused."""
+    def mapping(self, node, where: str, keys: tuple[str, ...], *, go_on: bool = False) -> dict:
+        """{key: (key node, value node)} of a mapping; unknown and repeated keys refused, all of
+        them at once (`go_on`, when collecting errors: recorded, and the other keys read)."""
         if not isinstance(node, yaml.MappingNode):
             raise self.error(
                 node, f"{where} must be a mapping of keys to values, not {ys.describe(node)}"
             )
         out: dict[str, tuple] = {}
         merged = []
+        refused = Errors()
         for knode, vnode in node.value:
             if isinstance(knode, yaml.ScalarNode) and knode.tag == ys.CORE_TAG + "merge":
                 merged.append(vnode)
@@ -71,14 +132,25 @@ class Nodes:
             key = knode.value
             if key in out:
                 first = out[key][0].start_mark.line + 1
-                raise self.error(knode, f"duplicate key '{key}' in {where} (first on line {first})")
+                refused.add(
+                    self.error(knode, f"duplicate key '{key}' in {where} (first on line {first})")
+                )
+                continue
             if key not in keys:
                 near = difflib.get_close_matches(key, keys, n=1)
                 hint = (
                     f"did you mean '{near[0]}'?" if near else "expected one of " + ", ".join(keys)
                 )
-                raise self.error(knode, f"unknown key '{key}' in {where}; {hint}")
+                if key in KEY_HINTS and KEY_HINTS[key][0] in keys:
+                    hint = f"did you mean '{KEY_HINTS[key][0]}'? ({KEY_HINTS[key][1]})"
+                refused.add(self.error(knode, f"unknown key '{key}' in {where}; {hint}"))
+                continue
             out[key] = (knode, vnode)
+        if refused.found:
+            if not (go_on and self.errors is not None):
+                raise refused.error() if self.errors is not None else refused.found[0]
+            for exc in refused.found:
+                self.attempt(_raise, exc)
         for vnode in merged:
             sources = vnode.value if isinstance(vnode, yaml.SequenceNode) else [vnode]
             for src in sources:

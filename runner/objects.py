@@ -248,7 +248,7 @@ class ObjectReader(Nodes):
                 f"{len(items)} objects are past the limit of "
                 f"{self.limits.max_objects} objects; raise it with --max-objects",
             )
-        return [self.listed(i, item) for i, item in enumerate(items)]
+        return self.each(self.listed, items)
 
     def listed(self, i: int, node) -> Listed:
         what = f"objects[{i}]"

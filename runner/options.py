@@ -13,9 +13,8 @@ from __future__ import annotations
 
 import argparse
 
-from collide2d.engine.models import MODEL_NAMES
+from collide2d.engine.models import MAX_EVENTS_PER_TICK, MODEL_NAMES
 from collide2d.runner.limits import Limits
-from collide2d.runner.scenario import DEFAULT_MAX_EVENTS_PER_TICK
 
 _LIMIT_OPTIONS = (
     ("--max-objects", "max_objects", "objects in a scenario"),
@@ -56,16 +55,19 @@ def add_limit_arguments(parser: argparse.ArgumentParser, *, output: bool = False
             flag,
             dest=field,
             type=positive_int,
-            default=getattr(defaults, field),
+            default=None,
             metavar="N",
-            help=f"largest number of {what} (default {getattr(defaults, field):,})",
+            help=f"largest number of {what} (default {getattr(defaults, field):,}, or the "
+            "project's [tool.collide2d.limits])",
         )
 
 
-def limits_from_args(args: argparse.Namespace) -> Limits:
-    """The Limits asked for on the command line (defaults for options not present)."""
+def limits_from_args(args: argparse.Namespace, project=None) -> Limits:
+    """The Limits asked for on the command line, over the project's `[tool.collide2d.limits]`
+    (a runner.config.Config) when given, over the defaults."""
     fields = [f for _, f, _ in _LIMIT_OPTIONS + _OUTPUT_OPTIONS]
-    return Limits(**{f: getattr(args, f) for f in fields if getattr(args, f, None)})
+    given = {f: getattr(args, f) for f in fields if getattr(args, f, None)}
+    return project.limits(given) if project is not None else Limits(**given)
 
 
 def add_override_arguments(parser: argparse.ArgumentParser) -> None:
@@ -84,7 +86,7 @@ def add_cap_argument(parser: argparse.ArgumentParser) -> None:
         metavar="N",
         help="largest number of wall and pair events in one tick of the exact model, a runaway "
         "past it (default: the scenario's model.max_events_per_tick, else "
-        f"{DEFAULT_MAX_EVENTS_PER_TICK:,})",
+        f"{MAX_EVENTS_PER_TICK:,})",
     )
 
 
@@ -108,8 +110,12 @@ def add_threads_argument(p: argparse.ArgumentParser) -> None:
     )
 
 
-def apply_threads(args: argparse.Namespace) -> int:
-    """Put the command line's `--threads` (or all cores) in force; the number in force."""
+def apply_threads(args: argparse.Namespace, project=None) -> int:
+    """Put the command line's `--threads`, else the project's `[tool.collide2d] threads` (a
+    runner.config.Config), else all cores, in force; the number in force."""
     from collide2d.engine.threads import set_threads
 
-    return set_threads(getattr(args, "threads", None))
+    given = getattr(args, "threads", None)
+    if given is None and project is not None:
+        given = project.value("threads")
+    return set_threads(given)

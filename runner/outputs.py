@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 from PIL import GifImagePlugin, Image
 
-from collide2d.engine.events import format_event, format_number
+from collide2d.engine.events import event_dict, format_event, format_number
 from collide2d.runner import swapdir
 
 # zlib level of every PNG (0-9): fixed so that the same pixels give the same bytes.
@@ -423,26 +423,44 @@ class EventsWriter(_StreamWriter):
     """Streams events.jsonl: one `engine.events.format_event` line per event, in the order given.
 
     `write(events)` appends an EVENT_DTYPE array; `close` renames the file into place, `abort`
-    removes it. As a context manager it closes on success and aborts on an exception.
+    removes it. As a context manager it closes on success and aborts on an exception. `names`
+    (per object, None where not given): a named object's name follows its id, as `"name"` in a
+    wall event and `"a_name"` / `"b_name"` in a pair event.
     """
 
-    def __init__(self, path: str | os.PathLike):
+    def __init__(self, path: str | os.PathLike, names=None):
         self._file = _StreamFile(path)
         self.count = 0
+        self.names = list(names) if names is not None and any(names) else None
+
+    def line(self, rec) -> str:
+        if self.names is None:
+            return format_event(rec)
+        d = event_dict(rec)
+        named = (("id", "name"),) if "id" in d else (("a", "a_name"), ("b", "b_name"))
+        out = {}
+        for key, value in d.items():
+            out[key] = value
+            for id_key, name_key in named:
+                if key == id_key and self.names[value] is not None:
+                    out[name_key] = self.names[value]
+        return json.dumps(out)
 
     def write(self, events: np.ndarray) -> None:
         # in slices, so that the text of a tick with millions of events is never held whole
         for start in range(0, len(events), EVENTS_PER_WRITE):
             part = events[start : start + EVENTS_PER_WRITE]
-            text = "".join(format_event(rec) + "\n" for rec in part)
+            text = "".join(self.line(rec) + "\n" for rec in part)
             self._file.write(text.encode("utf-8"))
             self.count += len(part)
 
 
-def final_csv_text(pos: np.ndarray, vel: np.ndarray) -> str:
+def final_csv_text(pos: np.ndarray, vel: np.ndarray, names=None) -> str:
     """final.csv's text: header `id,x,y,vx,vy`, then one row per object in id order.
 
     pos (n, 2) px and vel (n, 2) px/s; numbers as `engine.events.format_number` writes them.
+    `names` (per object, None where not given): when any object has a name, a last column `name`
+    holds it (empty for the others; CSV-quoted when it needs to be).
     """
     pos = np.asarray(pos, dtype=np.float64).reshape(-1, 2)
     vel = np.asarray(vel, dtype=np.float64).reshape(-1, 2)
@@ -454,12 +472,22 @@ def final_csv_text(pos: np.ndarray, vel: np.ndarray) -> str:
     lines.extend(
         f"{i},{fmt(x)},{fmt(y)},{fmt(vx)},{fmt(vy)}" for i, (x, y, vx, vy) in enumerate(cols)
     )
+    if names is not None and any(names):
+        lines[0] += ",name"
+        for i, name in enumerate(names):
+            lines[i + 1] += "," + _csv_cell(name or "")
     return "\n".join(lines) + "\n"
 
 
-def write_final_csv(path: str | os.PathLike, pos: np.ndarray, vel: np.ndarray) -> None:
+def _csv_cell(text: str) -> str:
+    if any(c in text for c in ',"\r\n') or text != text.strip():
+        return '"' + text.replace('"', '""') + '"'
+    return text
+
+
+def write_final_csv(path: str | os.PathLike, pos: np.ndarray, vel: np.ndarray, names=None) -> None:
     """Write final.csv (see `final_csv_text`) to `path` atomically."""
-    atomic_write_text(path, final_csv_text(pos, vel))
+    atomic_write_text(path, final_csv_text(pos, vel, names))
 
 
 def write_json(path: str | os.PathLike, obj) -> None:

@@ -10,13 +10,20 @@ section 5 into a staging folder that replaces `OUT/NAME/` whole when the run is 
 runaway (an `engine.errors.Runaway`: the exact model's event cap or an object with no room to move,
 the stepped model's fold limit) raises `RunStopped` with a message for the user. The summary counts
 the wall and pair events whether or not they are logged (the models count them as they happen).
+Kernels compiled during a run (a first run, before numba has cached them) are timed apart
+(`runner.compiling`): the summary's `compile_time_s` holds them and `run_time_s` leaves them out.
+Ctrl-C during `run_to_dir` stops the run at the end of the current chunk of ticks: what was written
+so far (events, PNG frames, the final state at that tick, a summary with `interrupted_at_tick`)
+becomes OUT/NAME, without the GIF, which would be an animation of part of the run.
 """
 
 from __future__ import annotations
 
 import os
 import shutil
+import signal
 import sys
+import threading
 import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
@@ -29,7 +36,7 @@ from collide2d.engine.errors import Runaway
 from collide2d.engine.events import empty_events
 from collide2d.engine.invariants import kinetic_energy, momentum
 from collide2d.engine.raster import Renderer
-from collide2d.runner import budget, outputs, rundir, viewer
+from collide2d.runner import budget, compiling, outputs, rundir, viewer
 from collide2d.runner.frames import FrameRule
 from collide2d.runner.limits import Limits
 from collide2d.runner.overlay import Overlay
@@ -69,6 +76,7 @@ def drive(
     progress: Progress | None = None,
     on_tick: Callable[[object], None] | None = None,
     overlay=None,
+    interruptible: bool = False,
 ) -> tuple[object, dict]:
     """Run the scenario; returns (the model at the end, the summary).
 
@@ -80,6 +88,8 @@ def drive(
     tick's state); the model then advances one tick per call.
     overlay: a `runner.overlay.Overlay`; it may wrap the model, takes the events and draws over
     each frame before `on_frame` sees it.
+    interruptible: Ctrl-C (SIGINT, in the main thread) ends the run after the current chunk of
+    ticks; the summary then holds `interrupted_at_tick`.
     """
     bodies = scenario.bodies
     options = models.scenario_options(
@@ -103,6 +113,8 @@ def drive(
     renderer = Renderer(scenario.world, bodies) if frames else None
     start = _energy_momentum(bodies, model.velocities())
     began = time.perf_counter()
+    compiled_before = compiling.seconds()
+    interrupted = _Interrupt() if interruptible else None
 
     if on_tick is not None:
         on_tick(model)
@@ -110,32 +122,35 @@ def drive(
     if next_frame == 0:
         on_frame(0, _drawn(renderer, model, 0, overlay))
         next_frame = frames.next_from(1)
-    while model.tick < scenario.ticks:
-        stop = min(scenario.ticks, model.tick + CHUNK_TICKS)
-        if next_frame is not None:
-            stop = min(stop, next_frame)
-        if on_tick is not None:
-            stop = model.tick + 1
-        try:
-            events = model.advance(stop - model.tick, logging)
-        except Runaway as exc:
-            when = f"tick {stop}" if stop == model.tick + 1 else f"ticks {model.tick + 1}-{stop}"
-            raise RunStopped(
-                f"{scenario.path or scenario.name}: error: the {scenario.model} model stopped "
-                f"the run in {when}: {exc}"
-            ) from None
-        if log_events and len(events) and on_events is not None:
-            on_events(events)
-        if overlay is not None and logging:
-            overlay.events(events)
-        if on_tick is not None:
-            on_tick(model)
-        if model.tick == next_frame:
-            on_frame(model.tick, _drawn(renderer, model, model.tick, overlay))
-            next_frame = frames.next_from(model.tick + 1)
-        if progress is not None:
-            progress.update(model.tick)
-    run_time = time.perf_counter() - began
+    with interrupted or _NoInterrupt():
+        while model.tick < scenario.ticks and not (interrupted and interrupted.seen):
+            stop = min(scenario.ticks, model.tick + CHUNK_TICKS)
+            if next_frame is not None:
+                stop = min(stop, next_frame)
+            if on_tick is not None:
+                stop = model.tick + 1
+            try:
+                events = model.advance(stop - model.tick, logging)
+            except Runaway as exc:
+                when = (
+                    f"tick {stop}" if stop == model.tick + 1 else f"ticks {model.tick + 1}-{stop}"
+                )
+                raise RunStopped(
+                    f"{scenario.path or scenario.name}: error: the {scenario.model} model stopped "
+                    f"the run in {when}: {exc}"
+                ) from None
+            if log_events and len(events) and on_events is not None:
+                on_events(events)
+            if overlay is not None and logging:
+                overlay.events(events)
+            if on_tick is not None:
+                on_tick(model)
+            if model.tick == next_frame:
+                on_frame(model.tick, _drawn(renderer, model, model.tick, overlay))
+                next_frame = frames.next_from(model.tick + 1)
+            if progress is not None:
+                progress.update(model.tick)
+    run_time = time.perf_counter() - began - (compiling.seconds() - compiled_before)
     if progress is not None:
         progress.close()
 
@@ -151,8 +166,11 @@ def drive(
         "events": {"wall": walls, "pair": pairs},
         "kinetic_energy": {"start": start[0], "end": end[0]},
         "momentum": {"start": list(start[1]), "end": list(end[1])},
-        "run_time_s": round(run_time, 6),
+        "run_time_s": round(max(run_time, 0.0), 6),
+        "compile_time_s": round(compiling.seconds(), 6),
     }
+    if model.tick < scenario.ticks:
+        summary["interrupted_at_tick"] = model.tick
     return model, summary
 
 
@@ -160,6 +178,34 @@ def _drawn(renderer, model, k: int, overlay) -> np.ndarray:
     """Frame k's index picture, with the overlays when there are any."""
     idx = renderer.draw(model.positions())
     return idx if overlay is None else overlay.draw(k, idx, model)
+
+
+class _Interrupt:
+    """While open (in the main thread), SIGINT sets `seen` instead of raising KeyboardInterrupt."""
+
+    def __init__(self):
+        self.seen = False
+        self.previous = None
+
+    def __enter__(self):
+        if threading.current_thread() is threading.main_thread():
+            self.previous = signal.signal(signal.SIGINT, self._caught)
+        return self
+
+    def _caught(self, signum, frame) -> None:
+        self.seen = True
+
+    def __exit__(self, *exc) -> None:
+        if self.previous is not None:
+            signal.signal(signal.SIGINT, self.previous)
+
+
+class _NoInterrupt:
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc) -> None:
+        return None
 
 
 def simulate(
@@ -262,9 +308,7 @@ def _shown(filename, stage: Path, target: Path) -> str:
 
 def _write_run(scenario: Scenario, folder: Path, options: RunOptions, plan) -> dict:
     """Run the scenario, writing its files into the empty `folder`; returns the summary."""
-    frames_dir = folder / "frames"
-    if plan.png:
-        frames_dir.mkdir()
+    frames_dir = folder / "frames"  # made with its first frame: never an empty folder
     layer = None
     if options.overlay or options.viewer:
         layer = Overlay(scenario, options.overlay, record=options.viewer)
@@ -280,9 +324,9 @@ def _write_run(scenario: Scenario, folder: Path, options: RunOptions, plan) -> d
             scenario.ticks + 1,
             scale=options.scale,
         )
-        if gif.note and not options.quiet:
+        if gif.note and not options.quiet and sys.stderr.isatty():
             print(f"{scenario.name}: {gif.note}", file=sys.stderr)
-    log = outputs.EventsWriter(folder / "events.jsonl") if options.events else None
+    log = outputs.EventsWriter(folder / "events.jsonl", scenario.names) if options.events else None
     # the viewer refuses a run too long to view
     recorder = viewer.Recorder(scenario, layer) if options.viewer else None
     digits = max(6, len(str(scenario.ticks)))
@@ -291,6 +335,7 @@ def _write_run(scenario: Scenario, folder: Path, options: RunOptions, plan) -> d
         if gif is not None:
             gif.add(idx)
         if k in plan.png:
+            frames_dir.mkdir(exist_ok=True)
             name = f"frame_{k:0{digits}d}.png"
             outputs.write_png(frames_dir / name, palette[idx], scale=options.scale)
 
@@ -306,15 +351,21 @@ def _write_run(scenario: Scenario, folder: Path, options: RunOptions, plan) -> d
             progress=progress,
             on_tick=recorder.add if recorder is not None else None,
             overlay=layer,
+            interruptible=True,
         )
+        if "interrupted_at_tick" in summary and gif is not None:
+            writers.remove(gif)  # an animation of part of the run: not kept
+            gif.abort()
         for writer in writers:
             writer.close()
     except BaseException:
         for writer in writers:
             writer.abort()
         raise
-    outputs.write_final_csv(folder / "final.csv", model.positions(), model.velocities())
-    if recorder is not None:
+    outputs.write_final_csv(
+        folder / "final.csv", model.positions(), model.velocities(), scenario.names
+    )
+    if recorder is not None and "interrupted_at_tick" not in summary:
         outputs.atomic_write_bytes(folder / viewer.VIEWER_FILE, recorder.page())
     outputs.write_json(folder / "summary.json", summary)
     return summary

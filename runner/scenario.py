@@ -73,7 +73,7 @@ from collide2d.runner import assemble, yamlfast
 from collide2d.runner import yamlsafe as ys
 from collide2d.runner.assemble import PALETTE_SIZE
 from collide2d.runner.limits import Limits
-from collide2d.runner.nodes import MAX_INTEGER, Nodes, fmt, is_number
+from collide2d.runner.nodes import FAILED, MAX_INTEGER, Errors, Nodes, fmt, is_number
 from collide2d.runner.objects import (
     BLOCK_KEYS,
     BLOCK_SHAPES,
@@ -209,19 +209,28 @@ class Scenario:
 
 
 def load(
-    path, *, overrides: dict | None = None, limits: Limits | None = None, edit=None
+    path,
+    *,
+    overrides: dict | None = None,
+    limits: Limits | None = None,
+    defaults=None,
+    edit=None,
 ) -> Scenario:
     """Read and check the scenario file at `path` (str or os.PathLike); ScenarioError if bad.
 
+    `defaults`: model settings a project gives where the file gives none (`kind`, `substeps`,
+    `geometry`, `max_events_per_tick`; runner.config), below the file and the overrides.
     `edit(root) -> root`, when given, changes the composed YAML node tree before it is read (a
     sweep's dotted keys, `runner.sweep.matrix`); the result is checked like the file itself."""
     shown = os.fspath(path)
     limits = limits if limits is not None else Limits()
     text, digest = ys.read_file(path, limits)
-    return _Reader(shown, shown, overrides, limits).scenario(text, digest, edit)
+    return _Reader(shown, shown, overrides, limits, defaults).scenario(text, digest, edit)
 
 
-def loads(text: str, path: str = "<string>", *, overrides=None, limits=None) -> Scenario:
+def loads(
+    text: str, path: str = "<string>", *, overrides=None, limits=None, defaults=None
+) -> Scenario:
     """Check scenario text; `path` only names it in errors (and gives the default name).
 
     Without a `name`, text read under the default path is named NAME_FOR_TEXT.
@@ -229,14 +238,15 @@ def loads(text: str, path: str = "<string>", *, overrides=None, limits=None) -> 
     limits = limits if limits is not None else Limits()
     ys.check_length(len(text), path, limits)  # characters: never more than the UTF-8 bytes
     digest = hashlib.sha256(text.encode("utf-8", "surrogatepass")).hexdigest()
-    return _Reader(path, None, overrides, limits).scenario(text, digest)
+    return _Reader(path, None, overrides, limits, defaults).scenario(text, digest)
 
 
 class _Reader(Nodes):
     """One reading of one scenario: its path, limits and overrides, and the top-level sections."""
 
-    def __init__(self, path: str, file_path: str | None, overrides, limits):
+    def __init__(self, path: str, file_path: str | None, overrides, limits, defaults=None):
         super().__init__(path)
+        self.defaults = dict(defaults or {})
         self.file_path = file_path
         self.limits = limits if limits is not None else Limits()
         self.overrides = {}
@@ -266,37 +276,47 @@ class _Reader(Nodes):
         return self._scenario(text, digest, None, edit)
 
     def _scenario(self, text: str, digest: str, fast, edit=None) -> Scenario:
+        """Read the whole document, collecting the errors of its parts (up to MAX_ERRORS, in
+        line order: a part that depends on a refused one is not read, so that no error follows
+        from another); raise them all, or return the Scenario. `fast`: the fast lane's object
+        rows (runner.yamlfast), read in place of the empty list the text then holds."""
         root = ys.compose(text, self.path, self.limits)
         if edit is not None:
             root = edit(root)
         self.root = root
-        top = self.mapping(root, "the scenario", TOP_KEYS)
-        self.version(top, root)
-        name = self.name(top)
-        description = ""
-        if "description" in top:
-            description = self.string(top["description"][1], "description")
-        world, background = self.world(top)
-        model, substeps, geometry, cap = self.model(top)
-        ticks = self.ticks(top, world.fps)
-        rules = ModelRules.of(model, geometry, self.model_from)
-        objects = ObjectReader(self.path, self.limits, world, rules, self.fps_from)
-        listed = objects.objects(top)
-        if fast is not None:
-            node = top["objects"][1] if "objects" in top else None
-            if not (isinstance(node, yaml.SequenceNode) and not node.value):
-                raise yamlfast.FallBack
-            if node.start_mark.line + 1 != fast.first_line:
-                raise yamlfast.FallBack
-            table = yamlfast.table(fast, world, rules.paper_rates, self.limits.max_objects)
-        else:
-            table = table_of(self, top, self.file_path, self.limits, world, rules.paper_rates)
-        blocks = objects.blocks(top, len(listed) + (table.n if table else 0))
-        outputs = OutputReader(self.path, self.limits, self.ticks_from)
-        output = outputs.output(top, ticks)
-        golden = outputs.golden(top, ticks)
+        self.errors = Errors()
+        top = self.mapping(root, "the scenario", TOP_KEYS, go_on=True)
+        self.attempt(self.version, top, root)
+        name = self.attempt(self.name, top)
+        description = self.attempt(self.description, top)
+        world_background = self.attempt(self.world, top)
+        settings = self.attempt(self.model, top)
+        ticks = FAILED
+        if world_background is not FAILED:
+            world, background = world_background
+            ticks = self.attempt(self.ticks, top, world.fps)
+        if world_background is not FAILED and settings is not FAILED:
+            model, substeps, geometry, cap = settings
+            rules = ModelRules.of(model, geometry, self.model_from)
+            objects = ObjectReader(self.path, self.limits, world, rules, self.fps_from)
+            objects.errors = self.errors
+            listed = self.attempt(objects.objects, top)
+            if listed is not FAILED:
+                table = self.attempt(self.table, top, fast, world, rules)
+                if table is not FAILED:
+                    rows = len(listed) + (table.n if table else 0)
+                    blocks = self.attempt(objects.blocks, top, rows)
+        if ticks is not FAILED:
+            outputs = OutputReader(self.path, self.limits, self.ticks_from)
+            outputs.errors = self.errors
+            output = self.attempt(outputs.output, top, ticks)
+            golden = self.attempt(outputs.golden, top, ticks)
+        found = self.errors.error()
+        self.errors = None
+        if found is not None:
+            raise found
         bodies, names, lines, palette = assemble.bodies(
-            self, listed, blocks, world, background, table
+            self, listed, blocks, world, background, geometry, table
         )
         if model == "exact":
             self.room(world, bodies, geometry, names, listed, lines, table)
@@ -319,6 +339,11 @@ class _Reader(Nodes):
             text_sha256=digest,
             max_events_per_tick=cap,
         )
+
+    def description(self, top: dict) -> str:
+        if "description" in top:
+            return self.string(top["description"][1], "description")
+        return ""
 
     def version(self, top: dict, root) -> None:
         if "version" not in top:
@@ -395,7 +420,9 @@ class _Reader(Nodes):
     def model(self, top: dict) -> tuple[str, int, str, int]:
         """(kind, substeps, geometry, max_events_per_tick) from `model` and the overrides."""
         kind, substeps, geometry, cap = "paper", 1, None, DEFAULT_MAX_EVENTS_PER_TICK
-        sub_node = geo_node = None
+        sub_node = geo_node = cap_node = None
+        if "model" not in top:
+            kind = self.defaults.get("kind", kind)
         if "model" in top:
             node = top["model"][1]
             if isinstance(node, yaml.MappingNode):
@@ -452,9 +479,44 @@ class _Reader(Nodes):
                     f"--max-events-per-tick {v}: must be a whole number from 1 to {MAX_EVENT_CAP}",
                 )
             cap = v
+        if self.model_from:  # the file's settings went with its model
+            sub_node = cap_node = None
+        substeps, geometry, cap = self.model_defaults(
+            kind, sub_node, geometry, cap_node, substeps, cap
+        )
         if geometry is None:
             geometry = "exact" if kind == "exact" else "box"
         return kind, substeps, geometry, cap
+
+    def model_defaults(self, kind, sub_node, geometry, cap_node, substeps, cap):
+        """The project's model defaults (runner.config) where neither the file nor the command
+        line set a value and the model takes it."""
+        d = self.defaults
+        if kind == "stepped" and sub_node is None and "substeps" in d:
+            substeps = d["substeps"]
+        if geometry is None and kind != "paper" and "geometry" in d:
+            geometry = d["geometry"]
+        if (
+            kind == "exact"
+            and cap_node is None
+            and "max_events_per_tick" in d
+            and "max_events_per_tick" not in self.overrides
+        ):
+            cap = d["max_events_per_tick"]
+        return substeps, geometry, cap
+
+    def table(self, top, fast, world, rules):
+        """The objects given as a table: the fast lane's rows when `fast` (the text's object list
+        must then be the empty list it left, else the lane declines), else the `objects: {file}`
+        table (runner.table), or None."""
+        if fast is None:
+            return table_of(self, top, self.file_path, self.limits, world, rules.paper_rates)
+        node = top["objects"][1] if "objects" in top else None
+        if not (isinstance(node, yaml.SequenceNode) and not node.value):
+            raise yamlfast.FallBack
+        if node.start_mark.line + 1 != fast.first_line:
+            raise yamlfast.FallBack
+        return yamlfast.table(fast, world, rules.paper_rates, self.limits.max_objects)
 
     def room(self, world, bodies, geometry, names, listed, lines, table=None) -> None:
         """Refuse, at the object, a moving object with no room on an axis it moves on (the exact

@@ -27,17 +27,24 @@ from collide2d.runner.schema import json_schema
 
 def run_validate(args: argparse.Namespace) -> int:
     """Check every file of args.scenarios; print one line per file; 2 if any is bad, else 0."""
-    limits = limits_from_args(args)
+    from collide2d.runner import config
+    from collide2d.runner.cli import plural
+
+    project = config.find()
+    limits = limits_from_args(args, project)
     overrides = overrides_from_args(args)
     status = EXIT_OK
     for path in args.scenarios:
         try:
-            sc = load(path, overrides=overrides, limits=limits)
+            sc = load(path, overrides=overrides, limits=limits, defaults=project.model_defaults())
         except ScenarioError as err:
             print(str(err), file=sys.stderr)
             status = EXIT_BAD_INPUT
             continue
-        print(f"{path}: ok ({sc.bodies.n} objects, model {sc.model}, {sc.ticks} ticks)")
+        print(
+            f"{path}: ok ({plural(sc.bodies.n, 'object')}, model {sc.model}, "
+            f"{plural(sc.ticks, 'tick')})"
+        )
     return status
 
 

@@ -81,6 +81,30 @@ class ScenarioError(Exception):
         return f"{self.path}:{self.line}:{self.col}: error: {self.message}"
 
 
+class OptionError(ScenarioError):
+    """A refusal caused by a command-line option, not by a place in the file: str(err) is
+    f"{path}: error: {message}", the message starting with the option (`--ticks 5: ...`)."""
+
+    def __init__(self, path, message):
+        super().__init__(path, 0, 0, message)
+
+    def __str__(self) -> str:
+        return f"{self.path}: error: {self.message}"
+
+
+class ScenarioErrors(ScenarioError):
+    """Several errors of one file, in line order (`errors`); str(err) is one line each. As a
+    ScenarioError it is the first of them."""
+
+    def __init__(self, errors: list[ScenarioError]):
+        first = errors[0]
+        super().__init__(first.path, first.line, first.col, first.message)
+        self.errors = list(errors)
+
+    def __str__(self) -> str:
+        return "\n".join(str(e) for e in self.errors)
+
+
 def read_file(path, limits: Limits) -> tuple[str, str]:
     """(text, SHA-256 of the bytes) of the file at `path`, read in pieces within
     `limits.max_file_bytes`; a located ScenarioError when it cannot be read or is not UTF-8."""
@@ -144,6 +168,15 @@ def _yaml_error(exc: yaml.YAMLError, path: str, text: str) -> ScenarioError:
     if isinstance(exc, yaml.MarkedYAMLError):
         mark = exc.problem_mark or exc.context_mark
         problem = exc.problem or "unexpected text"
+        if mark is not None and 0 <= mark.index < len(text) and text[mark.index] == "\t":
+            start = text.rfind("\n", 0, mark.index) + 1
+            where = "in the indentation" if not text[start : mark.index].strip() else "here"
+            return mark_error(
+                path,
+                mark,
+                f"a tab character {where}: YAML indents with spaces only; replace the tab "
+                "with spaces (2 per level is usual)",
+            )
         context = f" ({exc.context})" if exc.context else ""
         return mark_error(path, mark, f"invalid YAML{context}: {problem}")
     return ScenarioError(path, 1, 1, f"invalid YAML: {exc}")

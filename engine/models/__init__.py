@@ -20,6 +20,8 @@ import importlib
 from collide2d.engine.world import Bodies, WorldSpec
 
 MODEL_NAMES = ("paper", "stepped", "exact")
+# The exact model's default cap of wall and pair events in one tick (a runaway past it).
+MAX_EVENTS_PER_TICK = 1_000_000
 # The settings a scenario gives each model (SPEC 2 and 3): the paper model takes none.
 SCENARIO_OPTIONS = {
     "paper": (),

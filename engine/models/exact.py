@@ -57,7 +57,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from collide2d.engine import events
+from collide2d.engine import events, models
 from collide2d.engine.broadphase import grid_cell, grid_dims
 from collide2d.engine.cells import build_grid, cell_insert, cell_remove, room_around, room_needed
 from collide2d.engine.errors import EventCapExceeded, NoRoom
@@ -137,7 +137,7 @@ from collide2d.engine.shapes import GEOMETRIES, build_cores
 from collide2d.engine.world import Bodies, WorldSpec
 
 # Most wall and pair events one tick may take before the run is stopped as a runaway.
-MAX_EVENTS_PER_TICK = 1_000_000
+MAX_EVENTS_PER_TICK = models.MAX_EVENTS_PER_TICK
 # After an event, predict again only the objects it touched ("touched", the model), or every
 # moving object ("all": the same events and state to the bit, at the cost the local
 # re-prediction saves; its heap room grows with n^2, so only for small scenes: tests and

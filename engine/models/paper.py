@@ -43,8 +43,9 @@ from numba import njit
 from collide2d.engine.broadphase import (
     KEY_MASK,
     KEY_SHIFT,
-    candidates,
     choose,
+    find,
+    marker,
     workspace,
 )
 from collide2d.engine.events import (
@@ -151,7 +152,7 @@ def _walls(pos, room, step, disp, tick, log, ev, n_ev, st):
 
 
 @njit(cache=True)
-def _relist(pos, size, disp, movable, margin, method, cell, order, lo, hi, keys, ws):
+def _relist(pos, size, disp, movable, margin, finder, cell, order, lo, hi, keys, ws):
     """List the pairs whose reach boxes, grown by `margin` px on every side, overlap (keys
     a << KEY_SHIFT | b, a < b, in no particular order); pairs of two immovable objects are left
     out. Returns how many there are; only as many as `keys` holds are written."""
@@ -160,7 +161,7 @@ def _relist(pos, size, disp, movable, margin, method, cell, order, lo, hi, keys,
             d = disp[i, ax]
             lo[i, ax] = pos[i, ax] - max(d, 0) - margin
             hi[i, ax] = pos[i, ax] - min(d, 0) + size[i, ax] + margin
-    return candidates(method, lo, hi, movable, cell, order, keys, ws)
+    return find(finder, lo, hi, movable, cell, order, keys, ws)
 
 
 @njit(cache=True, inline="always")
@@ -220,10 +221,10 @@ def _run(pos, size, room, step, period, count, movable, stop, log, st, bp, ev, w
     done x _N_STAGES, a tick's end); returns _DONE, or _LOG_FULL / _KEYS_FULL when `ev` or the
     candidate buffers need more room (grow them and call again: the tick resumes at the stage it
     stopped). st: the scalar state (see _S_*); bp = (order, anchor, keys, near, disp, lo, hi,
-    params) with params = [margin px, method, grid cell px] (float64)."""
-    order, anchor, keys, near, disp, lo, hi, params = bp
+    params, finder) with params = [margin px, method, grid cell px] (float64) and finder the
+    method's marker (broadphase.marker: only that pair finder is compiled)."""
+    order, anchor, keys, near, disp, lo, hi, params, finder = bp
     margin = int(params[0])
-    method = int(params[1])
     cell = params[2]
     n = pos.shape[0]
     n_ev = st[_S_EVENTS]
@@ -250,7 +251,7 @@ def _run(pos, size, room, step, period, count, movable, stop, log, st, bp, ev, w
         elif stage == _STAGE_BROAD:
             # broad: the candidate list, when it is to be made anew
             if st[_S_RELIST]:
-                k = _relist(pos, size, disp, movable, margin, method, cell, order, lo, hi, keys, ws)
+                k = _relist(pos, size, disp, movable, margin, finder, cell, order, lo, hi, keys, ws)
                 if k > keys.shape[0]:
                     st[_S_NEEDED] = k
                     st[_S_EVENTS] = n_ev
@@ -316,6 +317,7 @@ class Model:
             np.empty((n, 2), np.int64),  # reach boxes
             np.empty((n, 2), np.int64),
             params,
+            marker(method),
         )
         self._ws = workspace(n, np.int64)
 

@@ -40,6 +40,9 @@ from collide2d.runner.golden.store import (
     scenario_files,
 )
 
+# `--report` given with no folder: the project's report folder (runner.config).
+REPORT_FROM_PROJECT = object()
+
 
 class _Usage(Exception):
     """Bad input: the message goes to stderr and the command exits with EXIT_BAD_INPUT. `located`
@@ -100,7 +103,12 @@ def register(subparsers, *, load=None, simulate=None) -> None:
         )
         if name == "check":
             p.add_argument(
-                "--report", metavar="DIR", help="write expected/actual/diff images and HTML"
+                "--report",
+                metavar="DIR",
+                nargs="?",
+                const=REPORT_FROM_PROJECT,
+                help="write expected/actual/diff images and HTML into DIR (with no DIR: the "
+                "project's [tool.collide2d] report folder, else report/)",
             )
             add_check_formats(p)
             _cluster_arguments(p)
@@ -155,7 +163,7 @@ def check_command(args, *, load=default_load, simulate=default_simulate) -> int:
     try:
         root, scenarios = _prepare(args, load)
         report_dir = Path(args.report) if args.report else None
-        store = GoldenStore(root)
+        store = _store(args, root)
         if report_dir is not None and _inside(report_dir, store.dir):
             raise _Usage(f"--report {args.report} is inside {GOLDENS_DIR}/; name another folder")
         if report_dir is not None:
@@ -244,8 +252,8 @@ def bless_command(args, *, load=default_load, simulate=default_simulate) -> int:
         if getattr(args, "from_report", None):
             return bless_from_report(args, partial(_prepare, load=load))
         root, scenarios = _prepare(args, load)
-        store = GoldenStore(root)
-        used = _all_names(root, scenarios, load) if args.prune else []
+        store = _store(args, root)
+        used = _all_names(root, scenarios, load, args.project) if args.prune else []
     except _Usage as exc:
         return exc.exit()
     status = EXIT_OK
@@ -277,19 +285,20 @@ def bless_command(args, *, load=default_load, simulate=default_simulate) -> int:
 def _prepare(args, load):
     """(root, [(path, Scenario)]) for the command's arguments; _Usage on any bad input, before
     anything runs."""
+    project = _project(args)
+    root, folder = project.root, project.value("scenarios")
+    if args.root and not (root / folder).is_dir():
+        raise _Usage(f"--root {args.root} has no {folder}/ folder")
+    if getattr(args, "report", None) is REPORT_FROM_PROJECT:
+        args.report = shown_path(project.folder("report"))
     try:
-        root = Path(args.root).resolve() if args.root else find_root()
+        _store(args, root).check_dir()
     except GoldenError as exc:
         raise _Usage(str(exc)) from None
-    if args.root and not (root / SCENARIOS_DIR).is_dir():
-        raise _Usage(f"--root {args.root} has no {SCENARIOS_DIR}/ folder")
-    try:
-        GoldenStore(root).check_dir()
-    except GoldenError as exc:
-        raise _Usage(str(exc)) from None
-    paths = [_resolve(a, root) for a in args.scenarios] or scenario_files(root)
+    paths = [_resolve(a, root, folder) for a in args.scenarios] or scenario_files(root, folder)
     if not paths:
-        raise _Usage(f"no scenario files in {shown_path(root / SCENARIOS_DIR)}")
+        raise _Usage(f"no scenario files in {shown_path(root / folder)}")
+    load = partial(load, **project.load_options())
     cap = getattr(args, "max_events_per_tick", None)
     if cap is not None:
         load = partial(load, overrides={"max_events_per_tick": cap})
@@ -303,6 +312,33 @@ def _prepare(args, load):
             )
         seen[scn.name] = path
     return root, scenarios
+
+
+def _project(args):
+    """The project (runner.config.Config) of --root, else found upward from here: the nearest
+    folder with a [tool.collide2d] table or a scenarios/ folder; _Usage when there is none or
+    its table is refused. Kept on `args` for the goldens folder."""
+    from collide2d.runner import config
+
+    try:
+        if args.root:
+            project = config.at(args.root)
+        else:
+            project = config.find()
+            if project.file is None:
+                project = config.at(find_root())
+    except GoldenError as exc:
+        raise _Usage(str(exc)) from None
+    except config.ConfigError as exc:
+        raise _Usage(str(exc), located=True) from None
+    args.project = project
+    return project
+
+
+def _store(args, root) -> GoldenStore:
+    """The goldens of the project: its [tool.collide2d] goldens folder, else goldens/."""
+    project = getattr(args, "project", None)
+    return GoldenStore(root, project.value("goldens") if project else GOLDENS_DIR)
 
 
 def _load_all(paths, load):
@@ -323,22 +359,23 @@ def scenario_errors() -> tuple:
     return (ScenarioError,)
 
 
-def _resolve(arg: str, root: Path) -> Path:
+def _resolve(arg: str, root: Path, folder: str = SCENARIOS_DIR) -> Path:
     """A scenario argument as a file: the path itself, else ROOT/scenarios/ARG.yaml."""
     path = Path(arg)
     if path.is_file():
         return path
     for suffix in SCENARIO_SUFFIXES:
-        candidate = root / SCENARIOS_DIR / f"{arg}{suffix}"
+        candidate = root / folder / f"{arg}{suffix}"
         if candidate.is_file():
             return candidate
-    raise _Usage(f"no scenario {arg!r}: not a file, and no {SCENARIOS_DIR}/{arg}.yaml")
+    raise _Usage(f"no scenario {arg!r}: not a file, and no {folder}/{arg}.yaml")
 
 
-def _all_names(root, scenarios, load) -> list[str]:
+def _all_names(root, scenarios, load, project) -> list[str]:
     """The names of every scenario in ROOT/scenarios/ plus the ones given."""
     loaded = {Path(p).resolve(): s.name for p, s in scenarios}
-    rest = [p for p in scenario_files(root) if p.resolve() not in loaded]
+    files = scenario_files(root, project.value("scenarios"))
+    rest = [p for p in files if p.resolve() not in loaded]
     return sorted(set(loaded.values()) | {s.name for _p, s in _load_all(rest, load)})
 
 

@@ -3,9 +3,12 @@
 Registered through the `pytest11` entry point of the distribution, so it loads in the pytest run
 of any project that installs collide2d.
 Inputs: the scenario files of the project (`ROOT/scenarios/`, ROOT found upward from the current
-directory or given by `--golden-root`) and the options below. Outputs: test outcomes whose failure
-text is the same as `collide2d check` prints, a report per failing scenario, and with
-`--update-goldens` the goldens of the tests that ran.
+directory or given by `--golden-root`; the folders and the scenarios' limits and model defaults
+come from ROOT's `[tool.collide2d]` table, runner.config) and the options below. In a project
+with that table, every scenario file of its scenarios folder is collected as one test,
+`scenarios/NAME.yaml::golden`, with no test file or conftest; other projects are untouched.
+Outputs: test outcomes whose failure text is the same as `collide2d check` prints, a report per
+failing scenario, and with `--update-goldens` the goldens of the tests that ran.
 
     --update-goldens     bless what runs instead of comparing (refused with exit status 2 when the
                          CI environment variable is set)
@@ -68,25 +71,86 @@ def pytest_configure(config) -> None:
         )
 
 
-def _root(config) -> Path:
+def _project(config):
+    """The project's runner.config.Config: --golden-root's, else the nearest one upward with a
+    [tool.collide2d] table or a scenarios/ folder (GoldenError when there is neither)."""
+    from collide2d.runner import config as cfg
     from collide2d.runner.golden.store import find_root
 
     given = config.getoption("golden_root")
     if given:
-        return Path(given).resolve()
-    return find_root(config.invocation_params.dir)
+        return cfg.at(given)
+    found = cfg.find(config.invocation_params.dir)
+    return found if found.file else cfg.at(find_root(config.invocation_params.dir))
+
+
+def _root(config) -> Path:
+    return _project(config).root
+
+
+def _scenario_files(project):
+    from collide2d.runner.golden.store import scenario_files
+
+    return scenario_files(project.root, project.value("scenarios"))
+
+
+def pytest_collect_file(file_path, parent):
+    """A scenario file in the scenarios folder of a project with a [tool.collide2d] table is one
+    golden test."""
+    if file_path.suffix not in (".yaml", ".yml"):
+        return None
+    from collide2d.runner import config as cfg
+
+    try:
+        project = cfg.find(file_path.parent)
+    except cfg.ConfigError:
+        return None
+    if project.file is None or file_path.parent != project.scenarios.resolve():
+        return None
+    return GoldenFile.from_parent(parent, path=file_path)
+
+
+class GoldenFile(pytest.File):
+    """A scenario file collected as a test module holding its one golden test."""
+
+    def collect(self):
+        yield GoldenItem.from_parent(self, name="golden")
+
+
+class GoldenItem(pytest.Item):
+    """The golden test of one scenario file: check it (or bless it with --update-goldens)."""
+
+    def runtest(self) -> None:
+        project = _project(self.config)
+        check_golden(
+            self,
+            self.path,
+            project,
+            _default_load(project),
+            _default_simulate(),
+            # what the tmp_path_factory fixture returns (an Item has no fixtures of its own)
+            self.config._tmp_path_factory,
+        )
+
+    def repr_failure(self, excinfo):
+        if isinstance(excinfo.value, pytest.fail.Exception):
+            return str(excinfo.value)
+        return super().repr_failure(excinfo)
+
+    def reportinfo(self):
+        return self.path, None, f"golden {self.path.stem}"
 
 
 def pytest_generate_tests(metafunc) -> None:
     if "golden_scenario" not in metafunc.fixturenames:
         return
-    from collide2d.runner.golden.store import GoldenError, scenario_files
+    from collide2d.runner.golden.store import GoldenError
 
     try:
-        root = _root(metafunc.config)
+        _root(metafunc.config)
     except GoldenError as exc:
         pytest.fail(str(exc), pytrace=False)
-    params = [pytest.param(p, id=p.stem) for p in scenario_files(root)]
+    params = [pytest.param(p, id=p.stem) for p in _scenario_files(_project(metafunc.config))]
     if not params:
         params = [pytest.param(None, id="no-scenarios")]
     metafunc.parametrize("golden_scenario", params)
@@ -99,58 +163,76 @@ def golden_root(pytestconfig) -> Path:
 
 
 @pytest.fixture(scope="session")
-def golden_load():
-    """The scenario loader: path -> Scenario."""
-    from collide2d.runner.golden.cli import default_load
-
-    return default_load
+def golden_load(pytestconfig):
+    """The scenario loader: path -> Scenario (with the project's limits and model defaults)."""
+    return _default_load(_project(pytestconfig))
 
 
 @pytest.fixture(scope="session")
 def golden_simulate():
     """The simulator, called as runner.run.simulate."""
+    return _default_simulate()
+
+
+def _default_load(project):
+    from functools import partial
+
+    from collide2d.runner.golden.cli import default_load
+
+    return partial(default_load, **project.load_options())
+
+
+def _default_simulate():
     from collide2d.runner.golden.cli import default_simulate
 
     return default_simulate
 
 
 @pytest.fixture
-def golden_check(request, golden_root, golden_load, golden_simulate, tmp_path_factory):
+def golden_check(request, golden_load, golden_simulate, tmp_path_factory):
     """check(path): run the scenario file `path` and compare it with its golden (or, with
     --update-goldens, bless it); fails the test with the text `collide2d check` prints."""
-    from collide2d.runner.golden import bless_run, check_run, shown_path
-    from collide2d.runner.golden.cli import run_scenario, scenario_errors
-    from collide2d.runner.golden.store import SCENARIOS_DIR, GoldenError, GoldenStore
-
-    config = request.config
+    project = _project(request.config)
 
     def check(path) -> None:
         if path is None:
-            pytest.fail(f"no scenario files in {golden_root / SCENARIOS_DIR}", pytrace=False)
-        try:
-            scenario = golden_load(shown_path(path))
-        except scenario_errors() as exc:
-            pytest.fail(str(exc), pytrace=False)
-        request.node.user_properties.append((PROP_NAME, scenario.name))
-        result = run_scenario(scenario, golden_simulate)
-        store = GoldenStore(golden_root)
-        if config.getoption("update_goldens"):
-            try:
-                blessed = bless_run(scenario, result, store)
-            except GoldenError as exc:  # a symbolic link in the way
-                pytest.fail(str(exc), pytrace=False)
-            request.node.user_properties.append((PROP_BLESSED, blessed.line()))
-            return
-        given = config.getoption("golden_report")
-        report_dir = Path(given) if given else tmp_path_factory.getbasetemp() / "golden-report"
-        try:
-            outcome = check_run(scenario, result, store, path=path, report_dir=report_dir)
-        except GoldenError as exc:  # the report folder refused (a symbolic link)
-            pytest.fail(str(exc), pytrace=False)
-        if not outcome.ok:
-            pytest.fail(outcome.message(), pytrace=False)
+            pytest.fail(f"no scenario files in {project.scenarios}", pytrace=False)
+        check_golden(request.node, path, project, golden_load, golden_simulate, tmp_path_factory)
 
     return check
+
+
+def check_golden(node, path, project, load, simulate, tmp_path_factory) -> None:
+    """The golden test of the scenario file `path` in `project` (a runner.config.Config), run as
+    the test `node`: check it, or bless it under --update-goldens; pytest.fail with the text
+    `collide2d check` prints."""
+    from collide2d.runner.golden import bless_run, check_run, shown_path
+    from collide2d.runner.golden.cli import run_scenario, scenario_errors
+    from collide2d.runner.golden.store import GoldenError, GoldenStore
+
+    config = node.config
+    try:
+        scenario = load(shown_path(path))
+    except scenario_errors() as exc:
+        pytest.fail(str(exc), pytrace=False)
+    node.user_properties.append((PROP_NAME, scenario.name))
+    result = run_scenario(scenario, simulate)
+    store = GoldenStore(project.root, project.value("goldens"))
+    if config.getoption("update_goldens"):
+        try:
+            blessed = bless_run(scenario, result, store)
+        except GoldenError as exc:  # a symbolic link in the way
+            pytest.fail(str(exc), pytrace=False)
+        node.user_properties.append((PROP_BLESSED, blessed.line()))
+        return
+    given = config.getoption("golden_report")
+    report_dir = Path(given) if given else tmp_path_factory.getbasetemp() / "golden-report"
+    try:
+        outcome = check_run(scenario, result, store, path=path, report_dir=report_dir)
+    except GoldenError as exc:  # the report folder refused (a symbolic link)
+        pytest.fail(str(exc), pytrace=False)
+    if not outcome.ok:
+        pytest.fail(outcome.message(), pytrace=False)
 
 
 def pytest_terminal_summary(terminalreporter, exitstatus, config) -> None:
@@ -169,16 +251,16 @@ def pytest_terminal_summary(terminalreporter, exitstatus, config) -> None:
     names = {v for k, v in props if k == PROP_NAME}
     if not names:
         return
-    from collide2d.runner.golden.store import GoldenError, GoldenStore, scenario_files
+    from collide2d.runner.golden.store import GoldenError, GoldenStore
 
     try:
-        root = _root(config)
+        project = _project(config)
     except GoldenError:
         return
     # Unused goldens are only known when every scenario ran.
-    if len(names) == len(scenario_files(root)):
+    if len(names) == len(_scenario_files(project)):
         try:
-            unused = GoldenStore(root).unused(names)
+            unused = GoldenStore(project.root, project.value("goldens")).unused(names)
         except GoldenError:  # goldens/ is a link: every golden test already failed saying so
             return
         if unused:

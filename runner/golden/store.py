@@ -92,9 +92,9 @@ def find_root(start=None) -> Path:
     )
 
 
-def scenario_files(root) -> list[Path]:
-    """Every scenario file in ROOT/scenarios/, sorted by file name."""
-    folder = Path(root) / SCENARIOS_DIR
+def scenario_files(root, folder: str = SCENARIOS_DIR) -> list[Path]:
+    """Every scenario file in ROOT/scenarios/ (or ROOT/FOLDER), sorted by file name."""
+    folder = Path(root) / folder
     if not folder.is_dir():
         return []
     files = [p for p in folder.iterdir() if p.suffix in SCENARIO_SUFFIXES and p.is_file()]
@@ -138,9 +138,9 @@ class Golden:
 class GoldenStore:
     """The goldens of one project: ROOT/goldens/NAME/ per scenario."""
 
-    def __init__(self, root):
+    def __init__(self, root, goldens: str = GOLDENS_DIR):
         self.root = Path(root)
-        self.dir = self.root / GOLDENS_DIR
+        self.dir = self.root / goldens
 
     def folder(self, name: str) -> Path:
         return self.dir / check_name(name)

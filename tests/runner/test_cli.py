@@ -80,7 +80,9 @@ def test_events_and_no_events(tmp_path):
         "t": 5.1,
         "type": "pair",
         "a": 0,
+        "a_name": "left",  # the scenario names its objects
         "b": 1,
+        "b_name": "right",
         "axis": "x",
         "xdiff": 2,
         "ydiff": 10,
@@ -99,8 +101,8 @@ def test_ticks_sets_the_length(tmp_path):
     summary = json.loads((tmp_path / "tunnelling_10fps" / "summary.json").read_text())
     assert summary["ticks"] == 30
     rows = (tmp_path / "tunnelling_10fps" / "final.csv").read_text().splitlines()
-    assert rows[0] == "id,x,y,vx,vy"
-    assert rows[1].split(",")[:3] == ["0", "130", "115"]  # id 0 at 100 + 30 px
+    assert rows[0] == "id,x,y,vx,vy,name"  # the scenario names its objects
+    assert rows[1].split(",") == ["0", "130", "115", "10", "0", "left"]  # id 0 at 100 + 30 px
 
 
 def test_model_is_checked_again_under_the_new_model(tmp_path, capsys):
@@ -222,7 +224,8 @@ def test_every_scenario_runs_end_to_end(tmp_path, path):
     assert run([path, "--out", tmp_path, "--png", "--quiet"]) == 0
     folder = next(tmp_path.iterdir())
     summary = json.loads((folder / "summary.json").read_text())
-    final = np.loadtxt(folder / "final.csv", delimiter=",", skiprows=1, ndmin=2)
+    # the columns id, x, y, vx, vy (and name when the scenario names objects)
+    final = np.loadtxt(folder / "final.csv", delimiter=",", skiprows=1, ndmin=2, usecols=range(5))
     assert final.shape[0] == summary["objects"]
     assert np.isfinite(final).all()
     assert (folder / "animation.gif").is_file() and list((folder / "frames").glob("*.png"))

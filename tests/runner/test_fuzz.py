@@ -28,6 +28,7 @@ from collide2d.runner.scenario import (
     ScenarioError,
     loads,
 )
+from collide2d.runner.yamlsafe import OptionError
 
 ROOT = Path(__file__).resolve().parents[2]
 KNOWN_KEYS = sorted(set(TOP_KEYS + WORLD_KEYS + OBJECT_KEYS + BLOCK_KEYS + OUTPUT_KEYS))
@@ -179,10 +180,14 @@ BREAKS = re.compile("\r\n|[\n\r\x85\u2028\u2029]")
 
 
 def check_located(err: ScenarioError, text: str, path: str) -> None:
-    assert err.path == path
-    assert 1 <= err.line <= len(BREAKS.findall(text)) + 2, str(err)
-    assert err.col >= 1 and err.message.strip(), str(err)
-    assert str(err).startswith(f"{path}:{err.line}:{err.col}: error: ")
+    for one in getattr(err, "errors", [err]):  # every error of the file, or the one
+        assert one.path == path
+        if isinstance(one, OptionError):  # caused by a command-line option: named by it
+            assert str(one) == f"{path}: error: {one.message}" and one.message.startswith("--")
+            continue
+        assert 1 <= one.line <= len(BREAKS.findall(text)) + 2, str(one)
+        assert one.col >= 1 and one.message.strip(), str(one)
+        assert str(one).startswith(f"{path}:{one.line}:{one.col}: error: ")
 
 
 # ----------------------------------------------------------------------------- the loader

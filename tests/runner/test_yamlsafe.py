@@ -49,8 +49,8 @@ def test_top_level_must_be_a_mapping(text):
 
 
 def test_yaml_syntax_errors_are_located():
-    # the tab cannot start a token: it is the first character of line 3
-    check_refused("version: 1\nobjects:\n\t- x\n", "\t", "invalid YAML")
+    # the tab cannot start a token: it is the first character of line 3, and is explained
+    check_refused("version: 1\nobjects:\n\t- x\n", "\t", "a tab character in the indentation")
     # the flow mapping is never closed; the parser notices at the next line's key
     check_refused("version: 1\nworld: {width: 10\nticks: 5\n", ": 5", "invalid YAML")
 

@@ -1,0 +1,48 @@
+"""Seconds spent compiling numba kernels, kept apart from run time, and the first-run notice.
+
+numba compiles a kernel the first time it runs with new argument types and keeps it in its cache
+(next to the sources) for later processes; loading from that cache is quick and is not a
+compilation. `install(notice)` registers a listener for numba's `numba:compile` event, which
+numba raises only around a real compilation: from then on `seconds()` is the total time this
+process spent compiling (nested compilations, a kernel compiling the kernels it calls, count
+once), and `notice()`, when given, is called once, at the start of the first compilation (the CLI
+prints "compiling kernels, first run only ..." on a terminal). With NUMBA_DISABLE_JIT=1 nothing
+compiles and `seconds()` stays 0.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+
+_state = {"seconds": 0.0, "depth": 0, "started": 0.0, "installed": False, "notice": None}
+
+
+def install(notice: Callable[[], None] | None = None) -> None:
+    """Start counting compile time (once per process); `notice` replaces the one given before."""
+    _state["notice"] = notice
+    if _state["installed"]:
+        return
+    from numba.core import event
+
+    class _Timer(event.Listener):
+        def on_start(self, ev) -> None:
+            if _state["depth"] == 0:
+                _state["started"] = time.perf_counter()
+                told, _state["notice"] = _state["notice"], None
+                if told is not None:
+                    told()
+            _state["depth"] += 1
+
+        def on_end(self, ev) -> None:
+            _state["depth"] -= 1
+            if _state["depth"] == 0:
+                _state["seconds"] += time.perf_counter() - _state["started"]
+
+    event.register("numba:compile", _Timer())
+    _state["installed"] = True
+
+
+def seconds() -> float:
+    """Seconds this process has spent compiling kernels since `install` (0 before it)."""
+    return _state["seconds"]

@@ -1,0 +1,88 @@
+"""Kernels compile only what a scene needs: the paper model's pair stage only the pair finder the
+scene chose (broadphase.find over a method marker), the rasteriser only the drawing code of the
+kinds the scene has (draw.draw_shape over a shapes marker), with the same results as the code that
+holds every branch."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from numba import njit
+
+from collide2d.engine import broadphase as bp
+from collide2d.engine.draw import shapes_marker
+from collide2d.engine.raster import Renderer
+from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON
+from collide2d.runner.scenario import loads
+
+
+@njit
+def _via_marker(marker, lo, hi, movable, cell, order, out, ws):
+    return bp.find(marker, lo, hi, movable, cell, order, out, ws)
+
+
+@pytest.mark.parametrize("method", [bp.METHOD_SWEEP, bp.METHOD_GRID, bp.METHOD_CELLS])
+def test_the_marker_finds_the_pairs_its_method_finds(method):
+    rng = np.random.default_rng(method)
+    n = 300
+    lo = rng.uniform(0, 400, (n, 2))
+    hi = lo + rng.uniform(2, 14, (n, 2))
+    movable = rng.random(n) < 0.8
+    expected = bp.find_pairs(method, lo, hi, movable, 20.0)
+    ws = bp.workspace(n, lo.dtype)
+    order = np.argsort(lo[:, 0], kind="stable").astype(np.int64)
+    out = np.empty(4 * n, np.int64)
+    k = _via_marker(bp.marker(method), lo, hi, movable, 20.0, order, out, ws)
+    assert len(expected) > 10
+    np.testing.assert_array_equal(bp.keys_to_pairs(out[:k]), expected)
+    marker_type = _via_marker.signatures[-1][0]
+    assert str(marker_type.dtype) == str(np.dtype(bp.marker(method).dtype))
+
+
+@pytest.mark.parametrize(
+    "kinds, dtype",
+    [
+        ([KIND_BOX], np.uint8),
+        ([KIND_BOX, KIND_BOX], np.uint8),
+        ([KIND_BOX, KIND_CIRCLE], np.uint64),
+        ([KIND_POLYGON], np.uint64),
+        ([KIND_CIRCLE, KIND_POLYGON, KIND_BOX], np.uint64),
+    ],
+)
+def test_the_shapes_marker_names_the_kinds_present(kinds, dtype):
+    marker = shapes_marker(np.array(kinds, np.int8))
+    assert marker.dtype == dtype and marker.size == 0
+
+
+SHOWCASE = """version: 1
+world: {width: 90, height: 60}
+ticks: 3
+objects:
+  - {shape: box, size: [12, 8], position: [2, 2], color: red}
+  - {shape: circle, diameter: 11, position: [30, 5], color: lime, fill: true}
+  - {shape: circle, diameter: 8, position: [50, 30], color: blue}
+  - {shape: polygon, points: [[0, 9], [5, 0], [10, 9]], position: [70, 40], color: white}
+"""
+
+
+def test_a_scene_of_boxes_draws_as_the_code_with_every_kind():
+    keep = "box"
+    full = loads(SHOWCASE)
+    lines = SHOWCASE.splitlines()
+    kept = [
+        line
+        for line in lines
+        if "shape:" not in line or line.split("shape: ")[1].split(",")[0] in keep.split("|")
+    ]
+    sc = loads("\n".join(kept) + "\n")
+    assert sc.bodies.n < full.bodies.n
+    pos = sc.bodies.pos + np.array([1.0, 2.0])
+    some = Renderer(sc.world, sc.bodies)
+    every = Renderer(sc.world, sc.bodies)
+    every._art = every._art[:-1] + (np.zeros(0, np.uint64),)  # the code with every kind
+    assert some._art[-1].dtype == np.uint8
+    first = some.draw_full(pos).copy()
+    np.testing.assert_array_equal(first, every.draw_full(pos))
+    assert first.any()
+    moved = pos + np.array([3.0, 1.0])
+    np.testing.assert_array_equal(some.draw(moved), every.draw(moved))  # the dirty redraw too

@@ -1,0 +1,121 @@
+"""Tests of runner/config.py and `collide2d config`: the [tool.collide2d] table, its checks, and
+the precedence command line > scenario > table > defaults."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from collide2d.runner import config
+from collide2d.runner.cli import main
+from collide2d.runner.limits import Limits
+from collide2d.runner.scenario import loads
+
+SCENARIO = "version: 1\nticks: 3\nobjects:\n  - {shape: box, size: 4, position: [1, 1]}\n"
+
+
+def project(tmp_path: Path, table: str) -> Path:
+    (tmp_path / "pyproject.toml").write_text(f'[project]\nname = "demo"\n\n{table}')
+    return tmp_path
+
+
+def test_the_table_sets_folders_limits_and_model_defaults_with_their_source(tmp_path):
+    root = project(
+        tmp_path,
+        '[tool.collide2d]\nscenarios = "cases"\ngoldens = "expected"\n'
+        "[tool.collide2d.limits]\nmax_objects = 7\n"
+        '[tool.collide2d.model]\nkind = "stepped"\nsubsteps = 4\n',
+    )
+    deep = root / "a" / "b"
+    deep.mkdir(parents=True)
+    found = config.find(deep)
+    assert found.root == root.resolve() and found.file == root.resolve() / "pyproject.toml"
+    assert found.scenarios == root.resolve() / "cases"
+    assert found.goldens == root.resolve() / "expected"
+    assert found.folder("report") == root.resolve() / "report"
+    assert found.settings["scenarios"].source.endswith("pyproject.toml [tool.collide2d]")
+    assert found.settings["report"].source == config.DEFAULT
+    assert found.limits() == Limits(max_objects=7)
+    assert found.limits({"max_objects": 9}).max_objects == 9  # the command line wins
+    assert found.model_defaults() == {"kind": "stepped", "substeps": 4}
+
+
+def test_a_project_without_the_table_keeps_the_defaults(tmp_path):
+    (tmp_path / "pyproject.toml").write_text('[project]\nname = "x"\n')
+    (tmp_path / "scenarios").mkdir()
+    found = config.find(tmp_path)
+    assert found.file is None and found.root == tmp_path.resolve()
+    assert found.value("goldens") == "goldens" and found.load_options() == {}
+    assert not config.has_table(tmp_path / "pyproject.toml")
+
+
+@pytest.mark.parametrize(
+    "table, line, says",
+    [
+        (
+            '[tool.collide2d]\nscenario = "s"\n',
+            5,
+            "has no setting 'scenario'; did you mean 'scenarios'?",
+        ),
+        (
+            "[tool.collide2d]\n[tool.collide2d.limits]\nmax_object = 3\n",
+            6,
+            "did you mean 'max_objects'?",
+        ),
+        (
+            "[tool.collide2d]\n[tool.collide2d.model]\nsubsteps = 0\n",
+            6,
+            "model.substeps must be a whole number >= 1",
+        ),
+        ('[tool.collide2d]\n[tool.collide2d.model]\ngeometry = "round"\n', 6, "one of box | exact"),
+        ('[tool.collide2d]\ngoldens = "../elsewhere"\n', 5, "leads outside the project folder"),
+        ("[tool.collide2d\n", 4, "not valid TOML"),
+    ],
+)
+def test_a_bad_table_is_refused_at_its_line(tmp_path, table, line, says):
+    project(tmp_path, table)
+    with pytest.raises(config.ConfigError) as info:
+        config.find(tmp_path)
+    text = str(info.value)
+    assert text.startswith(f"{tmp_path / 'pyproject.toml'}:{line}:") and says in text
+
+
+def test_precedence_command_line_then_scenario_then_table_then_defaults():
+    table = {"kind": "stepped", "substeps": 4, "geometry": "exact"}
+    assert loads(SCENARIO).model == "paper"  # defaults
+    got = loads(SCENARIO, defaults=table)  # the table
+    assert (got.model, got.substeps, got.geometry) == ("stepped", 4, "exact")
+    own = SCENARIO + "model: {kind: stepped, substeps: 2}\n"  # the scenario over the table
+    got = loads(own, defaults=table)
+    assert (got.model, got.substeps, got.geometry) == ("stepped", 2, "exact")
+    got = loads(own, defaults=table, overrides={"model": "paper"})  # the command line over all
+    assert (got.model, got.geometry) == ("paper", "box")
+    cap = {"max_events_per_tick": 77}
+    assert loads(SCENARIO + "model: exact\n", defaults=cap).max_events_per_tick == 77
+    assert (
+        loads(SCENARIO + "model: exact\n", defaults=cap, overrides=cap | {"max_events_per_tick": 5})
+    ).max_events_per_tick == 5
+    assert loads(SCENARIO, defaults=cap).model == "paper"  # a setting the model does not take
+
+
+def test_config_command_prints_each_value_and_its_source(tmp_path, monkeypatch, capsys):
+    project(tmp_path, '[tool.collide2d]\nout = "runs"\n[tool.collide2d.limits]\nmax_ticks = 500\n')
+    monkeypatch.chdir(tmp_path)
+    assert main(["config", "--max-objects", "12"]) == 0
+    rows = {line.split()[0]: line for line in capsys.readouterr().out.splitlines()}
+    assert rows["out"].split()[1] == "runs" and rows["out"].endswith("[tool.collide2d]")
+    assert rows["limits.max_ticks"].split()[1] == "500"
+    assert rows["limits.max_objects"].split()[1] == "12"
+    assert rows["limits.max_objects"].endswith("command line")
+    assert rows["goldens"].endswith("default")
+
+
+def test_run_and_validate_take_the_tables_limits_and_out_folder(tmp_path, monkeypatch, capsys):
+    project(tmp_path, '[tool.collide2d]\nout = "runs"\n[tool.collide2d.limits]\nmax_ticks = 2\n')
+    (tmp_path / "s.yaml").write_text(SCENARIO)
+    monkeypatch.chdir(tmp_path)
+    assert main(["validate", "s.yaml"]) == 2
+    assert "past the limit of 2 ticks" in capsys.readouterr().err
+    assert main(["run", "s.yaml", "--max-ticks", "3", "--quiet"]) == 0  # the command line wins
+    assert (tmp_path / "runs" / "s" / "final.csv").is_file()

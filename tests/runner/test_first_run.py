@@ -1,0 +1,228 @@
+"""What a user notices on a first run and after: the compile notice and compile time apart from
+run time, start-up that loads only the command's modules, `--version`, nothing on stderr when piped,
+the tqdm progress bar, no empty frames/ folder, Ctrl-C keeping the run so far, object names in the
+outputs, plurals."""
+
+from __future__ import annotations
+
+import fcntl
+import io
+import json
+import os
+import pty
+import signal
+import struct
+import subprocess
+import sys
+import termios
+import time
+from pathlib import Path
+
+import numba
+import pytest
+
+import collide2d
+from collide2d.runner import compiling, progress
+from collide2d.runner.cli import compile_notice, main
+
+ROOT = Path(__file__).resolve().parents[2]
+SMALL = """version: 1
+name: small
+world: {width: 60, height: 40, fps: FPS}
+ticks: TICKS
+objects:
+  - {name: left, shape: box, size: 6, position: [5, 5], velocity: [20, 0]}
+  - {name: right, shape: box, size: 6, position: [40, 5], velocity: [-20, 0]}
+  - {shape: box, size: 4, position: [5, 30], velocity: [10, 0]}
+output: {frames: [8], gif: true, events: true}
+"""
+
+
+def small(tmp_path: Path, fps: int = 10, ticks: int = 40) -> Path:
+    path = tmp_path / "small.yaml"
+    path.write_text(SMALL.replace("FPS", str(fps)).replace("TICKS", str(ticks)))
+    return path
+
+
+def cli(*args, **kwargs) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "collide2d", *map(str, args)],
+        capture_output=True,
+        text=True,
+        **kwargs,
+    )
+
+
+@pytest.mark.skipif(os.environ.get("NUMBA_DISABLE_JIT") == "1", reason="nothing compiles")
+def test_compile_time_is_counted_once_per_compilation_and_the_notice_said_once():
+    told = []
+    compiling.install(lambda: told.append(1))
+    before = compiling.seconds()
+
+    @numba.njit  # not cached: compiles here
+    def inner(x):
+        return x + 1
+
+    @numba.njit
+    def outer(x):
+        return inner(x) * 2
+
+    started = time.perf_counter()
+    assert outer(3) == 8
+    took = time.perf_counter() - started
+    assert 0 < compiling.seconds() - before <= took  # nested compilations counted once
+    assert told == [1]
+    outer(4)  # compiled: nothing more
+    assert told == [1] and compiling.seconds() - before <= took
+
+
+def test_summary_reports_compile_time_apart_from_run_time(tmp_path):
+    proc = cli("run", small(tmp_path, ticks=10), "--out", tmp_path / "out")
+    assert proc.returncode == 0 and proc.stderr == ""
+    summary = json.loads((tmp_path / "out" / "small" / "summary.json").read_text())
+    assert summary["compile_time_s"] >= 0 and 0 <= summary["run_time_s"] < 60
+    assert "10 ticks under paper, 0 wall and 1 pair event in" in proc.stdout
+
+
+def test_a_terminal_gets_the_compile_notice_unless_quiet(tmp_path, monkeypatch):
+    class Terminal(io.StringIO):
+        def isatty(self):
+            return True
+
+    monkeypatch.setattr(sys, "stderr", Terminal())
+    assert main(["run", str(small(tmp_path)), "--out", str(tmp_path / "o")]) == 0
+    assert compiling._state["notice"] in (compile_notice, None)  # None once it was said
+    assert main(["run", str(small(tmp_path)), "--out", str(tmp_path / "o"), "--quiet"]) == 0
+    assert compiling._state["notice"] is None
+
+
+def test_the_notice_is_one_line_on_stderr(capsys):
+    compile_notice()
+    assert capsys.readouterr().err == (
+        "compiling kernels, first run only (numba caches them for later runs) …\n"
+    )
+
+
+def test_run_loads_only_the_modules_of_its_command(tmp_path):
+    code = (
+        "import sys\nfrom collide2d.runner.cli import main\n"
+        f"assert main(['run', {str(small(tmp_path))!r}, '--out', {str(tmp_path / 'o')!r},"
+        " '--quiet']) == 0\n"
+        "print(sorted(m for m in sys.modules if m.startswith(('collide2d.runner.golden', "
+        "'collide2d.runner.stress', 'collide2d.runner.bench', 'collide2d.runner.init'))))\n"
+    )
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == "[]"
+    code = (
+        "import sys\nfrom collide2d.runner.cli import main\nmain(['config'])\n"
+        "print('numba' in sys.modules)"
+    )
+    proc = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path
+    )
+    assert proc.stdout.splitlines()[-1] == "False"
+
+
+def test_version(capsys):
+    with pytest.raises(SystemExit) as info:
+        main(["--version"])
+    assert info.value.code == 0
+    assert capsys.readouterr().out == f"collide2d {collide2d.__version__}\n"
+
+
+def test_nothing_on_stderr_when_piped_even_the_gif_note(tmp_path):
+    proc = cli("run", small(tmp_path, fps=200, ticks=40), "--out", tmp_path / "out")
+    assert proc.returncode == 0
+    assert proc.stderr == ""  # the GIF drops frames above 50 fps: a note only a terminal sees
+
+
+def test_no_empty_frames_folder(tmp_path):
+    # frame 8 is asked for, but --ticks makes the run 5 ticks long: no PNG, no frames/
+    args = ["run", str(small(tmp_path)), "--out", str(tmp_path / "o"), "--ticks", "5"]
+    assert main([*args, "--quiet"]) == 0
+    folder = tmp_path / "o" / "small"
+    assert (folder / "final.csv").is_file() and not (folder / "frames").exists()
+    assert main([*args, "--quiet", "--png"]) == 0  # every frame, then
+    assert len(list((folder / "frames").iterdir())) == 6
+
+
+def test_names_appear_in_final_csv_and_events(tmp_path):
+    assert main(["run", str(small(tmp_path)), "--out", str(tmp_path / "o"), "--quiet"]) == 0
+    folder = tmp_path / "o" / "small"
+    rows = (folder / "final.csv").read_text().splitlines()
+    assert rows[0] == "id,x,y,vx,vy,name"
+    assert [r.split(",")[-1] for r in rows[1:]] == ["left", "right", ""]
+    events = [json.loads(line) for line in (folder / "events.jsonl").read_text().splitlines()]
+    pair = next(e for e in events if e["type"] == "pair")
+    assert list(pair)[:7] == ["tick", "t", "type", "a", "a_name", "b", "b_name"]
+    assert (pair["a_name"], pair["b_name"]) == ("left", "right")
+
+
+def test_ctrl_c_keeps_the_run_so_far(tmp_path):
+    path = small(tmp_path, fps=1000, ticks=1_000_000_000)
+    text = path.read_text().replace("gif: true", "gif: false").replace("[8]", "none")
+    path.write_text(text + "golden: {frames: [0]}\n")
+    out = tmp_path / "out"
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "collide2d",
+            "run",
+            str(path),
+            "--out",
+            str(out),
+            "--max-ticks",
+            "1000000000",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    deadline = time.monotonic() + 120
+    while not list(tmp_path.glob("out/.small.*.run.tmp")):  # the run has started
+        assert time.monotonic() < deadline and proc.poll() is None
+        time.sleep(0.05)
+    time.sleep(2.0)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130
+    assert "interrupted at tick" in err and "holds the run so far" in err
+    summary = json.loads((out / "small" / "summary.json").read_text())
+    stopped = summary["interrupted_at_tick"]
+    assert 0 < stopped < 1_000_000_000
+    events = [
+        json.loads(line) for line in (out / "small" / "events.jsonl").read_text().splitlines()
+    ]
+    assert events and all(e["tick"] <= stopped for e in events)
+    assert summary["events"]["wall"] + summary["events"]["pair"] == len(events)
+    assert not (out / "small" / "animation.gif").exists()
+
+
+def test_the_progress_bar_fits_the_terminal_and_redraws_in_place(monkeypatch):
+    monkeypatch.setattr(progress, "SHOW_AFTER_S", 0)
+    monkeypatch.setattr(progress, "REDRAW_S", 0)
+    leader, follower = pty.openpty()
+    fcntl.ioctl(follower, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 40, 0, 0))
+    with os.fdopen(follower, "w") as stream:
+        bar = progress.Progress(1000, "demo", stream)
+        for done in range(0, 1001, 250):
+            bar.update(done)
+        bar.close()
+        stream.flush()
+        text = os.read(leader, 100_000).decode()
+    os.close(leader)
+    draws = [d for d in text.split("\r") if d.strip()]
+    assert "\n" not in text and len(draws) >= 4  # redrawn in place
+    assert all(len(d) <= 40 for d in draws)  # within the terminal's 40 columns
+    assert "demo" in draws[0] and "1000/1000" in "".join(draws)
+
+
+def test_plurals(tmp_path, capsys):
+    path = small(tmp_path, ticks=1)
+    path.write_text(path.read_text().replace("[8]", "[1]"))
+    assert main(["run", str(path), "--out", str(tmp_path / "o")]) == 0
+    assert "small: 1 tick under paper, 0 wall and 0 pair events" in capsys.readouterr().out
+    assert main(["validate", str(path)]) == 0
+    assert capsys.readouterr().out.endswith("ok (3 objects, model paper, 1 tick)\n")

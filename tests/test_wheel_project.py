@@ -1,0 +1,66 @@
+"""A user's project from a wheel: build collide2d's wheel, install it into a fresh virtualenv in a
+temporary folder, and run the README's workflow there: `collide2d init`, `pytest --update-goldens`,
+`pytest`, `collide2d check`. Slow (a fresh virtualenv compiles the kernels the example needs); CI
+runs it."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+import venv
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+pytestmark = pytest.mark.slow
+
+
+def run(args, cwd, env=None) -> subprocess.CompletedProcess:
+    proc = subprocess.run(
+        [str(a) for a in args], cwd=cwd, env=env, capture_output=True, text=True, timeout=900
+    )
+    assert proc.returncode == 0, f"{args}\n{proc.stdout}\n{proc.stderr}"
+    return proc
+
+
+def test_init_then_pytest_and_check_in_a_fresh_virtualenv_from_the_wheel(tmp_path):
+    source = tmp_path / "source"  # built from a copy: the build leaves nothing in the checkout
+    ignore = shutil.ignore_patterns("__pycache__", "*.egg-info", "build")
+    for part in ("collide2d", "engine", "runner"):
+        shutil.copytree(ROOT / part, source / part, ignore=ignore)
+    for part in ("pyproject.toml", "README.md"):
+        shutil.copy(ROOT / part, source / part)
+    pip = [sys.executable, "-m", "pip"]
+    run([*pip, "wheel", "--no-deps", "-q", "-w", tmp_path / "w", source], tmp_path)
+    (wheel,) = (tmp_path / "w").glob("collide2d-*.whl")
+
+    env_dir = tmp_path / "venv"
+    venv.create(env_dir, with_pip=True)
+    bin_dir = env_dir / "bin"
+    run([bin_dir / "python", "-m", "pip", "install", "-q", f"{wheel}[test]"], tmp_path)
+
+    project = tmp_path / "project"
+    project.mkdir()
+    env = {k: v for k, v in os.environ.items() if k not in ("CI", "PYTHONPATH", "VIRTUAL_ENV")}
+    env["PATH"] = f"{bin_dir}{os.pathsep}{env.get('PATH', '')}"
+    init = run([bin_dir / "collide2d", "init"], project, env)
+    assert "pytest --update-goldens" in init.stdout
+    assert (project / "scenarios" / "example.yaml").is_file()
+    assert "[tool.collide2d]" in (project / "pyproject.toml").read_text()
+    assert "out/" in (project / ".gitignore").read_text().splitlines()
+
+    # no test file and no conftest: the plugin collects one golden test per scenario
+    assert not list(project.rglob("test_*.py")) and not list(project.rglob("conftest.py"))
+    blessed = run([bin_dir / "pytest", "--update-goldens", "-p", "no:cacheprovider"], project, env)
+    assert "created   example:" in blessed.stdout and "1 passed" in blessed.stdout
+    manifest = json.loads((project / "goldens" / "example" / "manifest.json").read_text())
+    assert manifest["scenario"] == "example"
+    checked = run([bin_dir / "pytest", "-v", "-p", "no:cacheprovider"], project, env)
+    assert "scenarios/example.yaml::golden PASSED" in checked.stdout
+    check = run([bin_dir / "collide2d", "check"], project, env)
+    assert check.stdout.splitlines()[-1] == "1 passed, 0 failed"
