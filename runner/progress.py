@@ -16,15 +16,15 @@ SHOW_AFTER_S = 0.5
 
 
 class Progress:
-    """A bar for `total` ticks written to `stream`."""
+    """A bar for `total` ticks (or other `unit`s: a sweep counts runs) written to `stream`."""
 
-    def __init__(self, total: int, label: str, stream=None):
+    def __init__(self, total: int, label: str, stream=None, unit: str = " ticks"):
         from tqdm import tqdm
 
         self.bar = tqdm(
             total=max(int(total), 1),
             desc=label,
-            unit=" ticks",
+            unit=unit,
             file=stream if stream is not None else sys.stderr,
             dynamic_ncols=True,
             leave=False,

@@ -22,7 +22,7 @@ import sys
 import threading
 import uuid
 
-from collide2d.runner.progress import BAR_WIDTH, Progress
+from collide2d.runner.progress import Progress
 
 INSTALL = 'pip install "collide2d[dask]"'
 CONNECT_TIMEOUT_S = 30
@@ -82,23 +82,12 @@ def connect(workers: int | None = None, scheduler: str | None = None):
         cluster.close()
 
 
-class RunsProgress(Progress):
-    """The progress bar in runs: `sweep [####----] 57/200 runs, 12.3s left`."""
-
-    def line(self, done: int, elapsed: float) -> str:
-        frac = min(max(done / self.total, 0.0), 1.0)
-        filled = int(frac * BAR_WIDTH)
-        bar = "#" * filled + "-" * (BAR_WIDTH - filled)
-        rate = done / elapsed if elapsed > 0 else 0.0
-        eta = f"{(self.total - done) / rate:.1f}s left" if rate > 0 else "ETA unknown"
-        return f"{self.label} [{bar}] {done}/{self.total} runs, {eta}"
-
-
 def progress_for(total: int, label: str, quiet: bool) -> Progress | None:
-    """A runs progress bar on stderr when it is a terminal and not quiet, else None."""
+    """A progress bar of runs (done/total, rate and time left) on stderr when it is a terminal and
+    not quiet, else None."""
     if quiet or not sys.stderr.isatty():
         return None
-    return RunsProgress(total, label)
+    return Progress(total, label, unit=" runs")
 
 
 def run_all(client, fn, items, on_result, *, progress=None, label="collide2d", sizes=None) -> bool:

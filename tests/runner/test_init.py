@@ -15,6 +15,10 @@ from collide2d.runner.scenario import load
 
 pytest_plugins = ["pytester"]
 
+# the nested in-process runs leave out the cache and pytest-playwright, whose per-test hook keeps
+# global state that a run inside a run trips on
+NESTED = ("-p", "no:cacheprovider", "-p", "no:playwright")
+
 
 def test_init_makes_a_project_and_prints_the_next_three_commands(tmp_path, capsys):
     assert main(["init", str(tmp_path / "p")]) == 0
@@ -71,13 +75,13 @@ def inited(pytester):
 
 def test_plain_pytest_collects_one_golden_test_per_scenario_and_update_goldens_blesses(inited):
     assert not list(inited.path.rglob("*.py"))
-    result = inited.runpytest("-v", "-p", "no:cacheprovider")
+    result = inited.runpytest("-v", *NESTED)
     result.assert_outcomes(failed=2)
     result.stdout.fnmatch_lines(["*scenarios/example.yaml::golden FAILED*"])
     result.stdout.fnmatch_lines(["*to create it: collide2d bless scenarios/example.yaml*"])
-    inited.runpytest("--update-goldens", "-p", "no:cacheprovider").assert_outcomes(passed=2)
+    inited.runpytest("--update-goldens", *NESTED).assert_outcomes(passed=2)
     assert GoldenStore(inited.path).names() == ["example", "second"]
-    result = inited.runpytest("-v", "-p", "no:cacheprovider")
+    result = inited.runpytest("-v", *NESTED)
     result.assert_outcomes(passed=2)
     result.stdout.fnmatch_lines(["*scenarios/second.yaml::golden PASSED*"])
 
@@ -85,7 +89,7 @@ def test_plain_pytest_collects_one_golden_test_per_scenario_and_update_goldens_b
 def test_a_project_without_the_table_is_untouched(pytester):
     (pytester.path / "scenarios").mkdir()
     (pytester.path / "scenarios" / "a.yaml").write_text("version: 1\nticks: 1\n")
-    result = pytester.runpytest("-p", "no:cacheprovider")
+    result = pytester.runpytest(*NESTED)
     assert result.ret == pytest.ExitCode.NO_TESTS_COLLECTED
 
 
@@ -119,7 +123,7 @@ def test_the_plugin_reads_a_custom_scenarios_folder(pytester):
         pyproject.read_text().replace('scenarios = "scenarios"', 'scenarios = "cases"')
     )
     (pytester.path / "scenarios").rename(pytester.path / "cases")
-    result = pytester.runpytest("--update-goldens", "-v", "-p", "no:cacheprovider")
+    result = pytester.runpytest("--update-goldens", "-v", *NESTED)
     result.assert_outcomes(passed=1)
     result.stdout.fnmatch_lines(["*cases/example.yaml::golden PASSED*"])
     assert Path(pytester.path / "goldens" / "example" / "manifest.json").is_file()

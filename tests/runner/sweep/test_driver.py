@@ -12,9 +12,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from collide2d.runner.progress import Progress
 from collide2d.runner.run import drive
 from collide2d.runner.sweep import driver, results
-from collide2d.runner.sweep.cluster import RunsProgress
 from collide2d.runner.sweep.driver import batch_size
 from collide2d.runner.sweep.matrix import columns, expand, parse_set
 from collide2d.runner.sweep.runs import mark_outside, run_batch, run_one
@@ -133,9 +133,12 @@ def test_boxes_out_of_the_world_are_marked_once_each():
 
 
 def test_progress_counts_runs_and_gives_an_eta():
-    bar = RunsProgress(200, "sweep", io.StringIO())
-    assert bar.line(50, 10.0) == f"sweep [{'#' * 7}{'-' * 23}] 50/200 runs, 30.0s left"
-    assert bar.line(0, 0.0).endswith("0/200 runs, ETA unknown")
+    bar = Progress(200, "sweep", io.StringIO(), unit=" runs")
+    bar.update(50)
+    shown = str(bar.bar)  # the line tqdm draws: done/total, time so far<time left, rate
+    bar.close()
+    assert shown.startswith("sweep:") and "50/200" in shown and "runs/s" in shown
+    assert "<" in shown  # an estimate of the time left
 
 
 def test_runs_in_batches_give_the_same_rows(client, runs):
