@@ -42,6 +42,7 @@ from numba import njit, prange
 from numba.extending import overload
 
 from collide2d.engine.sort import heap_argsort, sort_order
+from collide2d.engine.threads import join_shares, shares_total
 
 # A candidate pair (a, b) is one sortable int64 key, a << KEY_SHIFT | b (ids below 2**31).
 KEY_SHIFT = 32
@@ -364,19 +365,10 @@ def _cell_pairs_split(order, key, start, box, movable, nx, ny, out, n, chunks):
             c * n // chunks, (c + 1) * n // chunks, order, key, start, box, movable, nx, ny,
             out, c * share, share,
         )
-    total = 0
-    fits = True
-    for c in range(chunks):
-        total += found[c]
-        fits = fits and found[c] <= share
-    if not fits:
-        return max(total, room + 1)
-    k = 0
-    for c in range(chunks):
-        for r in range(found[c]):
-            out[k + r] = out[c * share + r]
-        k += found[c]
-    return k
+    total = shares_total(found, share, room)
+    if total > room:
+        return total
+    return join_shares(found, share, out)
 
 
 @njit(cache=True)

@@ -7,6 +7,9 @@ one thread would do on its share, so results are the same bytes with one thread 
 splits only for scenes of at least PARALLEL_MIN_OBJECTS objects (below that, starting the threads
 costs more than they save) and only when more than one thread is allowed.
 
+`shares_total` and `join_shares` join a split stage's results: each chunk writes into its own
+share of one buffer, and the shares are moved together in chunk order.
+
 `set_threads(n)` is the one switch (the command line's `--threads N`; a configuration layer calls
 the same function): it sets numba's thread count for the kernels and the number of chunks the
 models and the renderer made after it use. With `NUMBA_DISABLE_JIT=1` prange is range and the
@@ -16,6 +19,8 @@ chunks run one after another, with the same results.
 from __future__ import annotations
 
 import os
+
+from numba import njit
 
 # Threads waiting at the end of a split stage sleep instead of spinning (OpenMP's default spins):
 # on a machine shared with other work a spinning thread holds a core another thread needs, and a
@@ -66,3 +71,28 @@ def chunks_for(n_objects: int) -> int:
 
 def _jit_disabled() -> bool:
     return os.environ.get("NUMBA_DISABLE_JIT", "0") not in ("", "0")
+
+
+@njit(cache=True)
+def shares_total(found, share, room):
+    """The results of a split stage whose chunk c wrote found[c] items into its own share of
+    `share` slots: how many in all, or more than `room` (the caller grows its buffer and asks
+    again) when a chunk found more than its share held."""
+    total = 0
+    fits = True
+    for c in range(found.shape[0]):
+        total += found[c]
+        fits = fits and found[c] <= share
+    return total if fits else max(total, room + 1)
+
+
+@njit(cache=True)
+def join_shares(found, share, out):
+    """Move the chunks' shares of `out` together in chunk order (chunk c's found[c] items from
+    c * share); returns how many."""
+    k = 0
+    for c in range(found.shape[0]):
+        for r in range(found[c]):
+            out[k + r] = out[c * share + r]
+        k += found[c]
+    return k

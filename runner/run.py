@@ -92,14 +92,8 @@ def drive(
     ticks; the summary then holds `interrupted_at_tick`.
     """
     bodies = scenario.bodies
-    options = models.scenario_options(
-        scenario.model,
-        substeps=scenario.substeps,
-        geometry=scenario.geometry,
-        max_events_per_tick=scenario.max_events_per_tick,
-    )
     try:
-        model = models.make(scenario.model, scenario.world, bodies, **options)
+        model = make_model(scenario)
     except Runaway as exc:
         raise RunStopped(
             f"{scenario.path or scenario.name}: error: the {scenario.model} model refused the "
@@ -172,6 +166,17 @@ def drive(
     if model.tick < scenario.ticks:
         summary["interrupted_at_tick"] = model.tick
     return model, summary
+
+
+def make_model(scenario: Scenario):
+    """The scenario's model at tick 0, with the options the scenario sets (engine.models)."""
+    options = models.scenario_options(
+        scenario.model,
+        substeps=scenario.substeps,
+        geometry=scenario.geometry,
+        max_events_per_tick=scenario.max_events_per_tick,
+    )
+    return models.make(scenario.model, scenario.world, scenario.bodies, **options)
 
 
 def _drawn(renderer, model, k: int, overlay) -> np.ndarray:

@@ -79,7 +79,7 @@ from collide2d.engine.events import (
 from collide2d.engine.response import exchange, fold, separate
 from collide2d.engine.shapes import GEOMETRIES, build_cores
 from collide2d.engine.sort import heap_argsort, sort_by_time
-from collide2d.engine.threads import chunks_for
+from collide2d.engine.threads import chunks_for, join_shares, shares_total
 from collide2d.engine.world import Bodies, WorldSpec
 
 # The candidate list's margin, px: this many of the fastest object's step (|v|·dt), within
@@ -379,19 +379,11 @@ def _overlapping_split(pos, vel, size, span, ext, keys, n_keys, near, when, dt, 
             pos, vel, size, span, ext, keys, c * n_keys // chunks, (c + 1) * n_keys // chunks,
             near, when, c * share, share, dt
         )
-    total = 0
-    fits = True
-    for c in range(chunks):
-        total += found[c]
-        fits = fits and found[c] <= share
-    if not fits:
-        return max(total, room + 1)
-    k = 0
-    for c in range(chunks):
-        for r in range(found[c]):
-            near[k + r] = near[c * share + r]
-            when[k + r] = when[c * share + r]
-        k += found[c]
+    total = shares_total(found, share, room)
+    if total > room:
+        return total
+    k = join_shares(found, share, near)
+    join_shares(found, share, when)
     sort_by_time(when, near, k)
     return k
 

@@ -19,7 +19,6 @@ import math
 import numpy as np
 from numba import njit
 
-from collide2d.engine import models
 from collide2d.engine.errors import Runaway
 from collide2d.engine.invariants import max_penetration
 
@@ -43,14 +42,10 @@ def mark_outside(pos, size, width, height, tol, left):
 
 def _checked(scenario) -> tuple[float, int]:
     """(deepest overlap px over every tick's end, objects that left the world at any)."""
+    from collide2d.runner.run import make_model
+
     bodies = scenario.bodies
-    options = models.scenario_options(
-        scenario.model,
-        substeps=scenario.substeps,
-        geometry=scenario.geometry,
-        max_events_per_tick=scenario.max_events_per_tick,
-    )
-    model = models.make(scenario.model, scenario.world, bodies, **options)
+    model = make_model(scenario)
     size = np.ascontiguousarray(bodies.size, np.float64)
     width, height = float(scenario.world.width), float(scenario.world.height)
     left = np.zeros(bodies.n, np.bool_)
