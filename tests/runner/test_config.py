@@ -119,3 +119,20 @@ def test_run_and_validate_take_the_tables_limits_and_out_folder(tmp_path, monkey
     assert "past the limit of 2 ticks" in capsys.readouterr().err
     assert main(["run", "s.yaml", "--max-ticks", "3", "--quiet"]) == 0  # the command line wins
     assert (tmp_path / "runs" / "s" / "final.csv").is_file()
+
+
+def test_the_tables_threads_are_put_in_force_unless_the_command_line_names_some(tmp_path):
+    import argparse
+
+    from collide2d.engine import threads
+    from collide2d.runner.options import apply_threads
+
+    found = config.find(project(tmp_path, "[tool.collide2d]\nthreads = 1\n"))
+    try:
+        assert apply_threads(argparse.Namespace(threads=None), found) == 1
+        assert threads.threads() == 1
+        everything = threads.available()
+        assert apply_threads(argparse.Namespace(threads=everything), found) == everything
+        assert apply_threads(argparse.Namespace(threads=None), None) == everything
+    finally:
+        threads.set_threads(None)
