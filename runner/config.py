@@ -113,7 +113,8 @@ class Config:
         rows = [("project", str(self.root), str(self.file) if self.file else "no [tool.collide2d]")]
         for key in (*FOLDER_KEYS, "threads"):
             s = self.settings.get(key, Setting(None, DEFAULT))
-            rows.append((key, "-" if s.value is None else _shown(s.value), s.source))
+            unset = "all cores" if key == "threads" else "-"
+            rows.append((key, unset if s.value is None else _shown(s.value), s.source))
         defaults = Limits()
         for k in LIMIT_KEYS:
             s = self.settings.get(f"limits.{k}", Setting(getattr(defaults, k), DEFAULT))
