@@ -322,10 +322,19 @@ def _words(data, name: str, default: str, lower: bool = True) -> tuple[np.ndarra
     n = data.shape[0]
     if name not in data.dtype.names:
         return np.array([default]), np.zeros(n, np.int64)
-    first_seen: dict = {}  # the distinct values in order of first use (a dict: no string sort)
-    inverse = np.array(
-        [first_seen.setdefault(v, len(first_seen)) for v in data[name].tolist()], np.int64
-    )
+    column = data[name]
+    if column.dtype.kind in "US":  # texts: numpy finds the distinct ones, in order of first use
+        unique, first, of = np.unique(column, return_index=True, return_inverse=True)
+        order = np.argsort(first, kind="stable")
+        rank = np.empty(order.shape[0], np.int64)
+        rank[order] = np.arange(order.shape[0])
+        first_seen: dict = dict.fromkeys(unique[order].tolist())
+        inverse = rank[of.reshape(-1)]
+    else:  # numbers (a .npy column): a dict keeps 1 and 1.0 as one value, each NaN apart
+        first_seen = {}
+        inverse = np.array(
+            [first_seen.setdefault(v, len(first_seen)) for v in column.tolist()], np.int64
+        )
     words = []
     for u in first_seen:
         if isinstance(u, bytes):
