@@ -323,14 +323,10 @@ def _words(data, name: str, default: str, lower: bool = True) -> tuple[np.ndarra
     if name not in data.dtype.names:
         return np.array([default]), np.zeros(n, np.int64)
     column = data[name]
-    if column.dtype.kind in "US":  # texts: numpy finds the distinct ones, in order of first use
-        unique, first, of = np.unique(column, return_index=True, return_inverse=True)
-        order = np.argsort(first, kind="stable")
-        rank = np.empty(order.shape[0], np.int64)
-        rank[order] = np.arange(order.shape[0])
-        first_seen: dict = dict.fromkeys(unique[order].tolist())
-        inverse = rank[of.reshape(-1)]
-    else:  # numbers (a .npy column): a dict keeps 1 and 1.0 as one value, each NaN apart
+    few = _few_distinct(column) if column.dtype.kind in "US" else None
+    if few is not None:
+        first_seen, inverse = few
+    else:  # many texts, or numbers (a .npy column: 1 and 1.0 one value, each NaN apart)
         first_seen = {}
         inverse = np.array(
             [first_seen.setdefault(v, len(first_seen)) for v in column.tolist()], np.int64
@@ -342,6 +338,28 @@ def _words(data, name: str, default: str, lower: bool = True) -> tuple[np.ndarra
         u = str(u).strip()
         words.append(u.lower() if lower else u)
     return np.array(words + [""])[:-1], inverse.reshape(-1)
+
+
+FEW_DISTINCT = 16  # a text column with more distinct values is taken apart by a dict
+
+
+def _few_distinct(column: np.ndarray):
+    """({value: None} in order of first use, each row's index into them) of a text column with
+    at most FEW_DISTINCT distinct values, found by comparing whole columns; None when it has
+    more."""
+    n = column.shape[0]
+    inverse = np.full(n, -1, np.int64)
+    seen: dict = {}
+    at = 0
+    while at < n:
+        if len(seen) == FEW_DISTINCT:
+            return None
+        value = column[at : at + 1]
+        inverse[at:][column[at:] == value[0]] = len(seen)
+        seen[value.tolist()[0]] = None
+        rest = np.flatnonzero(inverse[at:] < 0)
+        at = at + int(rest[0]) if rest.size else n
+    return seen, inverse
 
 
 def _first(bad: np.ndarray) -> int | None:
