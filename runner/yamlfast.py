@@ -8,8 +8,10 @@ A scenario that lists thousands of objects usually writes one per line,
 and reading that through the general path (an event pass, a node tree, a reader per object) costs
 tens of microseconds per value. When every line of the `objects` list has that form, with only
 plain values of the simplest kinds (decimal numbers, [x, y] pairs of them, and words), this lane
-takes the values of each key from the lines with one regular expression each, converts and checks
-them a column at a time with numpy, and hands the result on as a `runner.table.Table`; the rest of
+takes the values of each key from the lines (when every line has the first line's keys, in its
+order, with values of the same forms, by one pattern over the whole list, its groups the columns;
+else line by line), converts and checks them a column at a time with numpy, and hands the result
+on as a `runner.table.Table`; the rest of
 the file, with the list's lines blanked (so every line keeps its number), goes through the general
 path as before.
 
@@ -139,9 +141,7 @@ def _same_as_first(first: str, block: str, n: int):
     if any(k not in KEYS for k, _ in keys):
         return None
     indent = len(first) - len(first.lstrip())
-    line_re = re.compile(
-        rf"^ {{{indent}}}- \{{ *" + " *, *".join(parts) + r" *\} *$", re.MULTILINE
-    )
+    line_re = re.compile(rf"^ {{{indent}}}- \{{ *" + " *, *".join(parts) + r" *\} *$", re.MULTILINE)
     rows = line_re.findall(block)
     if len(rows) != n:
         return None
