@@ -77,6 +77,8 @@ _INITIAL_ROWS = 1024
 _MARGIN_STEPS = 8
 _MARGIN_MIN_PX = 2
 _MARGIN_MAX_PX = 32
+# Reach boxes are kept in int32 when the world, steps and sides keep them within this (px).
+REACH_INT32_MAX = 2**30
 
 # The kernel's scalar state (int64): ticks done, the stage of the next tick to run, candidates
 # listed (-1: none yet), this tick's drift (px) and whether a box left the world, whether the list
@@ -325,7 +327,7 @@ class Model:
             np.empty((n, 2), np.int64),
             params,
             marker(method),
-            np.empty((n, 4), np.int64),  # reach boxes side by side, for the narrow stage
+            np.empty((n, 4), _reach_dtype(world, self.size, self.step)),  # for the narrow stage
         )
         self._ws = workspace(n, np.int64)
 
@@ -407,6 +409,15 @@ class Model:
     def velocities(self) -> np.ndarray:
         """Velocities in px/s: V / P * fps per component."""
         return self.step / self.period * float(self.fps)
+
+
+def _reach_dtype(world: WorldSpec, size: np.ndarray, step: np.ndarray):
+    """int32 for the narrow stage's reach boxes when every value they can hold (a position in the
+    world, less or plus a step, plus a side) fits it with room to spare, so that they take half
+    the cache; else int64."""
+    far = max(int(world.width), int(world.height))
+    far += 2 * (int(np.abs(step).max()) if step.size else 0) + (int(size.max()) if size.size else 0)
+    return np.int32 if far <= REACH_INT32_MAX else np.int64
 
 
 def _margin(step: np.ndarray) -> int:
