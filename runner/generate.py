@@ -331,17 +331,15 @@ def _apart(pos: np.ndarray, size: np.ndarray) -> bool:
             return False
     x0, y0 = pos[:, 0], pos[:, 1]
     x1, y1 = pos[:, 0] + size[:, 0], pos[:, 1] + size[:, 1]
-    n = pos.shape[0]
-    ids = np.arange(n)
     for dx, dy in ((0, 0), (1, 0), (-1, 1), (0, 1), (1, 1)):
-        target = key + dy * gx + dx
+        target = sorted_key + dy * gx + dx  # for the boxes in cell order (sorted: a fast search)
         start = np.searchsorted(sorted_key, target, "left")
         stop = np.searchsorted(sorted_key, target, "right")
         for slot in range(APART_MAX_PER_CELL):
             has = start + slot < stop
             if not has.any():
                 break
-            i = ids[has]
+            i = order[has]
             j = order[start[has] + slot]
             if dx == 0 and dy == 0:
                 i, j = i[i != j], j[i != j]
