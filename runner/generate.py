@@ -287,9 +287,66 @@ def cell_size(extent_x: float, extent_y: float, max_sides: np.ndarray) -> float:
     grid has more than GRID_CELLS_PER_BOX cells per box.
     """
     n = max(1, int(max_sides.shape[0]))
-    median = float(np.median(max_sides)) if max_sides.shape[0] else GRID_MIN_CELL
+    median = _median(max_sides) if max_sides.shape[0] else GRID_MIN_CELL
     sparse = math.sqrt(max(extent_x, 1.0) * max(extent_y, 1.0) / (GRID_CELLS_PER_BOX * n))
     return max(GRID_MIN_CELL, median, sparse)
+
+
+def _median(v: np.ndarray) -> float:
+    """numpy.median of a non-empty 1-D array, bit for bit (the middle value, or the mean of the
+    two middle ones; NaN when any is NaN), without numpy.median's first-call import of numpy.ma."""
+    s = np.sort(np.asarray(v, dtype=np.float64))
+    if np.isnan(s[-1]):
+        return math.nan
+    k = s.shape[0] // 2
+    if s.shape[0] % 2:
+        return float(s[k])
+    return float((s[k - 1] + s[k]) / 2.0)
+
+
+APART_MAX_PER_CELL = 4  # _apart gives up (the kernel decides) past this many boxes in a cell
+_APART_MAX_COORD = 2.0**40  # and past coordinates this large (their rounding against a cell)
+
+
+def _apart(pos: np.ndarray, size: np.ndarray) -> bool:
+    """True only when no two boxes overlap, found with numpy alone (no kernel to load): each box
+    goes to the cell of its corner on a grid of the largest side (and a little more, for
+    rounding), so two boxes that overlap sit in the same or neighbouring cells, and every such
+    pair is tested as `_query` tests it. False when they may overlap or the scene does not suit
+    the test (crowded cells, huge coordinates): `first_overlap` then asks the kernel."""
+    if not (np.all(np.isfinite(pos)) and np.all(np.isfinite(size))):
+        return False
+    if np.max(np.abs(pos)) > _APART_MAX_COORD or np.max(size) > _APART_MAX_COORD:
+        return False
+    lo = pos.min(axis=0)
+    cell = float(np.max(size)) * 1.01 + 1e-9
+    c = np.floor((pos - lo) / cell).astype(np.int64)
+    gx = int(c[:, 0].max()) + 3
+    key = (c[:, 1] + 1) * gx + (c[:, 0] + 1)
+    order = np.argsort(key, kind="stable")
+    sorted_key = key[order]
+    if sorted_key.shape[0] > APART_MAX_PER_CELL:
+        crowded = sorted_key[APART_MAX_PER_CELL:] == sorted_key[:-APART_MAX_PER_CELL]
+        if crowded.any():
+            return False
+    x0, y0 = pos[:, 0], pos[:, 1]
+    x1, y1 = pos[:, 0] + size[:, 0], pos[:, 1] + size[:, 1]
+    for dx, dy in ((0, 0), (1, 0), (-1, 1), (0, 1), (1, 1)):
+        target = sorted_key + dy * gx + dx  # for the boxes in cell order (sorted: a fast search)
+        start = np.searchsorted(sorted_key, target, "left")
+        stop = np.searchsorted(sorted_key, target, "right")
+        for slot in range(APART_MAX_PER_CELL):
+            has = start + slot < stop
+            if not has.any():
+                break
+            i = order[has]
+            j = order[start[has] + slot]
+            if dx == 0 and dy == 0:
+                i, j = i[i != j], j[i != j]
+            hit = (x0[i] < x1[j]) & (x0[j] < x1[i]) & (y0[i] < y1[j]) & (y0[j] < y1[i])
+            if hit.any():
+                return False
+    return True
 
 
 def first_overlap(pos, size) -> tuple[int, int] | None:
@@ -301,7 +358,7 @@ def first_overlap(pos, size) -> tuple[int, int] | None:
     pos = np.ascontiguousarray(pos, dtype=np.float64).reshape(-1, 2)
     size = np.ascontiguousarray(size, dtype=np.float64).reshape(-1, 2)
     n = pos.shape[0]
-    if n < 2:
+    if n < 2 or _apart(pos, size):
         return None
     lo = pos.min(axis=0)
     hi = (pos + size).max(axis=0)

@@ -322,10 +322,15 @@ def _words(data, name: str, default: str, lower: bool = True) -> tuple[np.ndarra
     n = data.shape[0]
     if name not in data.dtype.names:
         return np.array([default]), np.zeros(n, np.int64)
-    first_seen: dict = {}  # the distinct values in order of first use (a dict: no string sort)
-    inverse = np.array(
-        [first_seen.setdefault(v, len(first_seen)) for v in data[name].tolist()], np.int64
-    )
+    column = data[name]
+    few = _few_distinct(column) if column.dtype.kind in "US" else None
+    if few is not None:
+        first_seen, inverse = few
+    else:  # many texts, or numbers (a .npy column: 1 and 1.0 one value, each NaN apart)
+        first_seen = {}
+        inverse = np.array(
+            [first_seen.setdefault(v, len(first_seen)) for v in column.tolist()], np.int64
+        )
     words = []
     for u in first_seen:
         if isinstance(u, bytes):
@@ -333,6 +338,28 @@ def _words(data, name: str, default: str, lower: bool = True) -> tuple[np.ndarra
         u = str(u).strip()
         words.append(u.lower() if lower else u)
     return np.array(words + [""])[:-1], inverse.reshape(-1)
+
+
+FEW_DISTINCT = 16  # a text column with more distinct values is taken apart by a dict
+
+
+def _few_distinct(column: np.ndarray):
+    """({value: None} in order of first use, each row's index into them) of a text column with
+    at most FEW_DISTINCT distinct values, found by comparing whole columns; None when it has
+    more."""
+    n = column.shape[0]
+    inverse = np.full(n, -1, np.int64)
+    seen: dict = {}
+    at = 0
+    while at < n:
+        if len(seen) == FEW_DISTINCT:
+            return None
+        value = column[at : at + 1]
+        inverse[at:][column[at:] == value[0]] = len(seen)
+        seen[value.tolist()[0]] = None
+        rest = np.flatnonzero(inverse[at:] < 0)
+        at = at + int(rest[0]) if rest.size else n
+    return seen, inverse
 
 
 def _first(bad: np.ndarray) -> int | None:

@@ -8,8 +8,10 @@ A scenario that lists thousands of objects usually writes one per line,
 and reading that through the general path (an event pass, a node tree, a reader per object) costs
 tens of microseconds per value. When every line of the `objects` list has that form, with only
 plain values of the simplest kinds (decimal numbers, [x, y] pairs of them, and words), this lane
-takes the values of each key from the lines with one regular expression each, converts and checks
-them a column at a time with numpy, and hands the result on as a `runner.table.Table`; the rest of
+takes the values of each key from the lines (when every line has the first line's keys, in its
+order, with values of the same forms, by one pattern over the whole list, its groups the columns;
+else line by line), converts and checks them a column at a time with numpy, and hands the result
+on as a `runner.table.Table`; the rest of
 the file, with the list's lines blanked (so every line keeps its number), goes through the general
 path as before.
 
@@ -44,6 +46,7 @@ _VALUE = rf"(?:{_NUM}|\[ *{_NUM} *, *{_NUM} *\]|{_WORD})"
 _ITEM_RE = re.compile(rf" *- \{{ *[a-z]+: {_VALUE}(?: *, *[a-z]+: {_VALUE})* *\}} *")
 _FIELD_RE = re.compile(rf"([a-z]+): (?:\[ *({_NUM}) *, *({_NUM}) *\]|({_NUM}|{_WORD}))")
 _HEAD_RE = re.compile(r"objects: *\n")
+_BLOCK_RE = re.compile(r"(?: *- [^\n]*(?:\n|\Z))*")
 KEYS = (
     "shape",
     "size",
@@ -76,6 +79,7 @@ class Split:
     rest: str
     lines: list[str]
     first_line: int
+    same: dict | None = None  # the columns when every line has the first's form (_same_as_first)
 
     @property
     def n(self) -> int:
@@ -94,39 +98,135 @@ def split(text: str) -> Split | None:
     if m is None:
         return None
     start = m.end()
-    lines = []
-    pos = start
-    while pos < len(text):
-        end = text.find("\n", pos)
-        end = len(text) if end < 0 else end
-        line = text[pos:end]
-        if not line.lstrip().startswith("- "):
-            break
-        lines.append(line)
-        pos = end + 1
+    pos = _BLOCK_RE.match(text, start).end()
+    block = text[start:pos]
+    if block.endswith("\n"):
+        block = block[:-1]
+    lines = block.split("\n") if block else []
     if len(lines) < FAST_MIN_OBJECTS:
         return None
     if pos < len(text) and not (text[pos].isalpha() or text[pos] == "#"):
         return None  # the list must end at the next top-level key (or a comment, or the end)
-    indent = len(lines[0]) - len(lines[0].lstrip())
-    if any(not _ITEM_RE.fullmatch(line) for line in lines) or any(
-        len(line) - len(line.lstrip()) != indent for line in lines
-    ):
+    if not _ITEM_RE.fullmatch(lines[0]):
         return None
+    rows = _same_as_first(lines[0], block, len(lines))
+    if rows is None:
+        indent = len(lines[0]) - len(lines[0].lstrip())
+        if any(not _ITEM_RE.fullmatch(line) for line in lines) or any(
+            len(line) - len(line.lstrip()) != indent for line in lines
+        ):
+            return None
     head_line = text.count("\n", 0, m.start())
     rest = text[: m.start()] + "objects: []\n" + "\n" * len(lines) + text[pos:]
     if pos >= len(text) and not text.endswith("\n"):
         rest = rest[:-1]
-    return Split(rest, lines, head_line + 1)
+    return Split(rest, lines, head_line + 1, rows)
+
+
+def _same_as_first(first: str, block: str, n: int):
+    """When every line of `block` has the keys of `first`, in its order, each with a value of the
+    same form (a pair or one value) and the same indent: {key: column} of the values' texts, a
+    pair's as two columns (key, key + "_y"); else None (the lines are then read one by one)."""
+    keys = []
+    parts = []
+    for key, x, _y, _one in _FIELD_RE.findall(first):
+        pair = bool(x)
+        keys.append((key, pair))
+        if pair:
+            parts.append(rf"{key}: \[ *({_NUM}) *, *({_NUM}) *\]")
+        else:
+            parts.append(rf"{key}: ({_NUM}|{_WORD})")
+    if len(keys) != first.count(":") or len({k for k, _ in keys}) != len(keys):
+        return None
+    if any(k not in KEYS for k, _ in keys):
+        return None
+    indent = len(first) - len(first.lstrip())
+    line_re = re.compile(rf"^ {{{indent}}}- \{{ *" + " *, *".join(parts) + r" *\} *$", re.MULTILINE)
+    rows = line_re.findall(block)
+    if len(rows) != n:
+        return None
+    if len(parts) == 1 and not keys[0][1]:
+        rows = [(r,) for r in rows]
+    columns = list(zip(*rows, strict=True)) if rows else []
+    out = {}
+    at = 0
+    for key, pair in keys:
+        out[key] = columns[at]
+        if pair:
+            out[key + "_y"] = columns[at + 1]
+        at += 2 if pair else 1
+    return {"keys": keys, "columns": out}
 
 
 def nodes(split_: Split) -> int:
     """YAML values the list holds (as the general path counts them): the mapping, each key and
     value, and two more for each pair."""
+    if split_.same is not None:
+        first = split_.lines[0]
+        return split_.n * (1 + 2 * first.count(":") + 2 * first.count("["))
     n = 0
     for line in split_.lines:
         n += 1 + 2 * line.count(":") + 2 * line.count("[")
     return n
+
+
+@dataclass
+class _Column:
+    """One key's values over the lines: `one` marks the lines giving one value (texts in `ones`,
+    in line order), `two` those giving an [x, y] pair (texts in `xs`, `ys`)."""
+
+    one: np.ndarray
+    ones: list
+    two: np.ndarray
+    xs: list
+    ys: list
+
+    @property
+    def present(self) -> np.ndarray:
+        return self.one | self.two
+
+
+def _columns(split_: Split) -> dict[str, _Column]:
+    """Every key's _Column: taken whole when all lines share the first's form, else line by line
+    (FallBack on an unknown or repeated key)."""
+    n = split_.n
+    none = np.zeros(n, bool)
+    every = np.ones(n, bool)
+    if split_.same is not None:
+        out = {k: _Column(none, [], none, [], []) for k in KEYS}
+        cols = split_.same["columns"]
+        for key, pair in split_.same["keys"]:
+            if pair:
+                out[key] = _Column(none, [], every, list(cols[key]), list(cols[key + "_y"]))
+            else:
+                out[key] = _Column(every, list(cols[key]), none, [], [])
+        return out
+    raw: dict[str, list] = {k: ([], [], [], [], []) for k in KEYS}
+    for i, line in enumerate(split_.lines):
+        fields = _FIELD_RE.findall(line)
+        if len(fields) != line.count(":"):
+            raise FallBack
+        seen = set()
+        for key, x, y, one in fields:
+            col = raw.get(key)
+            if col is None or key in seen:
+                raise FallBack  # an unknown or repeated key: the general path says so
+            seen.add(key)
+            if one:
+                col[0].append(i)
+                col[1].append(one)
+            else:
+                col[2].append(i)
+                col[3].append(x)
+                col[4].append(y)
+    out = {}
+    for key, (one_at, ones, two_at, xs, ys) in raw.items():
+        one = none.copy()
+        one[one_at] = True
+        two = none.copy()
+        two[two_at] = True
+        out[key] = _Column(one, ones, two, xs, ys)
+    return out
 
 
 def _number(values: list[str]) -> np.ndarray:
@@ -149,33 +249,28 @@ def table(split_: Split, world, paper: bool, max_objects: int):
     n = split_.n
     if n > max_objects:
         raise FallBack
-    # each key's values by line: a text, or a (x, y) pair of texts; None where absent
-    cols: dict[str, list] = {k: [None] * n for k in KEYS}
-    for i, line in enumerate(split_.lines):
-        fields = _FIELD_RE.findall(line)
-        if len(fields) != line.count(":"):
-            raise FallBack
-        for key, x, y, one in fields:
-            col = cols.get(key)
-            if col is None or col[i] is not None:
-                raise FallBack  # an unknown or repeated key: the general path says so
-            col[i] = one if one else (x, y)
+    cols = _columns(split_)
 
     def present(key) -> np.ndarray:
-        return np.array([v is not None for v in cols[key]], bool)
+        return cols[key].present
 
     def words(key) -> np.ndarray:
-        raw = cols[key]
-        if any(isinstance(v, tuple) for v in raw):
+        col = cols[key]
+        if col.two.any():
             raise FallBack
-        return np.array(["" if v is None else v for v in raw])
+        if col.one.all():
+            return np.array(col.ones)
+        out = np.full(n, "", dtype=np.array([*col.ones, ""]).dtype)
+        out[col.one] = col.ones
+        return out
 
     def pairs(key, default) -> np.ndarray:
-        out = np.full((n, 2), default, np.float64)
-        raw = [v for v in cols[key] if v is not None]
-        if any(not isinstance(v, tuple) for v in raw):
+        col = cols[key]
+        if col.one.any():
             raise FallBack
-        out[present(key)] = _number([c for v in raw for c in v]).reshape(-1, 2)
+        out = np.full((n, 2), default, np.float64)
+        out[col.two, 0] = _number(col.xs)
+        out[col.two, 1] = _number(col.ys)
         return out
 
     shape = words("shape")
@@ -185,16 +280,14 @@ def table(split_: Split, world, paper: bool, max_objects: int):
     # sizes: a box takes size (one number or [w, h]), a circle diameter (one number)
     if np.any(present("size") == circle) or np.any(present("diameter") != circle):
         raise FallBack
-    size_raw = [
-        d if c else b
-        for b, d, c in zip(cols["size"], cols["diameter"], circle.tolist(), strict=True)
-    ]
-    single = np.array([not isinstance(v, tuple) for v in size_raw], bool)
-    if np.any(circle & ~single):
+    box_size, diameter = cols["size"], cols["diameter"]
+    if diameter.two.any():
         raise FallBack
     size = np.empty((n, 2))
-    size[single] = _number([v for v in size_raw if not isinstance(v, tuple)])[:, None]
-    size[~single] = _number([c for v in size_raw if isinstance(v, tuple) for c in v]).reshape(-1, 2)
+    size[box_size.one] = _number(box_size.ones)[:, None]
+    size[diameter.one] = _number(diameter.ones)[:, None]
+    size[box_size.two, 0] = _number(box_size.xs)
+    size[box_size.two, 1] = _number(box_size.ys)
     if not np.all((size >= 1) & (size == np.floor(size)) & (size <= 2.0**53)):
         raise FallBack
     if not present("position").all():
@@ -218,8 +311,8 @@ def table(split_: Split, world, paper: bool, max_objects: int):
     mass = np.full(n, DEFAULT_MASS)
     has_mass = present("mass")
     if has_mass.any():
-        raw = [v for v in cols["mass"] if v is not None]
-        if any(isinstance(v, tuple) or not v[-1:].isdigit() for v in raw):
+        raw = cols["mass"].ones
+        if cols["mass"].two.any() or not all(v[-1:].isdigit() for v in raw):
             raise FallBack
         mass[has_mass] = _number(raw)
         if np.any(has_mass & static) or not np.all((mass >= MIN_MASS) & (mass <= MAX_MASS)):
@@ -238,9 +331,18 @@ def table(split_: Split, world, paper: bool, max_objects: int):
             rgb.append(colors.parse_color_text(word) if word else DEFAULT_COLOR)
         except ValueError:
             raise FallBack from None
-    names = tuple(cols["name"])
-    for name in set(names) - {None}:
-        if isinstance(name, tuple) or name in _NOT_TEXT or name[:1].isdigit() or name[0] == "-":
+    name = cols["name"]
+    if name.two.any():
+        raise FallBack
+    if name.one.all():
+        names = tuple(name.ones)
+    else:
+        listed = [None] * n
+        for i, text in zip(np.flatnonzero(name.one).tolist(), name.ones, strict=True):
+            listed[i] = text
+        names = tuple(listed)
+    for text in set(name.ones):
+        if text in _NOT_TEXT or text[:1].isdigit() or text[0] == "-":
             raise FallBack
     # inside the world and apart, as runner.assemble checks listed objects
     if np.any((pos < 0) | (pos + size > np.array([world.width, world.height]))):

@@ -77,6 +77,8 @@ _INITIAL_ROWS = 1024
 _MARGIN_STEPS = 8
 _MARGIN_MIN_PX = 2
 _MARGIN_MAX_PX = 32
+# Reach boxes are kept in int32 when the world, steps and sides keep them within this (px).
+REACH_INT32_MAX = 2**30
 
 # The kernel's scalar state (int64): ticks done, the stage of the next tick to run, candidates
 # listed (-1: none yet), this tick's drift (px) and whether a box left the world, whether the list
@@ -165,20 +167,27 @@ def _relist(pos, size, disp, movable, margin, finder, cell, order, lo, hi, keys,
 
 
 @njit(cache=True, inline="always")
-def _near(pos, size, disp, keys, n_keys, near):
+def _near(pos, size, disp, keys, n_keys, near, reach):
     """The listed pairs whose reach boxes overlap now, into `near` (as long as `keys`), sorted by
-    (a, b); returns how many."""
+    (a, b); returns how many. The reach boxes are first written side by side in one row per
+    object, reach (n, 4) = [x lo, x hi, y lo, y hi], so that testing a pair reads one row of each
+    object rather than its position, displacement and size from three arrays."""
+    for i in range(pos.shape[0]):
+        for ax in range(2):
+            d = disp[i, ax]
+            lo = pos[i, ax] - max(d, 0)
+            reach[i, 2 * ax] = lo
+            reach[i, 2 * ax + 1] = lo + abs(d) + size[i, ax]
     k = 0
     for c in range(n_keys):
         a = keys[c] >> KEY_SHIFT
         b = keys[c] & KEY_MASK
-        meet = True
-        for ax in range(2):
-            da = disp[a, ax]
-            db = disp[b, ax]
-            lo_a = pos[a, ax] - max(da, 0)
-            lo_b = pos[b, ax] - max(db, 0)
-            meet &= (lo_b < lo_a + abs(da) + size[a, ax]) & (lo_a < lo_b + abs(db) + size[b, ax])
+        meet = (
+            (reach[b, 0] < reach[a, 1])
+            & (reach[a, 0] < reach[b, 1])
+            & (reach[b, 2] < reach[a, 3])
+            & (reach[a, 2] < reach[b, 3])
+        )
         near[k] = keys[c]
         k += meet
     sort_keys(near, k)
@@ -221,9 +230,9 @@ def _run(pos, size, room, step, period, count, movable, stop, log, st, bp, ev, w
     done x _N_STAGES, a tick's end); returns _DONE, or _LOG_FULL / _KEYS_FULL when `ev` or the
     candidate buffers need more room (grow them and call again: the tick resumes at the stage it
     stopped). st: the scalar state (see _S_*); bp = (order, anchor, keys, near, disp, lo, hi,
-    params, finder) with params = [margin px, method, grid cell px] (float64) and finder the
+    params, finder, reach) with params = [margin px, method, grid cell px] (float64) and finder the
     method's marker (broadphase.marker: only that pair finder is compiled)."""
-    order, anchor, keys, near, disp, lo, hi, params, finder = bp
+    order, anchor, keys, near, disp, lo, hi, params, finder, reach = bp
     margin = int(params[0])
     cell = params[2]
     n = pos.shape[0]
@@ -263,7 +272,7 @@ def _run(pos, size, room, step, period, count, movable, stop, log, st, bp, ev, w
                     anchor[i, 1] = pos[i, 1]
         elif stage == _STAGE_NARROW:
             # narrow: the listed pairs whose reach boxes overlap, in (a, b) order
-            st[_S_NEAR] = _near(pos, size, disp, keys, st[_S_KEYS], near)
+            st[_S_NEAR] = _near(pos, size, disp, keys, st[_S_KEYS], near, reach)
         else:
             # response: the rule on each of them
             if log and n_ev + st[_S_NEAR] > ev.shape[0]:
@@ -318,6 +327,7 @@ class Model:
             np.empty((n, 2), np.int64),
             params,
             marker(method),
+            np.empty((n, 4), _reach_dtype(world, self.size, self.step)),  # for the narrow stage
         )
         self._ws = workspace(n, np.int64)
 
@@ -399,6 +409,15 @@ class Model:
     def velocities(self) -> np.ndarray:
         """Velocities in px/s: V / P * fps per component."""
         return self.step / self.period * float(self.fps)
+
+
+def _reach_dtype(world: WorldSpec, size: np.ndarray, step: np.ndarray):
+    """int32 for the narrow stage's reach boxes when every value they can hold (a position in the
+    world, less or plus a step, plus a side) fits it with room to spare, so that they take half
+    the cache; else int64."""
+    far = max(int(world.width), int(world.height))
+    far += 2 * (int(np.abs(step).max()) if step.size else 0) + (int(size.max()) if size.size else 0)
+    return np.int32 if far <= REACH_INT32_MAX else np.int64
 
 
 def _margin(step: np.ndarray) -> int:

@@ -299,6 +299,25 @@ def test_dense_crowd_equals_the_reference_and_logging_changes_nothing():
     assert m.positions().astype(int).tolist() == ref_pos
 
 
+def test_reach_boxes_in_int64_give_the_int32_run(monkeypatch):
+    """A world too large for int32 reach boxes keeps them in int64, with the same run."""
+    from collide2d.engine.models import paper
+
+    rng = np.random.default_rng(3)
+    cells = rng.choice(16 * 12, size=60, replace=False)
+    pos = np.stack([cells % 16 * 10, cells // 16 * 10], axis=1)
+    vel = rng.choice([-20, -10, 10, 20, 30], size=(60, 2))
+    small = Model(WorldSpec(160, 120, 10), Bodies.boxes(pos, 9, vel))
+    monkeypatch.setattr(paper, "REACH_INT32_MAX", 100)  # as if the world were far too large
+    large = Model(WorldSpec(160, 120, 10), Bodies.boxes(pos, 9, vel))
+    assert small._bp[-1].dtype == np.int32 and large._bp[-1].dtype == np.int64
+    assert logged(small.advance(200)) == logged(large.advance(200))
+    assert small.positions().tobytes() == large.positions().tobytes()
+    assert paper._reach_dtype(WorldSpec(2**30, 100, 10), np.ones((1, 2)), np.ones((1, 2))) == (
+        np.int64
+    )
+
+
 def test_far_jumps_fall_back_to_a_full_sort_and_stay_exact():
     # 60 px a tick in a 300 px world: the sweep order is reshuffled every tick
     rng = np.random.default_rng(5)

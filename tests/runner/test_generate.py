@@ -60,6 +60,32 @@ def test_first_overlap_with_mixed_sizes_matches_all_pairs():
         assert gen.first_overlap(pos, size) == brute_first_overlap(pos, size)
 
 
+@settings(max_examples=40, deadline=None)
+@given(st.data())
+def test_the_numpy_check_says_apart_only_when_no_two_overlap(data):
+    """gen._apart (numpy alone, before any kernel) may decline, but never misses an overlap."""
+    n = data.draw(st.integers(2, 40))
+    corner = st.tuples(st.integers(0, 30), st.integers(0, 30))
+    side = st.tuples(st.integers(1, 6), st.integers(1, 6))
+    pos = np.array(data.draw(st.lists(corner, min_size=n, max_size=n)), float) * 4.0
+    size = np.array(data.draw(st.lists(side, min_size=n, max_size=n)), float)
+    nudge = data.draw(st.sampled_from([0.0, 1e-9, -1e-9, 0.5]))
+    pos[1:] += nudge * (np.arange(n - 1) % 2)[:, None]
+    if gen._apart(pos, size):
+        assert brute_first_overlap(pos, size) is None
+
+
+def test_the_numpy_check_decides_a_spaced_lattice_and_finds_one_overlap():
+    ys, xs = np.mgrid[0:300, 0:300]
+    pos = np.stack([xs.ravel(), ys.ravel()], 1) * 12.0
+    size = np.full_like(pos, 12.0)  # every box touches its neighbours
+    assert gen._apart(pos, size)
+    assert gen.first_overlap(pos, size) is None
+    pos[77_777] += [0.0, 1e-6]  # now overlaps the box below it, 300 ids on
+    assert not gen._apart(pos, size)
+    assert gen.first_overlap(pos, size) == (77_777, 78_077)
+
+
 def test_touching_is_not_overlapping():
     pos = np.array([[0, 0], [10, 0], [0, 10], [10, 10], [20, 0]], float)
     assert gen.first_overlap(pos, np.full((5, 2), 10.0)) is None

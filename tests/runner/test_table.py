@@ -216,3 +216,14 @@ def test_a_bad_table_exits_2_and_writes_nothing(tmp_path, capsys):
     assert main(["run", str(tmp_path / "scene.yaml"), "--out", str(out), "--quiet"]) == 2
     assert "bodies.csv:5:20: error: row 4, column vx: must be a number" in capsys.readouterr().err
     assert not out.exists() or not any(out.iterdir())
+
+
+@pytest.mark.parametrize("distinct", [3, 20])  # compared column-wise, and past FEW_DISTINCT
+def test_colours_keep_the_order_of_first_use(tmp_path, distinct):
+    shades = [f"#{(37 * k) % 256:02x}{(91 * k) % 256:02x}{255 - k:02x}" for k in range(distinct)]
+    order = [shades[(7 * r) % distinct] for r in range(40)]
+    rows = ["id,shape,w,h,x,y,color"] + [f"{r},box,4,4,{r * 5},0,{c}" for r, c in enumerate(order)]
+    scene = load(write(tmp_path, rows=rows))
+    first_use = list(dict.fromkeys(order))
+    expected = [[int(c[i : i + 2], 16) for i in (1, 3, 5)] for c in first_use]
+    assert scene.palette[1 : 1 + len(expected)].tolist() == expected  # row 0: background

@@ -194,3 +194,42 @@ def test_a_list_inside_a_text_is_not_taken_for_objects(small_lane):
     same(loads(source), general(source))
     assert small_lane == []
     assert scenario_module.loads(source).bodies.n == 3
+
+
+def one_form(kind: int, n: int = 30) -> list[str]:
+    """Lines of one form only (the same keys, in one order, with values of the same kinds): the
+    lane then takes the list's columns whole instead of line by line."""
+    return lines(kind + 11, 150)[kind::5][:n]
+
+
+@pytest.mark.parametrize("kind", [0, 1, 2, 3, 4])
+def test_a_list_of_one_form_gives_the_scenario_of_the_general_path(small_lane, kind):
+    items = one_form(kind)
+    assert yamlfast.split(text(items)).same is not None
+    source = text(items)
+    same(loads(source), general(source))
+    assert small_lane == [len(items)]
+
+
+@pytest.mark.parametrize(
+    "change",
+    [
+        at(4, "shape: box", "shape: circle"),
+        at(4, "size: 12", "size: [12, 12]"),
+        at(4, "name: wall_", "name: yes_"),
+        at(4, "teal", "no"),
+        at(4, "static: true", "static: on"),
+        lambda ls: ls[:4] + [ls[4].replace("  - ", "   - ")] + ls[5:],
+        lambda ls: ls[:4] + [ls[4] + "  "] + ls[5:],
+    ],
+)
+def test_one_form_with_a_line_apart_reads_as_the_general_path(small_lane, change):
+    source = text(change(one_form(2)))
+    try:
+        expected = general(source)
+    except ScenarioError as err:
+        with pytest.raises(ScenarioError) as info:
+            loads(source)
+        assert str(info.value) == str(err)
+    else:
+        same(loads(source), expected)
