@@ -10,6 +10,7 @@ import io
 import json
 import os
 import pty
+import select
 import signal
 import struct
 import subprocess
@@ -200,6 +201,17 @@ def test_ctrl_c_keeps_the_run_so_far(tmp_path):
     assert not (out / "small" / "animation.gif").exists()
 
 
+def read_all(fd: int) -> bytes:
+    """Everything waiting on fd: one read may return only part of what a terminal holds."""
+    chunks = []
+    while select.select([fd], [], [], 0.5)[0]:
+        data = os.read(fd, 100_000)
+        if not data:
+            break
+        chunks.append(data)
+    return b"".join(chunks)
+
+
 def test_the_progress_bar_fits_the_terminal_and_redraws_in_place(monkeypatch):
     monkeypatch.setattr(progress, "SHOW_AFTER_S", 0)
     monkeypatch.setattr(progress, "REDRAW_S", 0)
@@ -211,7 +223,7 @@ def test_the_progress_bar_fits_the_terminal_and_redraws_in_place(monkeypatch):
             bar.update(done)
         bar.close()
         stream.flush()
-        text = os.read(leader, 100_000).decode()
+        text = read_all(leader).decode()
     os.close(leader)
     draws = [d for d in text.split("\r") if d.strip()]
     assert "\n" not in text and len(draws) >= 4  # redrawn in place
