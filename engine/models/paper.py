@@ -168,7 +168,7 @@ def _relist(pos, size, disp, movable, margin, finder, cell, order, lo, hi, keys,
 def _near(pos, size, disp, keys, n_keys, near):
     """The listed pairs whose reach boxes overlap now, into `near` (as long as `keys`), sorted by
     (a, b); returns how many."""
-    k = 0
+    k = np.int64(0)  # not the literal 0, which would compile sort_keys once more for it
     for c in range(n_keys):
         a = keys[c] >> KEY_SHIFT
         b = keys[c] & KEY_MASK

@@ -5,6 +5,10 @@ holds every branch."""
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 from numba import njit
@@ -86,3 +90,40 @@ def test_a_scene_of_boxes_draws_as_the_code_with_every_kind():
     assert first.any()
     moved = pos + np.array([3.0, 1.0])
     np.testing.assert_array_equal(some.draw(moved), every.draw(moved))  # the dirty redraw too
+
+
+SIGNATURES = """
+import numpy as np
+from numba import types
+from collide2d.engine import sort
+from collide2d.engine.models import paper
+
+rng = np.random.default_rng(1)
+n = 100
+keys = np.arange(n, dtype=np.int64)[::-1].copy()
+pos = np.zeros((n, 2))
+size = np.full((n, 2), 5.0)
+near = np.empty(n, np.int64)
+assert paper._near(pos, size, np.zeros((n, 2)), keys, n, near) == n
+sort.sort_by_time(rng.random(n), keys.copy(), n)
+sort.heap_argsort(rng.random(n))
+for f in (sort.sort_keys, sort._sift_keys, sort._sift_timed, sort._sift_order):
+    literal = any(isinstance(a, types.Literal) for s in f.signatures for a in s)
+    print(f.__name__, len(f.signatures), literal)
+"""
+
+
+@pytest.mark.skipif(os.environ.get("NUMBA_DISABLE_JIT") == "1", reason="nothing compiles")
+def test_the_sorts_compile_once_not_again_for_a_literal_zero(tmp_path):
+    """A literal 0 passed where a count or an index goes compiles a kernel a second time (numba
+    types it as Literal[int](0)); the paper model's pair sort and the heap sorts pass typed ints."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    got = subprocess.run(
+        [sys.executable, "-c", SIGNATURES], capture_output=True, text=True, env=env, check=True
+    ).stdout.split()
+    assert got == [
+        *("sort_keys", "1", "False"),
+        *("_sift_keys", "1", "False"),
+        *("_sift_timed", "1", "False"),
+        *("_sift_order", "1", "False"),
+    ]
