@@ -32,7 +32,7 @@ def test_the_marker_finds_the_pairs_its_method_finds(method):
     lo = rng.uniform(0, 400, (n, 2))
     hi = lo + rng.uniform(2, 14, (n, 2))
     movable = rng.random(n) < 0.8
-    expected = bp.find_pairs(method, lo, hi, movable, 20.0)
+    expected = bp.sweep_pairs(lo, hi, ~movable)  # the reference answer
     ws = bp.workspace(n, lo.dtype)
     order = np.argsort(lo[:, 0], kind="stable").astype(np.int64)
     out = np.empty(4 * n, np.int64)
@@ -127,3 +127,53 @@ def test_the_sorts_compile_once_not_again_for_a_literal_zero(tmp_path):
         *("_sift_timed", "1", "False"),
         *("_sift_order", "1", "False"),
     ]
+
+
+FINDERS = """
+import numpy as np
+from numba import njit
+from numba.core import event
+from collide2d.engine import broadphase as bp
+from collide2d.engine.models import stepped
+
+compiled = set()
+
+
+class Listen(event.Listener):
+    def on_start(self, ev):
+        compiled.add(ev.data["dispatcher"].py_func.__name__)
+
+    def on_end(self, ev):
+        pass
+
+
+event.register("numba:compile", Listen())
+
+
+@njit
+def stepped_candidates(finder, lo, hi, movable, cell, order, keys, ws, chunks):
+    return stepped._candidates(finder, lo, hi, movable, cell, order, keys, ws, chunks)
+
+
+lo = np.array([[0.0, 0.0], [5.0, 5.0], [50.0, 50.0]])
+hi = lo + 10.0
+movable = np.ones(3, bool)
+assert bp.find_pairs(bp.METHOD_SWEEP, lo, hi, movable).tolist() == [[0, 1]]
+keys = np.empty(16, np.int64)
+order = np.arange(3, dtype=np.int64)
+finder = bp.marker(bp.METHOD_SWEEP)
+assert stepped_candidates(finder, lo, hi, movable, 1.0, order, keys, bp.workspace(3), 2) == 1
+names = ("sweep_candidates", "grid_candidates", "cell_candidates", "cell_candidates_split")
+print(*(name for name in names if name in compiled))
+"""
+
+
+@pytest.mark.skipif(os.environ.get("NUMBA_DISABLE_JIT") == "1", reason="nothing compiles")
+def test_the_sweep_compiles_no_other_pair_finder(tmp_path):
+    """broadphase.find_pairs (the start-up overlap check) and the stepped model's pair stage
+    compile the one finder their method names, not the grid's and the cells' too."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    got = subprocess.run(
+        [sys.executable, "-c", FINDERS], capture_output=True, text=True, env=env, check=True
+    ).stdout.split()
+    assert got == ["sweep_candidates"]
