@@ -567,7 +567,7 @@ def _run(world, substeps, tick0, ticks, log, S, exact, cores, rows, times, bp):
     """
     width, height, fps = world
     dt = 1.0 / (fps * substeps)
-    n_ev = 0
+    n_ev = np.int64(0)  # not the literal 0, which would compile _step once more for it
     for tick in range(tick0 + 1, tick0 + ticks + 1):
         t = tick / fps
         for _ in range(substeps):
