@@ -177,3 +177,41 @@ def test_the_sweep_compiles_no_other_pair_finder(tmp_path):
         [sys.executable, "-c", FINDERS], capture_output=True, text=True, env=env, check=True
     ).stdout.split()
     assert got == ["sweep_candidates"]
+
+
+SPRITES = """
+from numba.core import event
+from collide2d.engine.sprites import sprites
+from collide2d.runner.scenario import loads
+
+compiled = set()
+
+
+class Listen(event.Listener):
+    def on_start(self, ev):
+        compiled.add(ev.data["dispatcher"].py_func.__name__)
+
+    def on_end(self, ev):
+        pass
+
+
+event.register("numba:compile", Listen())
+scene = loads(
+    "version: 1\\nworld: {width: 40, height: 30}\\nticks: 1\\nobjects:\\n"
+    "  - {shape: box, size: [3, 2], position: [2, 2]}\\n"
+)
+start, offsets = sprites(scene.bodies)
+assert start.tolist() == [0, 6], start
+print(*sorted(name for name in ("_circle", "_polygon") if name in compiled) or ["none"])
+"""
+
+
+@pytest.mark.skipif(os.environ.get("NUMBA_DISABLE_JIT") == "1", reason="nothing compiles")
+def test_the_sprites_of_boxes_compile_no_circle_or_polygon_drawing(tmp_path):
+    """The viewer's sprites (engine.sprites) draw through the shapes marker, as the renderer does:
+    a scene of boxes compiles no circle or polygon rasteriser for them."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    got = subprocess.run(
+        [sys.executable, "-c", SPRITES], capture_output=True, text=True, env=env, check=True
+    ).stdout.split()
+    assert got == ["none"]
