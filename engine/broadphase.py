@@ -491,11 +491,18 @@ def find_pairs(method: int, lo: np.ndarray, hi: np.ndarray, movable: np.ndarray,
     ws = workspace(n, lo.dtype)
     order = np.arange(n, dtype=np.int64)
     out = np.empty(max(16, n), np.int64)
-    k = candidates(method, lo, hi, movable, float(cell), order, out, ws)
+    finder = marker(method)
+    k = _find_keys(finder, lo, hi, movable, float(cell), order, out, ws)
     if k > out.shape[0]:
         out = np.empty(k, np.int64)
-        k = candidates(method, lo, hi, movable, float(cell), order, out, ws)
+        k = _find_keys(finder, lo, hi, movable, float(cell), order, out, ws)
     return keys_to_pairs(out[:k])
+
+
+@njit(cache=True)
+def _find_keys(finder, lo, hi, movable, cell, order, out, ws):
+    """`find` for callers outside the kernels: compiles only the finder `finder` names."""
+    return find(finder, lo, hi, movable, cell, order, out, ws)
 
 
 # --- the reference answer (tests) and the exact model's grid ------------------------------------

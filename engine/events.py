@@ -131,9 +131,11 @@ def log_event(rows, times, n, tick, t, kind, a, b, code):
     """Write event n, doubling the buffers first when full; returns the (rows, times) to use."""
     if n >= rows.shape[0]:
         more_rows = np.empty((max(2 * rows.shape[0], 16), ROW_COLUMNS), np.int64)
-        more_rows[:n] = rows[:n]
         more_times = np.empty(more_rows.shape[0])
-        more_times[:n] = times[:n]
+        for r in range(n):  # by element: a slice copy compiles numba's broadcast check
+            more_times[r] = times[r]
+            for c in range(ROW_COLUMNS):
+                more_rows[r, c] = rows[r, c]
         rows, times = more_rows, more_times
     put_event(rows, times, n, tick, t, kind, a, b, code)
     return rows, times

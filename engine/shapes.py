@@ -78,13 +78,13 @@ def pixel_hull(verts):
     for i in range(p.shape[0]):
         while h >= 2 and _cross(hull[h - 2], hull[h - 1], p[i]) <= 0:
             h -= 1
-        hull[h] = p[i]
+        hull[h, 0], hull[h, 1] = p[i, 0], p[i, 1]  # by element: no broadcast check to compile
         h += 1
     lower = h + 1
     for i in range(p.shape[0] - 2, -1, -1):
         while h >= lower and _cross(hull[h - 2], hull[h - 1], p[i]) <= 0:
             h -= 1
-        hull[h] = p[i]
+        hull[h, 0], hull[h, 1] = p[i, 0], p[i, 1]  # by element: no broadcast check to compile
         h += 1
     return hull[: h - 1].astype(np.float64)
 
@@ -141,7 +141,8 @@ def _build(kind, size, vert_start, verts, exact):
             counts[i] = 1
         elif k == KIND_POLYGON:
             hull = pixel_hull(verts[vert_start[i] : vert_start[i + 1]])
-            buf[at : at + hull.shape[0]] = hull
+            for r in range(hull.shape[0]):  # by element: no broadcast check to compile
+                buf[at + r, 0], buf[at + r, 1] = hull[r, 0], hull[r, 1]
             counts[i] = hull.shape[0]
         else:
             w = size[i, 0]
@@ -158,7 +159,9 @@ def _build(kind, size, vert_start, verts, exact):
     core = buf[:at].copy()
     normals = np.zeros((at, 2))
     for i in range(n):
-        normals[start[i] : start[i + 1]] = edge_normals(core[start[i] : start[i + 1]])
+        edges = edge_normals(core[start[i] : start[i + 1]])
+        for r in range(edges.shape[0]):  # by element: no broadcast check to compile
+            normals[start[i] + r, 0], normals[start[i] + r, 1] = edges[r, 0], edges[r, 1]
     return shape, radius, start, core, normals
 
 

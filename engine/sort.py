@@ -24,11 +24,12 @@ INSERTION_SORT_MAX = 64
 def _heapsort_order(order, key):
     """Sort `order` in place so that key[order] ascends (heap sort: allocates nothing)."""
     n = order.shape[0]
+    top = np.int64(0)  # a typed 0: a literal 0 would compile _sift_order once more
     for root in range(n // 2 - 1, -1, -1):
         _sift_order(order, key, root, n)
     for end in range(n - 1, 0, -1):
         order[0], order[end] = order[end], order[0]
-        _sift_order(order, key, 0, end)
+        _sift_order(order, key, top, end)
 
 
 @njit(cache=True)
@@ -88,11 +89,12 @@ def sort_keys(keys, n):
     """Sort keys[:n] in place, allocating nothing: insertion sort for the usual handful (the
     pairs that overlap in one step), a heap sort past INSERTION_SORT_MAX."""
     if n > INSERTION_SORT_MAX:
+        top = np.int64(0)  # a typed 0: a literal 0 would compile _sift_keys once more
         for root in range(n // 2 - 1, -1, -1):
             _sift_keys(keys, root, n)
         for end in range(n - 1, 0, -1):
             keys[0], keys[end] = keys[end], keys[0]
-            _sift_keys(keys, 0, end)
+            _sift_keys(keys, top, end)
         return
     for i in range(1, n):
         key = keys[i]
@@ -128,12 +130,13 @@ def sort_by_time(when, keys, n):
     """Sort when[:n] and keys[:n] together in place by (time, key), allocating nothing: insertion
     sort for the usual handful, a heap sort past INSERTION_SORT_MAX."""
     if n > INSERTION_SORT_MAX:
+        top = np.int64(0)  # a typed 0: a literal 0 would compile _sift_timed once more
         for root in range(n // 2 - 1, -1, -1):
             _sift_timed(when, keys, root, n)
         for end in range(n - 1, 0, -1):
             when[0], when[end] = when[end], when[0]
             keys[0], keys[end] = keys[end], keys[0]
-            _sift_timed(when, keys, 0, end)
+            _sift_timed(when, keys, top, end)
         return
     for i in range(1, n):
         t = when[i]

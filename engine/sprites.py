@@ -11,8 +11,9 @@ plus their offsets, inside the world, in its colour, over the background. The ru
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
-from collide2d.engine.draw import _draw_one
+from collide2d.engine.draw import draw_shape, shapes_marker
 from collide2d.engine.raster import _extents, round_positions
 from collide2d.engine.world import KIND_CIRCLE, Bodies
 
@@ -30,6 +31,7 @@ def sprites(bodies: Bodies) -> tuple[np.ndarray, np.ndarray]:
     counts = np.diff(vert_start) if kind.shape[0] else np.zeros(0, np.int64)
     diam = wh[kind == KIND_CIRCLE, 0]
     scratch = np.empty(max(1, int(counts.max(initial=0)), int(diam.max(initial=0))), np.int64)
+    shapes = shapes_marker(kind)
     start = [0]
     parts = []
     for i in range(kind.shape[0]):
@@ -38,8 +40,8 @@ def sprites(bodies: Bodies) -> tuple[np.ndarray, np.ndarray]:
             start.append(start[-1])
             continue
         buf = np.zeros((y1 - y0 + 1, x1 - x0 + 1), np.uint8)
-        _draw_one(
-            buf, i, -x0, -y0, kind, wh, ones, fill, vert_start, verts, scratch,
+        _draw_sprite(
+            shapes, buf, i, -x0, -y0, kind, wh, ones, fill, vert_start, verts, scratch,
             0, 0, x1 - x0, y1 - y0,
         )  # fmt: skip
         ys, xs = np.nonzero(buf)
@@ -59,3 +61,14 @@ def paint(world_w: int, world_h: int, color, start, offsets, ipos) -> np.ndarray
         pts = pts[ok]
         out[pts[:, 1], pts[:, 0]] = color[i]
     return out
+
+
+@njit(cache=True)
+def _draw_sprite(
+    shapes, buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, cx0, cy0, cx1, cy1
+):
+    """`engine.draw.draw_shape`: compiles only the drawing code of the kinds `shapes` names (a
+    scene of boxes never compiles the circle and polygon rasterisers for its sprites)."""
+    draw_shape(
+        shapes, buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, cx0, cy0, cx1, cy1
+    )

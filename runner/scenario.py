@@ -64,8 +64,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from collide2d.engine.models import MODEL_NAMES
-from collide2d.engine.models.exact import MAX_EVENTS_PER_TICK
+from collide2d.engine.models import MAX_EVENTS_PER_TICK, MODEL_NAMES
 from collide2d.engine.noroom import no_room, no_room_message
 from collide2d.engine.shapes import GEOMETRIES
 from collide2d.engine.world import Bodies, WorldSpec

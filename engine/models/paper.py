@@ -178,7 +178,7 @@ def _near(pos, size, disp, keys, n_keys, near, reach):
             lo = pos[i, ax] - max(d, 0)
             reach[i, 2 * ax] = lo
             reach[i, 2 * ax + 1] = lo + abs(d) + size[i, ax]
-    k = 0
+    k = np.int64(0)  # not the literal 0, which would compile sort_keys once more for it
     for c in range(n_keys):
         a = keys[c] >> KEY_SHIFT
         b = keys[c] & KEY_MASK

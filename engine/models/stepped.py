@@ -46,6 +46,7 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import njit, prange
+from numba.extending import overload
 
 from collide2d.engine.broadphase import (
     KEY_MASK,
@@ -53,9 +54,10 @@ from collide2d.engine.broadphase import (
     METHOD_CELLS,
     METHOD_GRID,
     METHOD_SWEEP,
-    candidates,
     cell_candidates_split,
     choose,
+    find,
+    marker,
     workspace,
 )
 from collide2d.engine.contact import (
@@ -270,7 +272,7 @@ def _relist(S, dt, margin, method, cell, bp):
     from it (on average more than REORDER_ROWS rows of the grid). Returns (the key buffer, possibly
     grown; how many keys)."""
     pos, vel, size, inv_mass, static, movable, span, ext, rank, anchor = S
-    keys, near, order, lo, hi, folds, state, params, ws, when = bp
+    keys, near, order, lo, hi, folds, state, params, ws, when, finder = bp
     n = pos.shape[0]
     for _ in range(2):
         for i in range(n):
@@ -283,7 +285,7 @@ def _relist(S, dt, margin, method, cell, bp):
             hi[i, 1] = max(pos[i, 1], by) + size[i, 1] + margin
             anchor[i, 0] = pos[i, 0]
             anchor[i, 1] = pos[i, 1]
-        k = _candidates(method, lo, hi, movable, cell, order, keys, ws, state[ST_CHUNKS])
+        k = _candidates(finder, lo, hi, movable, cell, order, keys, ws, state[ST_CHUNKS])
         if method == METHOD_GRID:
             break
         stray = 0
@@ -294,7 +296,7 @@ def _relist(S, dt, margin, method, cell, bp):
         _reorder(S, order)
     while k > keys.shape[0]:
         keys = np.empty(2 * k, np.int64)
-        k = _candidates(method, lo, hi, movable, cell, order, keys, ws, state[ST_CHUNKS])
+        k = _candidates(finder, lo, hi, movable, cell, order, keys, ws, state[ST_CHUNKS])
     return keys, k
 
 
@@ -307,13 +309,30 @@ def _swept_back(pos, vel, span, i, dt):
     return 0.0 <= x <= max(span[i, 0], 0.0) and 0.0 <= y <= max(span[i, 1], 0.0)
 
 
-@njit(cache=True)
-def _candidates(method, lo, hi, movable, cell, order, keys, ws, chunks):
-    """broadphase.candidates, its pair tests split among `chunks` threads for the cells method
-    when more than one (the same keys in the same order)."""
-    if chunks > 1 and method == METHOD_CELLS:
+def _candidates(finder, lo, hi, movable, cell, order, keys, ws, chunks):
+    """broadphase.find by the method the marker `finder` names, its pair tests split among
+    `chunks` threads for the cells method when more than one (the same keys in the same order).
+    A kernel compiles only the finder its marker names (this body runs only without the JIT)."""
+    if chunks > 1 and finder.dtype == marker(METHOD_CELLS).dtype:
         return cell_candidates_split(lo, hi, movable, cell, order, keys, ws, chunks)
-    return candidates(method, lo, hi, movable, cell, order, keys, ws)
+    return find(finder, lo, hi, movable, cell, order, keys, ws)
+
+
+@overload(_candidates)
+def _candidates_of(finder, lo, hi, movable, cell, order, keys, ws, chunks):
+    if finder.dtype.bitwidth == 32:  # the cells method's marker (broadphase.marker)
+
+        def cells(finder, lo, hi, movable, cell, order, keys, ws, chunks):
+            if chunks > 1:
+                return cell_candidates_split(lo, hi, movable, cell, order, keys, ws, chunks)
+            return find(finder, lo, hi, movable, cell, order, keys, ws)
+
+        return cells
+
+    def one(finder, lo, hi, movable, cell, order, keys, ws, chunks):
+        return find(finder, lo, hi, movable, cell, order, keys, ws)
+
+    return one
 
 
 @njit(cache=True)
@@ -475,7 +494,7 @@ def _step(first, last, S, dt, width, height, exact, cores, tick, t, log, rows, t
     """Run the stages first ... last-1 (of STAGES) of one step; returns (event buffers, how many
     events, bp): the buffers that grew replace the caller's. What a stage hands the next waits
     in bp between calls: the drift in params[P_DRIFT], the overlapping pairs in state[ST_NEAR]."""
-    keys, near, order, lo, hi, folds, state, params, ws, when = bp
+    keys, near, order, lo, hi, folds, state, params, ws, when, finder = bp
     if first <= _MOVE < last:
         # move, walls: every object; the walls' events in id order; how far anything drifted
         # from where the candidate list was made
@@ -494,14 +513,14 @@ def _step(first, last, S, dt, width, height, exact, cores, tick, t, log, rows, t
         # the candidate list made anew once an object drifted its margin
         if state[0] < 0 or params[P_DRIFT] >= params[0] - params[2]:
             keys, state[0] = _relist(S, dt, params[0], state[1], params[1], bp)
-            bp = (keys, near, order, lo, hi, folds, state, params, ws, when)
+            bp = (keys, near, order, lo, hi, folds, state, params, ws, when, finder)
     if first <= _NARROW < last:
         # the listed pairs in contact this step, in the order their contacts began
         state[ST_NEAR] = _narrow(S, keys, state[0], near, when, dt, state[ST_CHUNKS])
         while state[ST_NEAR] > near.shape[0]:
             near = np.empty(2 * state[ST_NEAR], np.int64)
             when = np.empty(2 * state[ST_NEAR])
-            bp = (keys, near, order, lo, hi, folds, state, params, ws, when)
+            bp = (keys, near, order, lo, hi, folds, state, params, ws, when, finder)
             state[ST_NEAR] = _narrow(S, keys, state[0], near, when, dt, state[ST_CHUNKS])
     if first <= _RESPONSE < last:
         rows, times, n_ev = _pairs(
@@ -530,8 +549,9 @@ def _run(world, substeps, tick0, ticks, log, S, exact, cores, rows, times, bp):
     many events, bp): the buffers that grew replace the caller's.
 
     S: the state arrays (a `State`). bp = (keys, near, order, lo, hi, folds, state, params, ws,
-    when): the candidate list kept between calls (see the module docstring) and scratch (`when`:
-    the times the pairs of `near` began their contacts); state = [keys
+    when, finder): the candidate list kept between calls (see the module docstring) and scratch
+    (`when`: the times the pairs of `near` began their contacts; `finder`: the marker of the
+    method, broadphase.marker, so that a kernel compiles only that pair finder); state = [keys
     listed (-1: no list yet), method, whether pairs can happen at all, wall events and pair events
     so far, logged or not (ST_WALLS, ST_PAIRS), overlapping pairs of this step (ST_NEAR), chunks
     the move and narrow stages split into among threads (ST_CHUNKS, engine.threads)]; params
@@ -539,7 +559,7 @@ def _run(world, substeps, tick0, ticks, log, S, exact, cores, rows, times, bp):
     """
     width, height, fps = world
     dt = 1.0 / (fps * substeps)
-    n_ev = 0
+    n_ev = np.int64(0)  # not the literal 0, which would compile _step once more for it
     for tick in range(tick0 + 1, tick0 + ticks + 1):
         t = tick / fps
         for _ in range(substeps):
@@ -729,4 +749,5 @@ def _broad_phase(world, pos, vel, size, movable, substeps, skip, broadphase):
         np.array([margin, cell, slack, 0.0]),
         workspace(n),
         np.empty(max(16, n)),  # when
+        marker(method),  # finder: the kernels compile only this method's pair finder
     )

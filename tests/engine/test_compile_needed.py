@@ -5,6 +5,10 @@ holds every branch."""
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 from numba import njit
@@ -28,7 +32,7 @@ def test_the_marker_finds_the_pairs_its_method_finds(method):
     lo = rng.uniform(0, 400, (n, 2))
     hi = lo + rng.uniform(2, 14, (n, 2))
     movable = rng.random(n) < 0.8
-    expected = bp.find_pairs(method, lo, hi, movable, 20.0)
+    expected = bp.sweep_pairs(lo, hi, ~movable)  # the reference answer
     ws = bp.workspace(n, lo.dtype)
     order = np.argsort(lo[:, 0], kind="stable").astype(np.int64)
     out = np.empty(4 * n, np.int64)
@@ -86,3 +90,128 @@ def test_a_scene_of_boxes_draws_as_the_code_with_every_kind():
     assert first.any()
     moved = pos + np.array([3.0, 1.0])
     np.testing.assert_array_equal(some.draw(moved), every.draw(moved))  # the dirty redraw too
+
+
+SIGNATURES = """
+import numpy as np
+from numba import types
+from collide2d.engine import sort
+from collide2d.engine.models import paper
+
+rng = np.random.default_rng(1)
+n = 100
+keys = np.arange(n, dtype=np.int64)[::-1].copy()
+pos = np.zeros((n, 2))
+size = np.full((n, 2), 5.0)
+near = np.empty(n, np.int64)
+assert paper._near(pos, size, np.zeros((n, 2)), keys, n, near) == n
+sort.sort_by_time(rng.random(n), keys.copy(), n)
+sort.heap_argsort(rng.random(n))
+for f in (sort.sort_keys, sort._sift_keys, sort._sift_timed, sort._sift_order):
+    literal = any(isinstance(a, types.Literal) for s in f.signatures for a in s)
+    print(f.__name__, len(f.signatures), literal)
+"""
+
+
+@pytest.mark.skipif(os.environ.get("NUMBA_DISABLE_JIT") == "1", reason="nothing compiles")
+def test_the_sorts_compile_once_not_again_for_a_literal_zero(tmp_path):
+    """A literal 0 passed where a count or an index goes compiles a kernel a second time (numba
+    types it as Literal[int](0)); the paper model's pair sort and the heap sorts pass typed ints."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    got = subprocess.run(
+        [sys.executable, "-c", SIGNATURES], capture_output=True, text=True, env=env, check=True
+    ).stdout.split()
+    assert got == [
+        *("sort_keys", "1", "False"),
+        *("_sift_keys", "1", "False"),
+        *("_sift_timed", "1", "False"),
+        *("_sift_order", "1", "False"),
+    ]
+
+
+FINDERS = """
+import numpy as np
+from numba import njit
+from numba.core import event
+from collide2d.engine import broadphase as bp
+from collide2d.engine.models import stepped
+
+compiled = set()
+
+
+class Listen(event.Listener):
+    def on_start(self, ev):
+        compiled.add(ev.data["dispatcher"].py_func.__name__)
+
+    def on_end(self, ev):
+        pass
+
+
+event.register("numba:compile", Listen())
+
+
+@njit
+def stepped_candidates(finder, lo, hi, movable, cell, order, keys, ws, chunks):
+    return stepped._candidates(finder, lo, hi, movable, cell, order, keys, ws, chunks)
+
+
+lo = np.array([[0.0, 0.0], [5.0, 5.0], [50.0, 50.0]])
+hi = lo + 10.0
+movable = np.ones(3, bool)
+assert bp.find_pairs(bp.METHOD_SWEEP, lo, hi, movable).tolist() == [[0, 1]]
+keys = np.empty(16, np.int64)
+order = np.arange(3, dtype=np.int64)
+finder = bp.marker(bp.METHOD_SWEEP)
+assert stepped_candidates(finder, lo, hi, movable, 1.0, order, keys, bp.workspace(3), 2) == 1
+names = ("sweep_candidates", "grid_candidates", "cell_candidates", "cell_candidates_split")
+print(*(name for name in names if name in compiled))
+"""
+
+
+@pytest.mark.skipif(os.environ.get("NUMBA_DISABLE_JIT") == "1", reason="nothing compiles")
+def test_the_sweep_compiles_no_other_pair_finder(tmp_path):
+    """broadphase.find_pairs (the start-up overlap check) and the stepped model's pair stage
+    compile the one finder their method names, not the grid's and the cells' too."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    got = subprocess.run(
+        [sys.executable, "-c", FINDERS], capture_output=True, text=True, env=env, check=True
+    ).stdout.split()
+    assert got == ["sweep_candidates"]
+
+
+SPRITES = """
+from numba.core import event
+from collide2d.engine.sprites import sprites
+from collide2d.runner.scenario import loads
+
+compiled = set()
+
+
+class Listen(event.Listener):
+    def on_start(self, ev):
+        compiled.add(ev.data["dispatcher"].py_func.__name__)
+
+    def on_end(self, ev):
+        pass
+
+
+event.register("numba:compile", Listen())
+scene = loads(
+    "version: 1\\nworld: {width: 40, height: 30}\\nticks: 1\\nobjects:\\n"
+    "  - {shape: box, size: [3, 2], position: [2, 2]}\\n"
+)
+start, offsets = sprites(scene.bodies)
+assert start.tolist() == [0, 6], start
+print(*sorted(name for name in ("_circle", "_polygon") if name in compiled) or ["none"])
+"""
+
+
+@pytest.mark.skipif(os.environ.get("NUMBA_DISABLE_JIT") == "1", reason="nothing compiles")
+def test_the_sprites_of_boxes_compile_no_circle_or_polygon_drawing(tmp_path):
+    """The viewer's sprites (engine.sprites) draw through the shapes marker, as the renderer does:
+    a scene of boxes compiles no circle or polygon rasteriser for them."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    got = subprocess.run(
+        [sys.executable, "-c", SPRITES], capture_output=True, text=True, env=env, check=True
+    ).stdout.split()
+    assert got == ["none"]

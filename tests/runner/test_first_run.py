@@ -110,8 +110,9 @@ def test_run_loads_only_the_modules_of_its_command(tmp_path):
         f"assert main(['run', {str(small(tmp_path))!r}, '--out', {str(tmp_path / 'o')!r},"
         " '--quiet']) == 0\n"
         "print(sorted(m for m in sys.modules if m.startswith(('collide2d.runner.golden', "
-        "'collide2d.runner.stress', 'collide2d.runner.bench', 'collide2d.runner.init'))))\n"
-    )
+        "'collide2d.runner.stress', 'collide2d.runner.bench', 'collide2d.runner.init', "
+        "'collide2d.engine.models.exact', 'collide2d.engine.models.stepped'))))\n"
+    )  # a run of a paper scene loads neither of the other models
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.strip() == "[]"
