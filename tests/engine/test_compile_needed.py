@@ -101,10 +101,11 @@ from collide2d.engine.models import paper
 rng = np.random.default_rng(1)
 n = 100
 keys = np.arange(n, dtype=np.int64)[::-1].copy()
-pos = np.zeros((n, 2))
-size = np.full((n, 2), 5.0)
+pos = np.zeros((n, 2), np.int64)
+size = np.full((n, 2), 5, np.int64)
 near = np.empty(n, np.int64)
-assert paper._near(pos, size, np.zeros((n, 2)), keys, n, near) == n
+reach = np.empty((n, 4), np.int64)
+assert paper._near(pos, size, np.zeros((n, 2), np.int64), keys, n, near, reach) == n
 sort.sort_by_time(rng.random(n), keys.copy(), n)
 sort.heap_argsort(rng.random(n))
 for f in (sort.sort_keys, sort._sift_keys, sort._sift_timed, sort._sift_order):
