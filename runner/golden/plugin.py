@@ -24,6 +24,7 @@ override them. The terminal summary lists the goldens written and the goldens no
 
 from __future__ import annotations
 
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -128,8 +129,7 @@ class GoldenItem(pytest.Item):
             project,
             _default_load(project),
             _default_simulate(),
-            # what the tmp_path_factory fixture returns (an Item has no fixtures of its own)
-            self.config._tmp_path_factory,
+            lambda: _basetemp(self.config),
         )
 
     def repr_failure(self, excinfo):
@@ -197,15 +197,28 @@ def golden_check(request, golden_load, golden_simulate, tmp_path_factory):
     def check(path) -> None:
         if path is None:
             pytest.fail(f"no scenario files in {project.scenarios}", pytrace=False)
-        check_golden(request.node, path, project, golden_load, golden_simulate, tmp_path_factory)
+        check_golden(
+            request.node, path, project, golden_load, golden_simulate, tmp_path_factory.getbasetemp
+        )
 
     return check
 
 
-def check_golden(node, path, project, load, simulate, tmp_path_factory) -> None:
+def _basetemp(config) -> Path:
+    """pytest's base temporary folder, for an Item (which has no fixtures of its own): the one the
+    tmp_path_factory fixture uses when pytest keeps its factory on the config, else a new
+    temporary folder (a pytest without that attribute still runs the golden tests)."""
+    factory = getattr(config, "_tmp_path_factory", None)
+    if factory is not None:
+        return factory.getbasetemp()
+    return Path(tempfile.mkdtemp(prefix="collide2d-golden-"))
+
+
+def check_golden(node, path, project, load, simulate, basetemp) -> None:
     """The golden test of the scenario file `path` in `project` (a runner.config.Config), run as
     the test `node`: check it, or bless it under --update-goldens; pytest.fail with the text
-    `collide2d check` prints."""
+    `collide2d check` prints. `basetemp()`: the folder a failure's report goes under when no
+    --golden-report is given."""
     from collide2d.runner.golden import bless_run, check_run, shown_path
     from collide2d.runner.golden.cli import run_scenario, scenario_errors
     from collide2d.runner.golden.store import GoldenError, GoldenStore
@@ -226,7 +239,7 @@ def check_golden(node, path, project, load, simulate, tmp_path_factory) -> None:
         node.user_properties.append((PROP_BLESSED, blessed.line()))
         return
     given = config.getoption("golden_report")
-    report_dir = Path(given) if given else tmp_path_factory.getbasetemp() / "golden-report"
+    report_dir = Path(given) if given else basetemp() / "golden-report"
     try:
         outcome = check_run(scenario, result, store, path=path, report_dir=report_dir)
     except GoldenError as exc:  # the report folder refused (a symbolic link)
