@@ -148,9 +148,9 @@ class _Place:
         return ScenarioError(self.shown, line, char, message)
 
 
-def _csv_cell(text: str, row: int, col: int) -> tuple[int, int]:
-    """(line, character column) of field `col` of data row `row` (blank lines skipped, as
-    numpy.loadtxt skips them), both from 1."""
+def _data_records(text: str):
+    """(data row from 0, line from 1, fields) of each CSV record after the header, blank lines
+    skipped as numpy.loadtxt skips them."""
     reader = csv.reader(io.StringIO(text))
     next(reader, None)
     k = -1
@@ -158,8 +158,14 @@ def _csv_cell(text: str, row: int, col: int) -> tuple[int, int]:
         if not record or all(not f.strip() for f in record) and len(record) <= 1:
             continue
         k += 1
+        yield k, reader.line_num, record
+
+
+def _csv_cell(text: str, row: int, col: int) -> tuple[int, int]:
+    """(line, character column) of field `col` of data row `row` (blank lines skipped, as
+    numpy.loadtxt skips them), both from 1."""
+    for k, line, _record in _data_records(text):
         if k == row:
-            line = reader.line_num
             raw = text.splitlines()[line - 1] if line - 1 < len(text.splitlines()) else ""
             return line, _field_start(raw, col)
     return 1, 1
@@ -248,17 +254,11 @@ def _read_csv(opened: str, shown: str, limits: Limits):
 def _first_bad_cell(text: str, header: list[str], place: _Place) -> ScenarioError:
     """The error numpy met, found again cell by cell: a row of the wrong length or a number that
     is not one."""
-    reader = csv.reader(io.StringIO(text))
-    next(reader, None)
-    k = -1
-    for record in reader:
-        if not record or all(not f.strip() for f in record) and len(record) <= 1:
-            continue
-        k += 1
+    for k, line, record in _data_records(text):
         if len(record) != len(header):
             return ScenarioError(
                 place.shown,
-                reader.line_num,
+                line,
                 1,
                 f"row {k + 1} has {len(record)} fields; the header names {len(header)}",
             )
