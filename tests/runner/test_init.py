@@ -63,8 +63,10 @@ def test_init_refuses_a_pyproject_that_is_not_toml_before_writing_anything(tmp_p
 
 
 @pytest.fixture
-def inited(pytester):
-    """A pytester project made by `collide2d init`, with a second scenario."""
+def inited(pytester, monkeypatch):
+    """A pytester project made by `collide2d init`, with a second scenario (run as on a
+    developer's machine: --update-goldens is refused where CI is set)."""
+    monkeypatch.delenv("CI", raising=False)
     assert main(["init", str(pytester.path)]) == 0
     text = (pytester.path / "scenarios" / "example.yaml").read_text()
     (pytester.path / "scenarios" / "second.yaml").write_text(
@@ -116,7 +118,8 @@ def test_check_and_bless_use_the_tables_folders(tmp_path, monkeypatch, capsys):
     assert (tmp_path / "report" / "index.html").is_file()  # the table's report folder
 
 
-def test_the_plugin_reads_a_custom_scenarios_folder(pytester):
+def test_the_plugin_reads_a_custom_scenarios_folder(pytester, monkeypatch):
+    monkeypatch.delenv("CI", raising=False)
     assert main(["init", str(pytester.path)]) == 0
     pyproject = pytester.path / "pyproject.toml"
     pyproject.write_text(
