@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import os
 
+import numba
 from numba import njit
 
 # Threads waiting at the end of a split stage sleep instead of spinning (OpenMP's default spins):
@@ -27,6 +28,14 @@ from numba import njit
 # split stage then took ten times as long as one thread (measured on 2 cores at load 9). Set before
 # numba starts its threads; a value the user set is kept.
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
+# The split stages compile as numba parallel kernels (parallel=True) only from this numba version
+# on. They are called from cached kernels, and older versions crashed loading such a chain from the
+# kernel cache (numba issue 8578; seen with 0.59 in test workers that loaded the stepped model
+# cached by another process). Below it the same source compiles without parallel=True: prange is
+# range, the chunks run one after another, and the results are the same bytes.
+PARALLEL_FROM_NUMBA = (0, 68)
+PARALLEL = tuple(int(x) for x in numba.__version__.split(".")[:2]) >= PARALLEL_FROM_NUMBA
 
 # Objects from which a stage splits its work among threads (tuned on the standard scene of
 # `collide2d bench`: 2 cores pay from about 20,000 boxes).
