@@ -380,7 +380,7 @@ def _check(data, place: _Place, width: int, height: int, fps: int, paper: bool) 
         if column not in names:
             return np.full(n, default)
         v = data[column].astype(np.float64)
-        refuse(~np.isfinite(v), column, lambda r: f"must be a finite number, not {v[r]!r}")
+        refuse(~np.isfinite(v), column, lambda r: f"must be a finite number, not {float(v[r])!r}")
         return np.where(np.isfinite(v), v, default) + 0.0  # -0.0 is 0.0
 
     def whole(v, column, lo, unit):
