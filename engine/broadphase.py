@@ -38,11 +38,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
-from numba.extending import overload
 
+from collide2d.engine.jit import njit, overload, prange
 from collide2d.engine.sort import heap_argsort, sort_order
-from collide2d.engine.threads import PARALLEL, join_shares, shares_total
+from collide2d.engine.threads import join_shares, shares_total
 
 # A candidate pair (a, b) is one sortable int64 key, a << KEY_SHIFT | b (ids below 2**31).
 KEY_SHIFT = 32
@@ -351,7 +350,7 @@ def _cell_pairs(s0, s1, order, key, start, box, movable, nx, ny, out, base, room
     return k
 
 
-@njit(cache=True, parallel=PARALLEL)
+@njit(cache=True, parallel=True)
 def _cell_pairs_split(order, key, start, box, movable, nx, ny, out, n, chunks):
     """`_cell_pairs` over all n slots cut into `chunks` contiguous runs, one per thread, each
     writing into its own share of `out`; the shares are then moved together in run order, so the

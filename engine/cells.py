@@ -10,7 +10,6 @@ bound the heap entries one prediction or one event may push.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 from collide2d.engine.broadphase import static_cells
 from collide2d.engine.eventqueue import RANK_CROSS, RANK_PAIR
@@ -30,6 +29,7 @@ from collide2d.engine.exactstate import (
     Y,
     hot,
 )
+from collide2d.engine.jit import njit
 
 # Grid cells (gnx·gny, 2) int64: the first moving object filed there (-1: none) and how many.
 C_HEAD, C_COUNT = range(2)

@@ -22,9 +22,9 @@ overlaps) with nx, ny = the signs ±1 of each axis; the response then acts on ea
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 from collide2d.engine.events import AXIS_NORMAL, AXIS_X, AXIS_XY, AXIS_Y
+from collide2d.engine.jit import njit
 from collide2d.engine.world import KIND_BOX, KIND_CIRCLE
 
 INF = np.inf

@@ -19,9 +19,8 @@ people.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
-from numba.extending import overload
 
+from collide2d.engine.jit import njit, overload
 from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON
 
 # --------------------------------------------------------------------------------------------

@@ -13,9 +13,9 @@ Events closer in time than `instant(t)` are one instant (rounding, not physics, 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 from collide2d.engine.exactstate import CNT, S_HEAP_N, hot
+from collide2d.engine.jit import njit
 
 # Children per heap node: a 4-ary heap is half as deep as a binary one, and its four children
 # share a cache line.

@@ -20,7 +20,8 @@ import json
 import math
 
 import numpy as np
-from numba import njit
+
+from collide2d.engine.jit import njit
 
 EV_WALL = 0
 EV_PAIR = 1

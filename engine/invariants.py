@@ -11,7 +11,8 @@ the stress checks do); `kinetic_energy` and `momentum` are its whole-array forms
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from collide2d.engine.jit import njit
 
 
 @njit(cache=True)

@@ -9,8 +9,6 @@ state.
 
 from __future__ import annotations
 
-from numba import njit
-
 from collide2d.engine.cells import C_HEAD
 from collide2d.engine.contact import box_next_contact, box_reach, next_contact
 from collide2d.engine.eventqueue import RANK_CROSS, RANK_PAIR, RANK_WALL, make_key, push
@@ -42,6 +40,7 @@ from collide2d.engine.exactstate import (
     hot,
     kernel,
 )
+from collide2d.engine.jit import njit
 from collide2d.engine.world import KIND_BOX
 
 

@@ -21,10 +21,10 @@ runs as plain Python.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
 
 from collide2d.engine.draw import _fill_rect, draw_shape, shapes_marker
-from collide2d.engine.threads import PARALLEL, chunks_for
+from collide2d.engine.jit import njit, prange
+from collide2d.engine.threads import chunks_for
 from collide2d.engine.world import KIND_CIRCLE, KIND_POLYGON, Bodies, WorldSpec
 
 # Rounded positions are clamped to +-POSITION_LIMIT_PX (px) so that pixel arithmetic on an object
@@ -104,7 +104,7 @@ def _draw_band(buf, y0, y1, ipos, kind, wh, color, fill, vert_start, verts, ext,
             )  # fmt: skip
 
 
-@njit(cache=True, parallel=PARALLEL)
+@njit(cache=True, parallel=True)
 def _draw_bands(buf, ipos, kind, wh, color, fill, vert_start, verts, ext, shapes, scratch, bands):
     """The frame cut into `bands` bands of rows, one per thread; each band cleared and every
     object drawn clipped to it, in id order. Clipping keeps each pixel's colour (the dirty-region

@@ -19,10 +19,9 @@ own sign, and only on an axis along which the pair approaches.
 
 from __future__ import annotations
 
-from numba import njit
-
 from collide2d.engine.errors import FoldLimitExceeded
 from collide2d.engine.events import AXIS_XY
+from collide2d.engine.jit import njit
 
 # More folds than this at one wall axis in one step is refused (a runaway, not a bounce).
 MAX_FOLDS_PER_STEP = 1000

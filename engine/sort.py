@@ -10,7 +10,8 @@ array (heap sort: O(n log n), compiles quickly, allocates only the result). All 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from collide2d.engine.jit import njit
 
 # An insertion sort that has to shift more than this many places per object falls back to a full
 # sort (a scene that reshuffled, e.g. objects crossing the world in one step).

@@ -11,9 +11,9 @@ plus their offsets, inside the world, in its colour, over the background. The ru
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 from collide2d.engine.draw import draw_shape, shapes_marker
+from collide2d.engine.jit import njit
 from collide2d.engine.raster import _extents, round_positions
 from collide2d.engine.world import KIND_CIRCLE, Bodies
 

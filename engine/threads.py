@@ -10,32 +10,24 @@ costs more than they save) and only when more than one thread is allowed.
 `shares_total` and `join_shares` join a split stage's results: each chunk writes into its own
 share of one buffer, and the shares are moved together in chunk order.
 
-`set_threads(n)` is the one switch (the command line's `--threads N`; a configuration layer calls
-the same function): it sets numba's thread count for the kernels and the number of chunks the
-models and the renderer made after it use. With `NUMBA_DISABLE_JIT=1` prange is range and the
-chunks run one after another, with the same results.
+`set_threads(n)` is the one switch: it sets numba's thread count for the kernels and the number
+of chunks the models and the renderer made after it use. The command line's `--threads N` (and
+`[tool.collide2d] threads`) go through `request(n)`, which waits until numba is loaded: a run whose
+kernels are interpreted (engine.jit) never loads it. Interpreted, prange is range and the chunks
+run one after another, with the same results.
 """
 
 from __future__ import annotations
 
 import os
 
-import numba
-from numba import njit
+from collide2d.engine.jit import njit, numba_module, when_loaded
 
 # Threads waiting at the end of a split stage sleep instead of spinning (OpenMP's default spins):
 # on a machine shared with other work a spinning thread holds a core another thread needs, and a
 # split stage then took ten times as long as one thread (measured on 2 cores at load 9). Set before
 # numba starts its threads; a value the user set is kept.
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
-
-# The split stages compile as numba parallel kernels (parallel=True) only from this numba version
-# on. They are called from cached kernels, and older versions crashed loading such a chain from the
-# kernel cache (numba issue 8578; seen with 0.59 in test workers that loaded the stepped model
-# cached by another process). Below it the same source compiles without parallel=True: prange is
-# range, the chunks run one after another, and the results are the same bytes.
-PARALLEL_FROM_NUMBA = (0, 68)
-PARALLEL = tuple(int(x) for x in numba.__version__.split(".")[:2]) >= PARALLEL_FROM_NUMBA
 
 # Objects from which a stage splits its work among threads (tuned on the standard scene of
 # `collide2d bench`: 2 cores pay from about 20,000 boxes).
@@ -46,7 +38,7 @@ _threads: int | None = None  # None: every core numba may use
 
 def available() -> int:
     """The most threads numba may run here (its NUMBA_NUM_THREADS, every core by default)."""
-    from numba import config
+    from numba import config  # imported only here: an interpreted run never asks
 
     return max(1, int(config.NUMBA_NUM_THREADS))
 
@@ -60,10 +52,16 @@ def set_threads(n: int | None) -> int:
     count = available() if n is None else min(int(n), available())
     _threads = count
     if not _jit_disabled():
-        import numba
-
-        numba.set_num_threads(count)
+        numba_module().set_num_threads(count)
     return count
+
+
+def request(n: int | None) -> None:
+    """`set_threads(n)` when numba loads (now if it is loaded): an interpreted run never loads it.
+    ValueError for n < 1."""
+    if n is not None and (int(n) != n or n < 1):
+        raise ValueError(f"threads must be a whole number >= 1, got {n!r}")
+    when_loaded(lambda: set_threads(n))
 
 
 def threads() -> int:
@@ -74,8 +72,10 @@ def threads() -> int:
 def chunks_for(n_objects: int) -> int:
     """How many chunks a stage over n_objects objects splits into: the thread count for a scene of
     PARALLEL_MIN_OBJECTS objects or more, else 1 (no split)."""
+    if n_objects < PARALLEL_MIN_OBJECTS:
+        return 1
     t = threads()
-    return t if t > 1 and n_objects >= PARALLEL_MIN_OBJECTS else 1
+    return t if t > 1 else 1
 
 
 def _jit_disabled() -> bool:

@@ -16,6 +16,7 @@ import numpy as np
 
 from collide2d.engine.world import Bodies, Looks, WorldSpec
 from collide2d.runner import generate as gen
+from collide2d.runner import lanes
 from collide2d.runner.nodes import Nodes, fmt
 from collide2d.runner.objects import Block, Listed
 from collide2d.runner.yamlsafe import ScenarioError
@@ -186,6 +187,12 @@ def check_placement(
 
 def _first_shape_overlap(listed: list[Listed], pos, size) -> tuple[int, int] | None:
     """The first pair (a, b) in (b, a) order whose exact shapes overlap with positive area."""
+    n = len(listed)
+    with lanes.objects(n):
+        return _shape_overlap(listed, pos, size)
+
+
+def _shape_overlap(listed: list[Listed], pos, size) -> tuple[int, int] | None:
     from collide2d.engine.broadphase import METHOD_SWEEP, find_pairs
     from collide2d.engine.contact import penetration
     from collide2d.engine.shapes import build_cores

@@ -47,6 +47,7 @@ def demo_path() -> str:
 def register_run(subparsers) -> None:
     from collide2d.runner.options import (
         add_cap_argument,
+        add_jit_argument,
         add_limit_arguments,
         add_override_arguments,
         add_threads_argument,
@@ -112,6 +113,7 @@ def register_run(subparsers) -> None:
     add_limit_arguments(p, output=True)
     add_cap_argument(p)
     add_threads_argument(p)
+    add_jit_argument(p)
     p.set_defaults(func=cmd_run)
 
 
@@ -133,12 +135,18 @@ def overlay_names(text: str) -> tuple[str, ...]:
 
 def cmd_run(args: argparse.Namespace) -> int:
     from collide2d.runner import config
-    from collide2d.runner.options import apply_threads, limits_from_args, overrides_from_args
+    from collide2d.runner.options import (
+        apply_jit,
+        apply_threads,
+        limits_from_args,
+        overrides_from_args,
+    )
     from collide2d.runner.run import RunOptions, run_to_dir
     from collide2d.runner.scenario import load
 
     project = config.find()
     apply_threads(args, project)
+    apply_jit(args, project)
     path = args.scenario or demo_path()
     limits = limits_from_args(args, project)
     scenario = load(

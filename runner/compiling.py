@@ -15,14 +15,22 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
+from collide2d.engine import jit
+
 _state = {"seconds": 0.0, "depth": 0, "started": 0.0, "installed": False, "notice": None}
 
 
 def install(notice: Callable[[], None] | None = None) -> None:
-    """Start counting compile time (once per process); `notice` replaces the one given before."""
+    """Start counting compile time (once per process; from when numba loads, engine.jit: a run
+    whose kernels are interpreted never loads it); `notice` replaces the one given before."""
     _state["notice"] = notice
     if _state["installed"]:
         return
+    _state["installed"] = True
+    jit.when_loaded(_listen)
+
+
+def _listen() -> None:
     from numba.core import event
 
     class _Timer(event.Listener):
@@ -40,7 +48,6 @@ def install(notice: Callable[[], None] | None = None) -> None:
                 _state["seconds"] += time.perf_counter() - _state["started"]
 
     event.register("numba:compile", _Timer())
-    _state["installed"] = True
 
 
 def seconds() -> float:

@@ -11,6 +11,7 @@ with its value and where it came from. The table (every key optional):
     report = "report"         # `collide2d check --report` with no folder named
     out = "out"               # `collide2d run`'s output folder
     threads = 2               # threads of the kernels that take them (read by `--threads`)
+    jit = "auto"              # auto | on | off: compiled kernels (read by `--jit`; runner.lanes)
 
     [tool.collide2d.limits]   # any of the --max-* options, as max_objects = 5000, ...
     [tool.collide2d.model]    # kind, substeps, geometry, max_events_per_tick
@@ -37,7 +38,8 @@ from collide2d.runner.yamlsafe import ScenarioError
 PYPROJECT = "pyproject.toml"
 TABLE = "tool.collide2d"
 FOLDER_KEYS = {"scenarios": "scenarios", "goldens": "goldens", "report": "report", "out": "out"}
-TOP_KEYS = (*FOLDER_KEYS, "threads", "limits", "model")
+TOP_KEYS = (*FOLDER_KEYS, "threads", "jit", "limits", "model")
+JIT_CHOICES = ("auto", "on", "off")
 LIMIT_KEYS = tuple(Limits.__dataclass_fields__)
 MODEL_KEYS = ("kind", "substeps", "geometry", "max_events_per_tick")
 MODEL_CHOICES = {"kind": ("paper", "stepped", "exact"), "geometry": ("box", "exact")}
@@ -111,9 +113,9 @@ class Config:
     def lines(self) -> list[str]:
         """`collide2d config`'s table: one line per setting, value and source."""
         rows = [("project", str(self.root), str(self.file) if self.file else "no [tool.collide2d]")]
-        for key in (*FOLDER_KEYS, "threads"):
+        for key in (*FOLDER_KEYS, "threads", "jit"):
             s = self.settings.get(key, Setting(None, DEFAULT))
-            unset = "all cores" if key == "threads" else "-"
+            unset = {"threads": "all cores", "jit": "auto"}.get(key, "-")
             rows.append((key, unset if s.value is None else _shown(s.value), s.source))
         defaults = Limits()
         for k in LIMIT_KEYS:
@@ -235,6 +237,10 @@ def _config(root: Path, pyproject: Path | None, table: dict) -> Config:
             config.settings[key] = Setting(_folder(table[key], key, root, fail), source)
     if "threads" in table:
         config.settings["threads"] = Setting(whole("threads", table["threads"]), source)
+    if "jit" in table:
+        if table["jit"] not in JIT_CHOICES:
+            raise fail("jit", f"jit must be one of {' | '.join(JIT_CHOICES)}, not {table['jit']!r}")
+        config.settings["jit"] = Setting(table["jit"], source)
     for section, keys in (("limits", LIMIT_KEYS), ("model", MODEL_KEYS)):
         given = table.get(section, {})
         if not isinstance(given, dict):

@@ -40,7 +40,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
+
+from collide2d.engine.jit import njit
+from collide2d.runner import lanes
 
 # Candidate positions drawn per batch from a block's generator (fixed: it is part of the stream).
 POSITION_BATCH = 4096
@@ -364,10 +366,12 @@ def first_overlap(pos, size) -> tuple[int, int] | None:
     hi = (pos + size).max(axis=0)
     extent = hi - lo
     cell = cell_size(extent[0], extent[1], size.max(axis=1))
-    grid = _Grid(lo[0], lo[1], extent[0], extent[1], cell, 0)
-    links = _count_links(pos, size, grid.ox, grid.oy, grid.cell, grid.gx, grid.gy)
-    grid = _Grid(lo[0], lo[1], extent[0], extent[1], cell, min(links, 4 * n + grid.gx * grid.gy))
-    found = grid.sweep(0, n, pos, size)
+    with lanes.objects(n):
+        grid = _Grid(lo[0], lo[1], extent[0], extent[1], cell, 0)
+        links = _count_links(pos, size, grid.ox, grid.oy, grid.cell, grid.gx, grid.gy)
+        cap = min(links, 4 * n + grid.gx * grid.gy)
+        grid = _Grid(lo[0], lo[1], extent[0], extent[1], cell, cap)
+        found = grid.sweep(0, n, pos, size)
     if found is None:
         return None
     b, a = found
@@ -413,6 +417,12 @@ def generate(
     inside the world, overlapping neither the fixed boxes nor each other. Raises PlacementError
     when a block's boxes cannot be placed.
     """
+    total = len(fixed_pos) + sum(int(b.count) for b in blocks)
+    with lanes.objects(total):
+        return _generate(width, height, fixed_pos, fixed_size, blocks)
+
+
+def _generate(width, height, fixed_pos, fixed_size, blocks):
     fixed_pos = np.asarray(fixed_pos, np.float64).reshape(-1, 2)
     fixed_size = np.asarray(fixed_size, np.float64).reshape(-1, 2)
     m = fixed_pos.shape[0]

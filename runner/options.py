@@ -110,12 +110,36 @@ def add_threads_argument(p: argparse.ArgumentParser) -> None:
     )
 
 
-def apply_threads(args: argparse.Namespace, project=None) -> int:
+def add_jit_argument(p: argparse.ArgumentParser) -> None:
+    """`--jit MODE`: compiled or interpreted kernels (runner.lanes)."""
+    p.add_argument(
+        "--jit",
+        choices=("auto", "on", "off"),
+        default=None,
+        help="compile the kernels with numba: auto (default: a small run is done interpreted "
+        "before numba would have loaded), on (every run), off (never: plain Python, slow for big "
+        "scenes); the results are the same bytes",
+    )
+
+
+def apply_jit(args: argparse.Namespace, project=None) -> None:
+    """Put the command line's `--jit`, else the project's `[tool.collide2d] jit`, else the
+    environment's COLLIDE2D_JIT (else auto) in force (runner.lanes)."""
+    from collide2d.runner import lanes
+
+    given = getattr(args, "jit", None)
+    if given is None and project is not None:
+        given = project.value("jit")
+    lanes.set_mode(given)
+
+
+def apply_threads(args: argparse.Namespace, project=None) -> None:
     """Put the command line's `--threads`, else the project's `[tool.collide2d] threads` (a
-    runner.config.Config), else all cores, in force; the number in force."""
-    from collide2d.engine.threads import set_threads
+    runner.config.Config), else all cores, in force for the compiled kernels (from when numba
+    loads: engine.threads.request)."""
+    from collide2d.engine.threads import request
 
     given = getattr(args, "threads", None)
     if given is None and project is not None:
         given = project.value("threads")
-    return set_threads(given)
+    request(given)

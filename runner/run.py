@@ -10,8 +10,10 @@ section 5 into a staging folder that replaces `OUT/NAME/` whole when the run is 
 runaway (an `engine.errors.Runaway`: the exact model's event cap or an object with no room to move,
 the stepped model's fold limit) raises `RunStopped` with a message for the user. The summary counts
 the wall and pair events whether or not they are logged (the models count them as they happen).
-Kernels compiled during a run (a first run, before numba has cached them) are timed apart
-(`runner.compiling`): the summary's `compile_time_s` holds them and `run_time_s` leaves them out.
+Each run's kernels run compiled or interpreted (`runner.lanes`, by the size of the run; the
+summary's `kernels` says which). Kernels compiled during a run (a first run, before numba has
+cached them) are timed apart (`runner.compiling`): the summary's `compile_time_s` holds them and
+`run_time_s` leaves them out.
 Ctrl-C during `run_to_dir` stops the run at the end of the current chunk of ticks: what was written
 so far (events, PNG frames, the final state at that tick, a summary with `interrupted_at_tick`)
 becomes OUT/NAME, without the GIF, which would be an animation of part of the run.
@@ -31,12 +33,12 @@ from pathlib import Path
 
 import numpy as np
 
-from collide2d.engine import models
+from collide2d.engine import jit, models
 from collide2d.engine.errors import Runaway
 from collide2d.engine.events import empty_events
 from collide2d.engine.invariants import kinetic_energy, momentum
 from collide2d.engine.raster import Renderer
-from collide2d.runner import budget, compiling, outputs, rundir, viewer
+from collide2d.runner import budget, compiling, lanes, outputs, rundir, viewer
 from collide2d.runner.frames import FrameRule
 from collide2d.runner.limits import Limits
 from collide2d.runner.overlay import Overlay
@@ -91,6 +93,23 @@ def drive(
     interruptible: Ctrl-C (SIGINT, in the main thread) ends the run after the current chunk of
     ticks; the summary then holds `interrupted_at_tick`.
     """
+    if not isinstance(frames, FrameRule):
+        frames = FrameRule.of(frames, scenario.ticks)
+    lane = lanes.RunLane(scenario, len(frames))
+    with jit.lane(lane.compiled):
+        model, summary = _drive(
+            scenario, frames, on_frame, log_events, on_events, progress, on_tick, overlay,
+            interruptible, lane,
+        )  # fmt: skip
+    summary["kernels"] = lane.name()
+    return model, summary
+
+
+def _drive(
+    scenario, frames, on_frame, log_events, on_events, progress, on_tick, overlay, interruptible,
+    lane,
+):  # fmt: skip
+    """`drive` in the lanes `lane` chooses as the run goes."""
     bodies = scenario.bodies
     try:
         model = make_model(scenario)
@@ -102,8 +121,6 @@ def drive(
     if overlay is not None:
         model = overlay.wrap(model)
     logging = log_events or (overlay is not None and overlay.wants_events)
-    if not isinstance(frames, FrameRule):
-        frames = FrameRule.of(frames, scenario.ticks)
     renderer = Renderer(scenario.world, bodies) if frames else None
     start = _energy_momentum(bodies, model.velocities())
     began = time.perf_counter()
@@ -123,8 +140,10 @@ def drive(
                 stop = min(stop, next_frame)
             if on_tick is not None:
                 stop = model.tick + 1
+            stop = model.tick + lane.step(stop - model.tick)
             try:
-                events = model.advance(stop - model.tick, logging)
+                with lane.timed():
+                    events = model.advance(stop - model.tick, logging)
             except Runaway as exc:
                 when = (
                     f"tick {stop}" if stop == model.tick + 1 else f"ticks {model.tick + 1}-{stop}"
@@ -140,7 +159,8 @@ def drive(
             if on_tick is not None:
                 on_tick(model)
             if model.tick == next_frame:
-                on_frame(model.tick, _drawn(renderer, model, model.tick, overlay))
+                with jit.lane(lane.compiled):
+                    on_frame(model.tick, _drawn(renderer, model, model.tick, overlay))
                 next_frame = frames.next_from(model.tick + 1)
             if progress is not None:
                 progress.update(model.tick)
@@ -221,6 +241,13 @@ def simulate(
     progress: bool = False,
 ) -> RunResult:
     """Run in memory; frames in `keep_frames` come back as RGB arrays."""
+    if not isinstance(keep_frames, FrameRule):
+        keep_frames = FrameRule.of(keep_frames, scenario.ticks)
+    with lanes.run(scenario, len(keep_frames)):  # drive's lane, for the final state too
+        return _simulate(scenario, keep_frames, log_events, progress)
+
+
+def _simulate(scenario: Scenario, keep_frames: FrameRule, log_events: bool, progress: bool):
     kept: dict[int, np.ndarray] = {}
     chunks: list[np.ndarray] = []
     # overlays only when the scenario asks for them (then its goldens show them too)
@@ -313,6 +340,11 @@ def _shown(filename, stage: Path, target: Path) -> str:
 
 def _write_run(scenario: Scenario, folder: Path, options: RunOptions, plan) -> dict:
     """Run the scenario, writing its files into the empty `folder`; returns the summary."""
+    with lanes.run(scenario, len(plan.draw)):  # the lane `drive` takes, for the viewer's too
+        return _write_files(scenario, folder, options, plan)
+
+
+def _write_files(scenario: Scenario, folder: Path, options: RunOptions, plan) -> dict:
     frames_dir = folder / "frames"  # made with its first frame: never an empty folder
     layer = None
     if options.overlay or options.viewer:

@@ -68,7 +68,7 @@ from collide2d.engine.models import MAX_EVENTS_PER_TICK, MODEL_NAMES
 from collide2d.engine.noroom import no_room, no_room_message
 from collide2d.engine.shapes import GEOMETRIES
 from collide2d.engine.world import Bodies, WorldSpec
-from collide2d.runner import assemble, yamlfast
+from collide2d.runner import assemble, lanes, yamlfast
 from collide2d.runner import yamlsafe as ys
 from collide2d.runner.assemble import PALETTE_SIZE
 from collide2d.runner.limits import Limits
@@ -520,7 +520,8 @@ class _Reader(Nodes):
     def room(self, world, bodies, geometry, names, listed, lines, table=None) -> None:
         """Refuse, at the object, a moving object with no room on an axis it moves on (the exact
         model would collide it again and again with no time passing; engine.models.exact)."""
-        found = no_room(world, bodies, geometry)
+        with lanes.objects(bodies.n):
+            found = no_room(world, bodies, geometry)
         if not found:
             return
         i = found[0].obj

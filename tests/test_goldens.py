@@ -1,9 +1,11 @@
 """The golden tests: every scenario in scenarios/ against its golden in goldens/ (SPEC section 7).
 
 One test per scenario file, `test_golden[fig2_case1]`, parametrised by the golden plugin
-(`runner.golden.plugin`). A test runs the scenario, compares events, final state and golden frames
-with `goldens/NAME/`, and fails with the same text `collide2d check` prints; a missing golden is a
-failure naming the command that creates it. `pytest --update-goldens` blesses what runs instead.
+(`runner.golden.plugin`), and the same again with the kernels compiled and interpreted
+(`test_golden_compiled_and_interpreted`): both lanes must give the golden's bytes. A test runs
+the scenario, compares events, final state and golden frames with `goldens/NAME/`, and fails with
+the same text `collide2d check` prints; a missing golden is a failure naming the command that
+creates it. `pytest --update-goldens` blesses what runs instead.
 """
 
 from __future__ import annotations
@@ -16,6 +18,18 @@ GOLDENS_BUDGET_BYTES = 5 * 1024 * 1024
 
 def test_golden(golden_scenario, golden_check):
     golden_check(golden_scenario)
+
+
+@pytest.mark.parametrize("mode", ["on", "off"])
+def test_golden_compiled_and_interpreted(golden_scenario, golden_check, mode):
+    # the same bytes whichever lane runs the kernels (runner.lanes; `auto` picks one per run)
+    from collide2d.runner import lanes
+
+    lanes.set_mode(mode)
+    try:
+        golden_check(golden_scenario)
+    finally:
+        lanes.set_mode(None)
 
 
 def test_goldens_stay_small(golden_root):

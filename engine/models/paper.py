@@ -38,7 +38,6 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from numba import njit
 
 from collide2d.engine.broadphase import (
     KEY_MASK,
@@ -64,6 +63,7 @@ from collide2d.engine.events import (
     new_log,
     put_row,
 )
+from collide2d.engine.jit import njit
 from collide2d.engine.motion import paper_rate
 from collide2d.engine.sort import sort_keys
 from collide2d.engine.world import Bodies, WorldSpec

@@ -45,8 +45,6 @@ import time
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit, prange
-from numba.extending import overload
 
 from collide2d.engine.broadphase import (
     KEY_MASK,
@@ -78,10 +76,11 @@ from collide2d.engine.events import (
     log_event,
     new_log,
 )
+from collide2d.engine.jit import njit, overload, prange
 from collide2d.engine.response import exchange, fold, separate
 from collide2d.engine.shapes import GEOMETRIES, build_cores
 from collide2d.engine.sort import heap_argsort, sort_by_time
-from collide2d.engine.threads import PARALLEL, chunks_for, join_shares, shares_total
+from collide2d.engine.threads import chunks_for, join_shares, shares_total
 from collide2d.engine.world import Bodies, WorldSpec
 
 # The candidate list's margin, px: this many of the fastest object's step (|v|·dt), within
@@ -187,7 +186,7 @@ def _move_walls_split(S, dt, folds, chunks):
     return _move_chunks(pos, vel, static, span, ext, anchor, dt, folds, chunks)
 
 
-@njit(cache=True, parallel=PARALLEL)
+@njit(cache=True, parallel=True)
 def _move_chunks(pos, vel, static, span, ext, anchor, dt, folds, chunks):
     """Run c of `chunks` writes its fold rows from row 2 x its first object (each object folds
     on two axes at most); then the runs' rows are moved together in run order."""
@@ -383,7 +382,7 @@ def _overlapping(pos, vel, size, span, ext, keys, n_keys, near, when, dt):
     return k
 
 
-@njit(cache=True, parallel=PARALLEL)
+@njit(cache=True, parallel=True)
 def _overlapping_split(pos, vel, size, span, ext, keys, n_keys, near, when, dt, chunks):
     """`_overlapping` with the listed pairs cut into `chunks` contiguous runs, one per thread: run
     c writes its pairs into its own share of `near` and `when`, then the shares are moved

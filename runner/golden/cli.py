@@ -134,11 +134,12 @@ def _cluster_runs(args, scenarios, run):
 
 
 def _common(p) -> None:
-    from collide2d.runner.options import add_cap_argument
+    from collide2d.runner.options import add_cap_argument, add_jit_argument
 
     p.add_argument("--root", metavar="DIR", help="project folder holding scenarios/ and goldens/")
     p.add_argument("--quiet", action="store_true", help="no progress output")
     add_cap_argument(p)
+    add_jit_argument(p)
 
 
 def _debug_option(parser) -> None:
@@ -285,7 +286,10 @@ def bless_command(args, *, load=default_load, simulate=default_simulate) -> int:
 def _prepare(args, load):
     """(root, [(path, Scenario)]) for the command's arguments; _Usage on any bad input, before
     anything runs."""
+    from collide2d.runner.options import apply_jit
+
     project = _project(args)
+    apply_jit(args, project)
     root, folder = project.root, project.value("scenarios")
     if args.root and not (root / folder).is_dir():
         raise _Usage(f"--root {args.root} has no {folder}/ folder")

@@ -14,10 +14,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from collide2d.engine.events import EV_WALL
 from collide2d.engine.invariants import energy_momentum, max_penetration
+from collide2d.engine.jit import njit
 from collide2d.engine.raster import round_positions
 from collide2d.runner.stress.scenes import Scene
 

@@ -17,10 +17,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from collide2d.engine.errors import Runaway
 from collide2d.engine.invariants import max_penetration
+from collide2d.engine.jit import njit
 
 OUTSIDE_TOL_PX = 1e-9  # px a box may stick out of the world by rounding
 STATUS_OK = "ok"

@@ -15,9 +15,9 @@ import pkgutil
 import numpy as np
 import pytest
 from numba.core.config import DISABLE_JIT
-from numba.core.registry import CPUDispatcher
 
 import collide2d.engine
+from collide2d.engine import jit
 from collide2d.engine.exactstate import JOB_EVENT, S_HEAP_N
 from collide2d.engine.models import make
 from collide2d.engine.prediction import predict, set_job
@@ -40,12 +40,12 @@ def _engine_modules():
         yield importlib.import_module(info.name)
 
 
-def _no_nrt_kernels() -> dict[tuple[str, str], CPUDispatcher]:
+def _no_nrt_kernels() -> dict[tuple[str, str], jit.Kernel]:
     found = {}
     for module in _engine_modules():
         for name, obj in vars(module).items():
             if (
-                isinstance(obj, CPUDispatcher)
+                isinstance(obj, jit.Kernel)
                 and obj.py_func.__module__ == module.__name__
                 and obj.targetoptions.get("_nrt") is False
             ):
@@ -76,7 +76,8 @@ def test_the_kernels_without_reference_counting_are_the_expected_ones():
 
 
 def test_every_kernel_without_reference_counting_compiles():
-    _tiny_runs()
+    with jit.lane(True):
+        _tiny_runs()
     for where, kernel in _no_nrt_kernels().items():
         assert kernel.signatures, f"{where} was not compiled by a model run"
         for signature in kernel.signatures:

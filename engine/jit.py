@@ -1,0 +1,170 @@
+"""Compiled or interpreted: the one place where the engine's kernels meet numba.
+
+Every kernel is written once, as plain Python over arrays, and decorated with `njit` from this
+module (not numba's). A call runs it in one of two lanes:
+
+- compiled: numba's `njit` with the same options, cached on disk. Fastest per step, but a process
+  pays about half a second to import numba and load its first cached kernel, and seconds per
+  kernel the first time one compiles;
+- interpreted: the function itself, as plain Python; numba is never imported. Each step is a
+  hundred times slower, but nothing is loaded or compiled: a small scene finishes before numba
+  would have started.
+
+The lane is a context variable: `compiled()` says which lane this thread runs, and
+`lane(compiled)` sets it for a `with` block (the runner picks one per run, `runner.lanes`). The
+default is compiled, unless the environment says `COLLIDE2D_JIT=0` (or numba's own
+`NUMBA_DISABLE_JIT=1`). Both lanes give the same bytes: the kernels' arithmetic is int64 and
+float64 in both, and the golden tests run every scenario in both lanes.
+
+Inside a compiled kernel, a call to another kernel is numba's own call: a `Kernel` shows numba its
+dispatcher's type (`_numba_type_`) and, for `inline="always"`, the `targetoptions` and `py_func`
+numba's inliner reads. `overload(func)` registers a numba implementation of `func` the first time
+numba is loaded (interpreted, `func` runs itself). `prange` is `range` until a kernel of a module
+compiles, when the module's `prange` becomes numba's. `parallel=True` takes effect from numba
+PARALLEL_FROM_NUMBA on (older versions crashed loading parallel kernels that cached kernels call,
+numba issue 8578); below it the same source compiles serially, with the same results.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import os
+from contextvars import ContextVar
+
+PARALLEL_FROM_NUMBA = (0, 68)
+
+prange = range
+
+_overloads: list[tuple] = []
+_on_load: list = []
+_numba = None
+
+
+def _default_compiled() -> bool:
+    if os.environ.get("NUMBA_DISABLE_JIT", "0") not in ("", "0"):
+        return False
+    return os.environ.get("COLLIDE2D_JIT", "1").strip().lower() not in ("0", "off", "no", "false")
+
+
+_DEFAULT = _default_compiled()
+_compiled: ContextVar[bool] = ContextVar("collide2d_compiled", default=_DEFAULT)
+
+
+def compiled() -> bool:
+    """Whether kernels called from this thread now run compiled."""
+    return _compiled.get()
+
+
+@contextlib.contextmanager
+def lane(compiled: bool):
+    """Run the kernels called inside the block compiled (True) or interpreted (False)."""
+    token = _compiled.set(bool(compiled))
+    try:
+        yield
+    finally:
+        _compiled.reset(token)
+
+
+def numba_module():
+    """numba, imported on first use; registers the overloads declared so far."""
+    global _numba
+    if _numba is None:
+        import numba
+        from numba.extending import overload as numba_overload
+
+        for func, impl, options in _overloads:
+            numba_overload(func, **options)(impl)
+        _numba = numba
+        for call in _on_load:
+            call()
+    return _numba
+
+
+def when_loaded(call) -> None:
+    """Call `call()` once numba is loaded: now if it is, else right after it loads."""
+    if _numba is not None:
+        call()
+    else:
+        _on_load.append(call)
+
+
+def parallel_supported() -> bool:
+    """Whether `parallel=True` compiles parallel kernels with the installed numba."""
+    version = numba_module().__version__.split(".")[:2]
+    return tuple(int(x) for x in version) >= PARALLEL_FROM_NUMBA
+
+
+class Kernel:
+    """A kernel: its Python function, and numba's dispatcher for it, made on first compiled use."""
+
+    def __init__(self, func, options: dict):
+        functools.update_wrapper(self, func)
+        self.py_func = func
+        self.targetoptions = dict(options)
+        self._dispatcher = None
+
+    @property
+    def dispatcher(self):
+        """numba's dispatcher of this kernel (imports numba)."""
+        if self._dispatcher is None:
+            numba = numba_module()
+            options = dict(self.targetoptions)
+            if options.get("parallel") and not parallel_supported():
+                options["parallel"] = False
+            scope = self.py_func.__globals__
+            if scope.get("prange") is range:
+                scope["prange"] = numba.prange
+            self._dispatcher = numba.njit(**options)(self.py_func)
+        return self._dispatcher
+
+    @property
+    def _numba_type_(self):
+        return self.dispatcher._numba_type_
+
+    def __call__(self, *args, **kwargs):
+        if _compiled.get():
+            return (self._dispatcher or self.dispatcher)(*args, **kwargs)
+        return self.py_func(*args, **kwargs)
+
+    def __getattr__(self, name: str):
+        # numba's dispatcher answers the rest (signatures, overloads, inspect_types, ...)
+        if name.startswith("__") or name in ("_dispatcher", "py_func", "targetoptions"):
+            raise AttributeError(name)
+        return getattr(self.dispatcher, name)
+
+    def __reduce__(self):
+        return _kernel_named, (self.py_func.__module__, self.py_func.__qualname__)
+
+    def __repr__(self) -> str:
+        return f"<kernel {self.py_func.__module__}.{self.py_func.__qualname__}>"
+
+
+def _kernel_named(module: str, qualname: str) -> Kernel:
+    import importlib
+
+    obj = importlib.import_module(module)
+    for part in qualname.split("."):
+        obj = getattr(obj, part)
+    return obj
+
+
+def njit(func=None, **options):
+    """`@njit` or `@njit(cache=True, ...)`: a Kernel taking numba's njit options."""
+    if func is None:
+        return lambda f: Kernel(f, options)
+    return Kernel(func, options)
+
+
+def overload(func, **options):
+    """numba's `overload(func)`, registered when numba is first loaded."""
+
+    def register(impl):
+        _overloads.append((func, impl, options))
+        if _numba is not None:
+            from numba.extending import overload as numba_overload
+
+            numba_overload(func, **options)(impl)
+        return impl
+
+    return register

@@ -1,0 +1,85 @@
+"""The two lanes of a kernel (engine.jit): compiled by numba or interpreted, chosen per call.
+
+A kernel runs its Python function in the interpreted lane and numba's dispatcher in the compiled
+one; inside a compiled kernel the kernels it calls (plain, inline="always", overloaded) compile
+with it; an interpreted lane never imports numba; a kernel pickles by name.
+"""
+
+from __future__ import annotations
+
+import os
+import pickle
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from collide2d.engine import jit
+from collide2d.engine.broadphase import METHODS, find_pairs, sweep_pairs
+from collide2d.engine.raster import _round_into, round_positions
+
+COMPILING = os.environ.get("NUMBA_DISABLE_JIT", "0") in ("", "0")
+
+
+def test_the_lane_is_set_for_a_block_and_restored():
+    outer = jit.compiled()
+    with jit.lane(not outer):
+        assert jit.compiled() is (not outer)
+        with jit.lane(outer):
+            assert jit.compiled() is outer
+        assert jit.compiled() is (not outer)
+    assert jit.compiled() is outer
+
+
+@pytest.mark.skipif(not COMPILING, reason="NUMBA_DISABLE_JIT: nothing compiles")
+def test_a_compiled_call_runs_numbas_dispatcher_and_an_interpreted_one_the_function():
+    pos = np.array([[0.5, -0.5], [2.4999999999999996, 1e300]])
+    with jit.lane(False):
+        interpreted = round_positions(pos)
+    with jit.lane(True):
+        compiled = round_positions(pos)
+    assert _round_into.signatures, "the compiled lane did not go through numba"
+    assert np.array_equal(interpreted, compiled)
+    assert interpreted.tolist() == [[1, 0], [2, 2**40]]
+
+
+@pytest.mark.skipif(not COMPILING, reason="NUMBA_DISABLE_JIT: nothing compiles")
+def test_kernels_calling_inlined_and_overloaded_kernels_give_the_same_pairs_in_both_lanes():
+    rng = np.random.default_rng(3)
+    lo = rng.uniform(0, 200, (120, 2))
+    hi = lo + rng.uniform(1, 25, (120, 2))
+    movable = rng.random(120) < 0.8
+    expected = sweep_pairs(lo, hi, ~movable)
+    for method in METHODS.values():  # `find`'s overload picks the finder by a marker's type
+        for compiled in (False, True):
+            with jit.lane(compiled):
+                got = find_pairs(method, lo, hi, movable, 30.0)
+            assert np.array_equal(got, expected), (method, compiled)
+
+
+def test_a_kernel_pickles_as_itself():
+    assert pickle.loads(pickle.dumps(_round_into)) is _round_into
+
+
+def test_an_interpreted_run_never_imports_numba(tmp_path):
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text(
+        "version: 1\nname: s\nworld: {width: 40, height: 30, fps: 10}\nticks: 20\n"
+        "objects:\n  - {shape: box, size: 4, position: [2, 2], velocity: [30, 20]}\n"
+        "  - {shape: circle, diameter: 6, position: [20, 10], velocity: [-20, 10]}\n"
+        "output: {frames: [0, 20], gif: true, events: true}\n"
+    )
+    code = (
+        "import sys\n"
+        "from collide2d.runner.cli import main\n"
+        f"status = main(['run', {str(scenario)!r}, '--out', {str(tmp_path / 'out')!r}, "
+        "'--quiet', '--jit', sys.argv[1]])\n"
+        "print(status, 'numba' in sys.modules)\n"
+    )
+    env = {k: v for k, v in os.environ.items() if k not in ("COLLIDE2D_JIT", "NUMBA_DISABLE_JIT")}
+    for mode, loads_numba in (("auto", "False"), ("off", "False"), ("on", "True")):
+        done = subprocess.run(
+            [sys.executable, "-c", code, mode], capture_output=True, text=True, env=env
+        )
+        assert done.stdout.split() == ["0", loads_numba], (mode, done.stdout, done.stderr)
