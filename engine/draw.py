@@ -80,16 +80,19 @@ def _line(buf, x0, y0, x1, y1, c, cx0, cy0, cx1, cy1):
     ry = n
     for _ in range(n + 1):
         _plot(buf, x, y, c, cx0, cy0, cx1, cy1)
-        x += sx
-        rx += ix
-        if rx >= two_n:
-            rx -= two_n
-            x += 1
-        y += sy
-        ry += iy
-        if ry >= two_n:
-            ry -= two_n
-            y += 1
+        x, rx = _dda_next(x, rx, sx, ix, two_n)
+        y, ry = _dda_next(y, ry, sy, iy, two_n)
+
+
+@njit(cache=True, inline="always")
+def _dda_next(v, r, step, extra, two_n):
+    """One DDA step on one axis: the coordinate and remainder after it (whole step `step`, and one
+    more pixel each time the remainder, growing by `extra`, reaches `two_n`)."""
+    v += step
+    r += extra
+    if r >= two_n:
+        return v + 1, r - two_n
+    return v, r
 
 
 @njit(cache=True)
@@ -110,16 +113,8 @@ def _line_points(x0, y0, x1, y1, out):
     for k in range(n + 1):
         out[k, 0] = x
         out[k, 1] = y
-        x += sx
-        rx += ix
-        if rx >= two_n:
-            rx -= two_n
-            x += 1
-        y += sy
-        ry += iy
-        if ry >= two_n:
-            ry -= two_n
-            y += 1
+        x, rx = _dda_next(x, rx, sx, ix, two_n)
+        y, ry = _dda_next(y, ry, sy, iy, two_n)
 
 
 @njit(cache=True, inline="always")

@@ -23,7 +23,7 @@ REPORT_DIR = "bench"
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
-    from collide2d.runner import outputs
+    from collide2d.runner import lanes, outputs
     from collide2d.runner.bench import (
         error,
         exact,
@@ -39,6 +39,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
         timing,
     )
 
+    lanes.set_mode("on")  # every run the bench times is compiled (runner.lanes)
     parts = tuple(dict.fromkeys(args.part)) if args.part else DEFAULT_PARTS
     if args.peers and "peers" not in parts:
         parts += ("peers",)

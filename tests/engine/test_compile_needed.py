@@ -39,8 +39,9 @@ def test_the_marker_finds_the_pairs_its_method_finds(method):
     k = _via_marker(bp.marker(method), lo, hi, movable, 20.0, order, out, ws)
     assert len(expected) > 10
     np.testing.assert_array_equal(bp.keys_to_pairs(out[:k]), expected)
-    marker_type = _via_marker.signatures[-1][0]
-    assert str(marker_type.dtype) == str(np.dtype(bp.marker(method).dtype))
+    if os.environ.get("NUMBA_DISABLE_JIT") != "1":  # compiled: one specialisation per marker
+        marker_type = _via_marker.signatures[-1][0]
+        assert str(marker_type.dtype) == str(np.dtype(bp.marker(method).dtype))
 
 
 @pytest.mark.parametrize(
