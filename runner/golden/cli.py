@@ -71,8 +71,13 @@ def default_simulate(scenario, **kwargs):
     return simulate(scenario, **kwargs)
 
 
-def run_scenario(scenario, simulate, *, progress=False):
-    """The golden run of `scenario`: events logged, its golden frames kept."""
+def run_scenario(scenario, simulate, *, progress=False, jit=None):
+    """The golden run of `scenario`: events logged, its golden frames kept; `jit`, when given, the
+    kernel mode to run it in (runner.lanes: a cluster worker does not share this process's)."""
+    if jit is not None:
+        from collide2d.runner import lanes
+
+        lanes.set_mode(jit)
     return simulate(
         scenario, keep_frames=tuple(golden_frames(scenario)), log_events=True, progress=progress
     )
@@ -178,7 +183,11 @@ def check_command(args, *, load=default_load, simulate=default_simulate) -> int:
             out = Output(args)
         except GoldenError as exc:
             raise _Usage(str(exc)) from None
-        runs = _cluster_runs(args, scenarios, partial(run_scenario, simulate=simulate))
+        from collide2d.runner import lanes
+
+        runs = _cluster_runs(
+            args, scenarios, partial(run_scenario, simulate=simulate, jit=lanes.mode())
+        )
     except _Usage as exc:
         return exc.exit()
     outcomes, status, errors = [], EXIT_OK, []

@@ -183,10 +183,10 @@ def test_ctrl_c_keeps_the_run_so_far(tmp_path):
         text=True,
     )
     deadline = time.monotonic() + 120
-    while not list(tmp_path.glob("out/.small.*.run.tmp")):  # the run has started
+    # the run is ticking: the first chunk's events are in the staging folder (kernels compiled)
+    while not any(p.stat().st_size for p in tmp_path.glob("out/.small.*.run.tmp/*")):
         assert time.monotonic() < deadline and proc.poll() is None
         time.sleep(0.05)
-    time.sleep(2.0)
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=120)
     assert proc.returncode == 130
