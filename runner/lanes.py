@@ -15,7 +15,9 @@ its wall events (each object's crossings of the room it has, |v| / fps / room pe
 The exact model compiles whenever two moving masses differ more than EXACT_MAX_MASS_RATIO times
 (a light object between a wall and a heavy one bounces about pi * sqrt(ratio) times). What no
 estimate sees, a run that starts interpreted also watches: once its ticks have taken
-INTERPRETED_BUDGET_S it goes on compiled (between two ticks: the state is the same arrays).
+INTERPRETED_BUDGET_S and the ticks left would take more than INTERPRETED_LEFT_S at the pace so far,
+it goes on compiled (between two ticks: the state is the same arrays). A busy machine slows both
+lanes alike, and a run near its end is not worth a compilation.
 
 Measured interpreted on this project's 2-core machine: the paper model's section IV demo (50
 boxes, 100 ticks, every frame drawn for the GIF) takes 0.19 s; a gas of 300 boxes over 120 ticks,
@@ -44,8 +46,10 @@ PIXELS_PER_OBJECT_TICK = 100
 LOAD_INTERPRETED_MAX_OBJECTS = 2_000
 # The exact model compiles when two moving masses differ more than this many times.
 EXACT_MAX_MASS_RATIO = 100.0
-# Seconds of interpreted ticks after which an `auto` run goes on compiled.
+# Seconds of interpreted ticks after which an `auto` run goes on compiled, if the ticks left would
+# take more than INTERPRETED_LEFT_S more.
 INTERPRETED_BUDGET_S = 1.0
+INTERPRETED_LEFT_S = 3.0
 # Ticks per model call while a run may still switch (how often the budget is looked at).
 INTERPRETED_CHUNK_TICKS = 8
 
@@ -111,26 +115,31 @@ def _mass_ratio(bodies) -> float:
 
 class RunLane:
     """The lane of one run as it goes: `compiled`, and whether it may still switch (an `auto` run
-    that starts interpreted). `step(ticks)` caps a model call's ticks while it may; `timed()`
-    wraps each call, and switches to compiled for good once the calls took INTERPRETED_BUDGET_S."""
+    that starts interpreted). `step(ticks)` caps a model call's ticks while it may; `timed(ticks)`
+    wraps each call of that many ticks and switches to compiled for good as the module docstring
+    says."""
 
     def __init__(self, scenario, frames: int):
         self.compiled = compiled_for_run(scenario, frames)
         self.started_compiled = self.compiled
         self.may_switch = not self.compiled and mode() == "auto"
         self.spent = 0.0
+        self.done = 0
+        self.ticks = scenario.ticks
 
     def step(self, ticks: int) -> int:
         return min(ticks, INTERPRETED_CHUNK_TICKS) if self.may_switch else ticks
 
     @contextlib.contextmanager
-    def timed(self):
+    def timed(self, ticks: int):
         began = time.perf_counter()
         with jit.lane(self.compiled):
             yield
         if self.may_switch:
             self.spent += time.perf_counter() - began
-            if self.spent > INTERPRETED_BUDGET_S:
+            self.done += ticks
+            left = self.spent / max(self.done, 1) * (self.ticks - self.done)
+            if self.spent > INTERPRETED_BUDGET_S and left > INTERPRETED_LEFT_S:
                 self.compiled, self.may_switch = True, False
 
     def name(self) -> str:

@@ -142,7 +142,7 @@ def _drive(
                 stop = model.tick + 1
             stop = model.tick + lane.step(stop - model.tick)
             try:
-                with lane.timed():
+                with lane.timed(stop - model.tick):
                     events = model.advance(stop - model.tick, logging)
             except Runaway as exc:
                 when = (

@@ -84,6 +84,7 @@ def test_a_run_over_its_interpreted_budget_goes_on_compiled_with_the_same_bytes(
     compiled = simulate(scenario, keep_frames=range(0, 61, 5))
     lanes.set_mode(None)
     monkeypatch.setattr(lanes, "INTERPRETED_BUDGET_S", 0.0)  # switch after the first call
+    monkeypatch.setattr(lanes, "INTERPRETED_LEFT_S", 0.0)
     switched = simulate(scenario, keep_frames=range(0, 61, 5))
     assert switched.summary["kernels"] == "interpreted, then compiled"
     assert compiled.summary["kernels"] == "compiled"
@@ -92,6 +93,8 @@ def test_a_run_over_its_interpreted_budget_goes_on_compiled_with_the_same_bytes(
     assert switched.frames.keys() == compiled.frames.keys()
     for k, frame in compiled.frames.items():
         assert np.array_equal(switched.frames[k], frame), k
+    monkeypatch.setattr(lanes, "INTERPRETED_LEFT_S", 1e9)  # never worth it: stays interpreted
+    assert simulate(scenario).summary["kernels"] == "interpreted"
 
 
 def test_run_writes_the_same_files_under_each_mode_and_says_which_lane(tmp_path):
