@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from collide2d.runner.bench import goals
 from collide2d.runner.bench.timing import median
 
 LOAD_N = 100_000
@@ -95,11 +96,12 @@ def load(quick: bool, echo, n: int | None = None) -> list[dict]:
     with tempfile.TemporaryDirectory() as tmp:
         paths = write_scenes(Path(tmp), n)
         runs = [
-            ("YAML list, fast lane", paths["yaml"], "fast", repeats, 2.0, 300),
-            ("CSV table", paths["csv"], "fast", repeats, 0.3, None),
-            ("YAML list, general path", paths["yaml"], "general", 1, None, None),
+            ("YAML list, fast lane", paths["yaml"], "fast", repeats),
+            ("CSV table", paths["csv"], "fast", repeats),
+            ("YAML list, general path", paths["yaml"], "general", 1),
         ]
-        for what, path, lane, times, target_s, target_mb in runs:
+        for what, path, lane, times in runs:
+            target_s, target_mb = goals.LOAD.get(what, (None, None))
             results = [_child(path, lane) for _ in range(times)]
             assert all(r["n"] == n for r in results)
             seconds = median([r["s"] for r in results])
@@ -111,6 +113,8 @@ def load(quick: bool, echo, n: int | None = None) -> list[dict]:
                 {
                     "part": "load",
                     "scene": f"{n:,} objects: {what}",
+                    "how": what,
+                    "peak_mb": peak,
                     "n": n,
                     "run_time_s": seconds,
                     "value": seconds,

@@ -17,8 +17,6 @@ from collide2d.runner.bench.timing import PROBE_S, QUICK_TARGET_S, REPEATS, TARG
 PYMUNK_HASH_SIDES = 2.0
 PYMUNK_HASH_CELLS_PER_OBJECT = 10
 PYMUNK_WARMUP_STEPS = 10
-# The target (stepped at least 5x pymunk's steps/s) is for N = 1,000 and up.
-PEER_TARGET_MIN_N = 1_000
 
 
 def pymunk_available() -> bool:

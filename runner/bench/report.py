@@ -8,8 +8,8 @@ import os
 
 import numpy as np
 
+from collide2d.runner.bench import goals
 from collide2d.runner.bench.error import NUDGE_PX_S
-from collide2d.runner.bench.peers import PEER_TARGET_MIN_N
 from collide2d.runner.bench.scenes import (
     STANDARD_COVERAGE,
     STANDARD_FPS,
@@ -132,11 +132,31 @@ def headline(rows: list[dict]) -> list[tuple[str, str, str, str]]:
         out.append((what, figure, target, "" if met is None else ("✓" if met else "✗")))
 
     scale = {r["n"]: r for r in rows if r["part"] == "scaling" and r["model"] == "stepped"}
+    paper = {r["n"]: r for r in rows if r["part"] == "scaling" and r["model"] == "paper"}
     for r in rows:
         if r["part"] == "peers" and "ratio" in r:
-            big = r["n"] >= PEER_TARGET_MIN_N
+            goal = goals.PEER_RATIO.get(r["n"])
             add(f"stepped / pymunk steps/s, N = {r['n']:,}", f"{r['ratio']:.2f}",
-                ">= 5" if big else "", r["ratio"] >= 5 if big else None)  # fmt: skip
+                f">= {goal:g}" if goal else "", r["ratio"] >= goal if goal else None)  # fmt: skip
+    n, most = goals.STEPPED_NS_PER_BODY_STEP
+    if n in scale:
+        ns = scale[n]["ns_per_body_step"]
+        add(f"stepped ns per body-step, N = {n:,}", f"{ns:.1f}", f"<= {most:g}", ns <= most)
+    n, least = goals.PAPER_STEPS_PER_S
+    if n in paper:
+        steps = paper[n]["steps_per_s"]
+        add(f"paper steps/s, N = {n:,}", f"{steps:,.0f}", f">= {least:,.0f}", steps >= least)
+    for r in rows:
+        if r["part"] == "exact" and r["scene"] in goals.EXACT_EVENTS_PER_S:
+            least = goals.EXACT_EVENTS_PER_S[r["scene"]]
+            add(f"exact events/s, {r['scene']}", f"{r['value']:,.0f}", f">= {least:,}",
+                r["value"] >= least)  # fmt: skip
+        if r["part"] == "load" and r.get("how") in goals.LOAD:
+            most_s, most_mb = goals.LOAD[r["how"]]
+            target = f"<= {most_s:g} s" + (f", <= {most_mb} MB" if most_mb else "")
+            met = r["value"] <= most_s and (most_mb is None or r["peak_mb"] <= most_mb)
+            figure = f"{r['value']:.2f} s, {r['peak_mb']:.0f} MB"
+            add(f"load {r['n']:,} objects, {r['how']}", figure, target, met)
     if 1_000 in scale and max(scale) > 1_000:
         big = max(scale)
         ratio = scale[big]["ns_per_body_step"] / scale[1_000]["ns_per_body_step"]

@@ -36,15 +36,33 @@ def test_headline_gives_the_ratios_the_issue_asks_for_with_target_and_mark():
          "noisy": "no", "spread": 0.15, "diverges_s": None, "pairs": 10, "missed": 0,
          "count_error": 0, "energy_drift": 0.0, "max_penetration_px": 0.0, "pareto": "yes"},
         {"part": "glancing", "value": None, "scene": "two boxes", "fps": 60, "note": "none"},
+        {"part": "scaling", "model": "paper", "n": 100_000, "steps_per_s": 310.0},
+        {"part": "peers", "model": "pymunk", "n": 100_000, "ratio": 31.0},
+        {"part": "exact", "scene": "two-body chain", "value": 3_900_000.0},
+        {"part": "exact", "scene": "standard-10000", "value": 510_000.0},
+        {"part": "load", "how": "CSV table", "n": 100_000, "value": 0.25, "peak_mb": 400.0},
+        {"part": "load", "how": "YAML list, fast lane", "n": 100_000, "value": 0.6,
+         "peak_mb": 320.0},
     ]  # fmt: skip
     head = {what: (figure, target, met) for what, figure, target, met in report.headline(rows)}
-    assert head["stepped / pymunk steps/s, N = 1,000"] == ("4.50", ">= 5", "✗")
+    assert head["stepped / pymunk steps/s, N = 1,000"] == ("4.50", ">= 10", "✗")
     assert head["stepped cost per body-step, N = 100,000 / N = 1,000"] == ("1.50", "<= 2", "✓")
+    assert head["stepped / pymunk steps/s, N = 100,000"] == ("31.00", ">= 30", "✓")
+    assert head["stepped ns per body-step, N = 100,000"] == ("30.0", "<= 10", "✗")
+    assert head["paper steps/s, N = 100,000"] == ("310", ">= 300", "✓")
+    assert head["exact events/s, two-body chain"] == ("3,900,000", ">= 4,000,000", "✗")
+    assert head["exact events/s, standard-10000"] == ("510,000", ">= 500,000", "✓")
+    assert head["load 100,000 objects, CSV table"] == ("0.25 s, 400 MB", "<= 0.3 s", "✓")
+    assert head["load 100,000 objects, YAML list, fast lane"] == (
+        "0.60 s, 320 MB",
+        "<= 2 s, <= 300 MB",
+        "✗",
+    )
     assert head["section IV demo headless"] == ("1,200,000", ">= 1,000,000", "✓")
     assert head["stepped error at 10 s, bench_dense_gas, 64 substeps"] == ("0.5 px", "< 1 px", "✓")
     assert head["glancing tunnelling at 1 substep below one box size per step"][2] == "✓"
     assert head["timings marked noisy (spread > 20 %)"] == ("1 of 3", "0", "✗")
     assert head["largest repeat spread (max - min) / median"][0] == "35%"
     md = report.markdown(rows, "collide2d bench", 1.0)
-    assert "| what | figure | target | met |" in md and "| 4.50 | >= 5 | ✗ |" in md
+    assert "| what | figure | target | met |" in md and "| 4.50 | >= 10 | ✗ |" in md
     assert "| bench_dense_gas | stepped | 60 | 64 | 200 | 190-220 | no | 0.1 | 0.5 |" in md

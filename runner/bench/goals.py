@@ -1,0 +1,18 @@
+"""The figures `collide2d bench` holds the engine to, in one place: its headline marks each met or
+not (runner.bench.report).
+
+- PEER_RATIO: the stepped model's steps/s over pymunk's on the same standard scene, through
+  `collide2d run` with every core, by N;
+- STEPPED_NS_PER_BODY_STEP: the stepped model's cost per body-step at that N, every core, at most;
+- PAPER_STEPS_PER_S: the paper model's steps/s at that N, at least;
+- EXACT_EVENTS_PER_S: the exact model's events/s by scene of the exact part, at least;
+- LOAD: seconds (and peak MB) to load that many objects, by how (runner.bench.load), at most.
+"""
+
+from __future__ import annotations
+
+PEER_RATIO = {1_000: 10.0, 10_000: 15.0, 100_000: 30.0}
+STEPPED_NS_PER_BODY_STEP = (100_000, 10.0)
+PAPER_STEPS_PER_S = (100_000, 300.0)
+EXACT_EVENTS_PER_S = {"two-body chain": 4_000_000, "standard-10000": 500_000}
+LOAD = {"YAML list, fast lane": (2.0, 300), "CSV table": (0.3, None)}
