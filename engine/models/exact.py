@@ -2,11 +2,13 @@
 
 Input: the world, the `Bodies` (copied) and the options `geometry` ("exact", the default, also
 for None: circles and polygons by their real shapes; "box": every object as its box),
-`max_events_per_tick`, `cell_size` (px; the grid's cell, chosen from the scene when not given)
-and `repredict` ("touched", the default; "all" predicts every moving object again after each
-event, the work the local re-prediction saves, for tests and `collide2d bench`). Output, per
-`advance`: the wall and pair events in the order they happened, `t` = the exact contact time;
-positions and velocities at the end of the last tick.
+`max_events_per_tick`, `cell_size` (px; the grid's cell, chosen from the scene when not given:
+one cell for the whole world when the grid would be at most 3 cells a side, where every cell is
+in every other's 3×3 anyway and crossings would be bookkeeping for nothing) and `repredict`
+("touched", the default; "all" predicts every moving object again after each event, the work
+the local re-prediction saves, for tests and `collide2d bench`). Output, per `advance`: the
+wall and pair events in the order they happened, `t` = the exact contact time; positions and
+velocities at the end of the last tick.
 
 Objects fly on straight lines between events. Each keeps its own clock (TLOC: its position is
 valid at that time) and an invalidation counter. A 4-ary heap, in preallocated arrays that grow
@@ -383,6 +385,10 @@ class Model:
         self._C = (cores.radius, cores.start, cores.verts, cores.normals)
         if cell_size is None:
             cell_size = grid_cell(world.width, world.height, bodies.size, static)
+            if max(grid_dims(world.width, world.height, cell_size)) <= 3:
+                # every cell is in every other's 3x3: one cell sees the same neighbours and
+                # spares the cell crossings (the grid never changes the answer)
+                cell_size = float(max(world.width, world.height))
         self.cell_size = float(cell_size)
         gnx, gny = grid_dims(world.width, world.height, self.cell_size)
         self._world = (
