@@ -133,7 +133,7 @@ from collide2d.engine.exactstate import (
     kernel,
 )
 from collide2d.engine.noroom import jammed, listing, no_room, no_room_message
-from collide2d.engine.prediction import predict, set_job
+from collide2d.engine.prediction import predict, predict_inline, set_job
 from collide2d.engine.response import exchange
 from collide2d.engine.shapes import GEOMETRIES, build_cores
 from collide2d.engine.world import Bodies, WorldSpec
@@ -303,7 +303,9 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
                         st[S_LOGGED] += 1
             # predict again for what it touched (and with `everyone`, for every moving object)
             for k in range(n_jobs):
-                predict(jobs, k, t, F, N, C, cells, s_start, s_items, HT, HI, HN, st, world)
+                predict_inline(
+                    jobs, k, t, F, N, C, cells, s_start, s_items, HT, HI, HN, st, world
+                )
             if everyone and n_jobs > 0:
                 for i in range(F.shape[0]):
                     if (
