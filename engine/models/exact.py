@@ -434,9 +434,13 @@ class Model:
         return events.event_records(rows, times, int(self._st[S_LOGGED]))
 
     def _call(self, target, log, cap, rows, times) -> int:
-        """One call of the kernel `_run` on the model's state; its status."""
+        """One call of the kernel `_run` on the model's state; its status. (Interpreted, a time
+        past float64's range, as a subnormal speed gives, is inf as compiled: no numpy warning.)"""
         everyone = self.repredict == "all"
-        return _run(self._state(), self._jobs, self._stack, target, log, cap, everyone, rows, times)
+        with np.errstate(over="ignore"):
+            return _run(
+                self._state(), self._jobs, self._stack, target, log, cap, everyone, rows, times
+            )
 
     def event_counts(self) -> tuple[int, int]:
         """(wall events, pair events) so far, logged or not."""
