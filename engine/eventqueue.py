@@ -108,17 +108,30 @@ def _sift_up(HT, HI, HN, i, t, key, ca, cb, nx, ny):
 
 
 @hot
+def _first_child(HT, HI, first, last):
+    """(slot, time) of the earliest of entries first..last-1 (the first one on a tie)."""
+    c = first
+    tc = HT[first]
+    for m in range(first + 1, last):
+        tm = HT[m]
+        if tm < tc or (tm == tc and HI[m, HKEY] < HI[c, HKEY]):
+            c = m
+            tc = tm
+    return c, tc
+
+
+@hot
 def _sift_down(HT, HI, HN, n, i, t, key, ca, cb, nx, ny):
     """Place an entry at hole i of a heap of n, moving it down past earlier children."""
     while True:
         first = ARITY * i + 1
-        if first >= n:
+        if first + ARITY <= n:  # a full family: a loop of constant length, unrolled
+            c, tc = _first_child(HT, HI, first, first + ARITY)
+        elif first < n:
+            c, tc = _first_child(HT, HI, first, n)
+        else:
             break
-        c = first
-        for m in range(first + 1, min(first + ARITY, n)):
-            if _earlier(HT, HI, m, HT[c], HI[c, HKEY]):
-                c = m
-        if not _earlier(HT, HI, c, t, key):
+        if not (tc < t or (tc == t and HI[c, HKEY] < key)):
             break
         _move(HT, HI, HN, i, c)
         i = c

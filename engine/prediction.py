@@ -38,7 +38,6 @@ from collide2d.engine.exactstate import (
     X,
     Y,
     hot,
-    kernel,
 )
 from collide2d.engine.jit import njit
 from collide2d.engine.world import KIND_BOX
@@ -143,11 +142,12 @@ def _predict_pair(i, j, t_now, horizon, F, N, C, HT, HI, HN, st):
         push(HT, HI, HN, st, t, make_key(RANK_PAIR, a, b, code), N[a, CNT], N[b, CNT], nx, ny)
 
 
-@kernel
+@hot
 def predict(jobs, k, t_now, F, N, C, cells, s_start, s_items, HT, HI, HN, st, world):
     """Run prediction job k for object i: push its horizon (the first of its next wall contact
     and its next cell crossing) and its contacts with the objects in the 3×3 cells around it
-    that come no later than that."""
+    that come no later than that. Inlined into the event loop's one call site: a call would
+    cost more than the prediction of a small scene."""
     i, skip, mode = jobs[k, J_OBJ], jobs[k, J_SKIP], jobs[k, J_HIGHER]
     higher = mode == JOB_FIRST
     t_wall, side = _wall_time(i, F, world)

@@ -2,11 +2,13 @@
 
 Input: the world, the `Bodies` (copied) and the options `geometry` ("exact", the default, also
 for None: circles and polygons by their real shapes; "box": every object as its box),
-`max_events_per_tick`, `cell_size` (px; the grid's cell, chosen from the scene when not given)
-and `repredict` ("touched", the default; "all" predicts every moving object again after each
-event, the work the local re-prediction saves, for tests and `collide2d bench`). Output, per
-`advance`: the wall and pair events in the order they happened, `t` = the exact contact time;
-positions and velocities at the end of the last tick.
+`max_events_per_tick`, `cell_size` (px; the grid's cell, chosen from the scene when not given:
+one cell for the whole world when the grid would be at most 3 cells a side, where every cell is
+in every other's 3×3 anyway and crossings would be bookkeeping for nothing) and `repredict`
+("touched", the default; "all" predicts every moving object again after each event, the work
+the local re-prediction saves, for tests and `collide2d bench`). Output, per `advance`: the
+wall and pair events in the order they happened, `t` = the exact contact time; positions and
+velocities at the end of the last tick.
 
 Objects fly on straight lines between events. Each keeps its own clock (TLOC: its position is
 valid at that time) and an invalidation counter. A 4-ary heap, in preallocated arrays that grow
@@ -49,8 +51,8 @@ state; exactstate.py), the event queue (a 4-ary heap; eventqueue.py), the grid's
 (cells.py), the predictions (prediction.py), objects with no room to move (noroom.py) and the
 event log (events.py). This module applies events (`_on_cross`, `_on_wall`, `_on_pair`) and
 runs the main loop, `_run`: take the next event, apply it, predict again for what it touched. The
-kernels `predict` and `_run` allocate nothing: growing the heap or the event log is done in
-Python between calls (the kernel stops before an event it has no room for, and resumes).
+kernel `_run` (with `predict` inlined) allocates nothing: growing the heap or the event log is
+done in Python between calls (the kernel stops before an event it has no room for, and resumes).
 """
 
 from __future__ import annotations
@@ -242,27 +244,36 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
     st[S_PAIRS] every event, logged or not.
     """
     F, N, C, cells, s_start, s_items, HT, HI, HN, st, stf, world = S
-    extra_room = F.shape[0] * F.shape[0] if everyone else 0
+    n = F.shape[0]
+    extra_room = n * n if everyone else 0
     # (The loop's steps are written out here, not as inlined helpers: helpers cost ~15 % of the
-    # events per second of a two-body chain, measured with numba 0.68.)
-    while st[S_FIRST] < F.shape[0]:  # the first predictions, at time 0: each pair once
-        i = st[S_FIRST]
-        if N[i, STATIC] == 0:
-            room = room_around(
-                N[i, CELL] % world[4], N[i, CELL] // world[4], N, cells, s_start, world
-            )
-            if not has_room(room, HT, HI, HN, st, N):
-                return STATUS_HEAP_FULL
-            set_job(jobs, 0, i, -1, JOB_FIRST)
-            for k in range(1):  # (as below: typed arguments, so that one compiled predict serves)
-                predict(
-                    jobs, k, stf[SF_T_NOW], F, N, C, cells, s_start, s_items, HT, HI, HN, st, world
+    # events per second of a two-body chain, measured with numba 0.68. Each pass makes the
+    # prediction jobs of one step, then runs them at the one place that inlines `predict`.)
+    while True:
+        n_jobs = 0
+        t = stf[SF_T_NOW]
+        first = st[S_FIRST] < n
+        if first:  # the first predictions, at time 0: each pair once
+            i = st[S_FIRST]
+            if N[i, STATIC] == 0:
+                room = room_around(
+                    N[i, CELL] % world[4], N[i, CELL] // world[4], N, cells, s_start, world
                 )
-        st[S_FIRST] += 1
-    while st[S_TICK] < tick_to:
-        tick = st[S_TICK] + 1
-        t_end = tick / world[2]
-        while st[S_HEAP_N] > 0 and HT[0] <= t_end + instant(t_end):  # t = k/fps is tick k's
+                if not has_room(room, HT, HI, HN, st, N):
+                    return STATUS_HEAP_FULL
+                set_job(jobs, 0, i, -1, JOB_FIRST)
+                n_jobs = 1
+            st[S_FIRST] += 1
+        else:
+            if st[S_TICK] >= tick_to:
+                return STATUS_DONE
+            tick = st[S_TICK] + 1
+            t_end = tick / world[2]
+            if st[S_HEAP_N] == 0 or HT[0] > t_end + instant(t_end):  # t = k/fps is tick k's
+                stf[SF_T_NOW] = t_end
+                st[S_TICK] = tick
+                st[S_TICK_EVENTS] = 0
+                continue
             # take the next event: the first valid entry of the top's instant, in key order, once
             # the heap has room for what it may push
             if not is_valid(HI, 0, N):
@@ -299,37 +310,27 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
                     if log:
                         put_event(rows, times, st[S_LOGGED], tick, t, kind, a, b, code)
                         st[S_LOGGED] += 1
-            # predict again for what it touched (and with `everyone`, for every moving object)
-            for k in range(n_jobs):
-                predict(jobs, k, t, F, N, C, cells, s_start, s_items, HT, HI, HN, st, world)
-            if everyone and n_jobs > 0:
-                for i in range(F.shape[0]):
-                    if (
-                        N[i, STATIC] == 0
-                        and i != jobs[0, J_OBJ]
-                        and (n_jobs < 2 or i != jobs[1, J_OBJ])
-                    ):
-                        set_job(jobs, J_EXTRA, i, N[i, PARTNER], JOB_CONTACTS)
-                        predict(
-                            jobs,
-                            J_EXTRA,
-                            t,
-                            F,
-                            N,
-                            C,
-                            cells,
-                            s_start,
-                            s_items,
-                            HT,
-                            HI,
-                            HN,
-                            st,
-                            world,
-                        )
-        stf[SF_T_NOW] = t_end
-        st[S_TICK] = tick
-        st[S_TICK_EVENTS] = 0
-    return STATUS_DONE
+        # predict again for what the step touched (and after an event with `everyone`, for
+        # every other moving object: contacts only, not against the partner of its last pair)
+        extra = 0 if everyone and not first and n_jobs > 0 else n
+        k = 0
+        while True:
+            if k < n_jobs:
+                job = k
+                k += 1
+            else:
+                while extra < n and (
+                    N[extra, STATIC] != 0
+                    or extra == jobs[0, J_OBJ]
+                    or (n_jobs > 1 and extra == jobs[1, J_OBJ])
+                ):
+                    extra += 1
+                if extra >= n:
+                    break
+                set_job(jobs, J_EXTRA, extra, N[extra, PARTNER], JOB_CONTACTS)
+                job = J_EXTRA
+                extra += 1
+            predict(jobs, job, t, F, N, C, cells, s_start, s_items, HT, HI, HN, st, world)
 
 
 class Model:
@@ -383,6 +384,10 @@ class Model:
         self._C = (cores.radius, cores.start, cores.verts, cores.normals)
         if cell_size is None:
             cell_size = grid_cell(world.width, world.height, bodies.size, static)
+            if max(grid_dims(world.width, world.height, cell_size)) <= 3:
+                # every cell is in every other's 3x3: one cell sees the same neighbours and
+                # spares the cell crossings (the grid never changes the answer)
+                cell_size = float(max(world.width, world.height))
         self.cell_size = float(cell_size)
         gnx, gny = grid_dims(world.width, world.height, self.cell_size)
         self._world = (
@@ -429,9 +434,13 @@ class Model:
         return events.event_records(rows, times, int(self._st[S_LOGGED]))
 
     def _call(self, target, log, cap, rows, times) -> int:
-        """One call of the kernel `_run` on the model's state; its status."""
+        """One call of the kernel `_run` on the model's state; its status. (Interpreted, a time
+        past float64's range, as a subnormal speed gives, is inf as compiled: no numpy warning.)"""
         everyone = self.repredict == "all"
-        return _run(self._state(), self._jobs, self._stack, target, log, cap, everyone, rows, times)
+        with np.errstate(over="ignore"):
+            return _run(
+                self._state(), self._jobs, self._stack, target, log, cap, everyone, rows, times
+            )
 
     def event_counts(self) -> tuple[int, int]:
         """(wall events, pair events) so far, logged or not."""

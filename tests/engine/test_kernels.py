@@ -18,9 +18,7 @@ from numba.core.config import DISABLE_JIT
 
 import collide2d.engine
 from collide2d.engine import jit
-from collide2d.engine.exactstate import JOB_EVENT, S_HEAP_N
 from collide2d.engine.models import make
-from collide2d.engine.prediction import predict, set_job
 from collide2d.engine.world import Bodies, WorldSpec
 
 pytestmark = pytest.mark.skipif(DISABLE_JIT, reason="NUMBA_DISABLE_JIT: nothing is compiled")
@@ -29,7 +27,6 @@ pytestmark = pytest.mark.skipif(DISABLE_JIT, reason="NUMBA_DISABLE_JIT: nothing 
 EXPECTED = {
     ("collide2d.engine.models.paper", "_run"),
     ("collide2d.engine.models.exact", "_run"),
-    ("collide2d.engine.prediction", "predict"),
 }
 
 
@@ -54,9 +51,7 @@ def _no_nrt_kernels() -> dict[tuple[str, str], jit.Kernel]:
 
 
 def _tiny_runs() -> None:
-    """Each model over two boxes that meet and hit the walls, and one prediction of the exact
-    model called on its own (a `_run` loaded from numba's cache does not compile `predict`):
-    every kernel compiles and runs."""
+    """Each model over two boxes that meet and hit the walls: every kernel compiles and runs."""
     world = WorldSpec(40, 20, 10)
     bodies = Bodies.boxes([[2, 5], [24, 5]], 6, [[40, 0], [-30, 0]])
     for name in ("paper", "stepped", "exact"):
@@ -64,11 +59,6 @@ def _tiny_runs() -> None:
         events = model.advance(10)
         assert len(events) > 0
         assert np.isfinite(model.positions()).all()
-    F, N, C, cells, s_start, s_items, HT, HI, HN, st, _stf, world_ = model._state()
-    heap_before = int(st[S_HEAP_N])
-    set_job(model._jobs, 0, 0, -1, JOB_EVENT)
-    predict(model._jobs, 0, 1.0, F, N, C, cells, s_start, s_items, HT, HI, HN, st, world_)
-    assert st[S_HEAP_N] > heap_before  # it pushed at least its horizon
 
 
 def test_the_kernels_without_reference_counting_are_the_expected_ones():
