@@ -5,9 +5,11 @@
 - a run of a small scenario with the kernels cached (`scenarios/tunnelling_1fps.yaml`);
 
 each with `--jit auto` (the default) and `--jit on` (every kernel compiled, as before the lanes),
-interleaved, medians with the spread. Usage:
+interleaved, medians with the spread; every command runs from an empty temporary folder (`check`
+with `--root` this repository). `--python PY` runs another installation's collide2d (a fresh
+virtualenv holding a wheel, say). Usage:
 
-    python benchmarks/first_run.py [--repeats 3] [--warm-repeats 9]
+    python benchmarks/first_run.py [--repeats 3] [--warm-repeats 9] [--python PY]
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ COMMAND = [sys.executable, "-m", "collide2d"]
 def timed(args: list[str], cache: Path, cwd: Path) -> float:
     env = dict(os.environ, NUMBA_CACHE_DIR=str(cache))
     env.pop("COLLIDE2D_JIT", None)
+    env.pop("PYTHONPATH", None)
     began = time.perf_counter()
     done = subprocess.run([*COMMAND, *args], cwd=cwd, env=env, capture_output=True, text=True)
     took = time.perf_counter() - began
@@ -51,7 +54,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=3, help="cold runs of each (default 3)")
     parser.add_argument("--warm-repeats", type=int, default=9, help="warm runs (default 9)")
+    parser.add_argument("--python", default=sys.executable, help="the Python to run collide2d")
     args = parser.parse_args()
+    COMMAND[0] = args.python
     results: dict[str, list[float]] = {}
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
@@ -61,7 +66,7 @@ def main() -> None:
             for mode in ("auto", "on"):
                 demo = cold(["run", "--out", out, "--quiet", "--jit", mode], work, work)
                 results.setdefault(f"demo, empty cache, --jit {mode}", []).append(demo)
-                check = cold(["check", "--quiet", "--jit", mode], work, ROOT)
+                check = cold(["check", "--root", str(ROOT), "--quiet", "--jit", mode], work, work)
                 results.setdefault(f"check, empty cache, --jit {mode}", []).append(check)
         warm = work / "warm"
         for mode in ("auto", "on"):  # fill the cache first
@@ -71,7 +76,7 @@ def main() -> None:
                 took = timed(["run", small, "--out", out, "--quiet", "--jit", mode], warm, work)
                 results.setdefault(f"small run, cached, --jit {mode}", []).append(took)
     load = os.getloadavg()[0]
-    print(f"# collide2d first-run times, wall (load average {load:.1f} at the end)")
+    print(f"# collide2d first-run times, wall, {args.python} (load average {load:.1f} at the end)")
     for name, times in results.items():
         print(f"{name:<34} {shown(times)}")
 
