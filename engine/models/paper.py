@@ -72,11 +72,14 @@ from collide2d.engine.world import Bodies, WorldSpec
 # tick's end, tick / fps.
 # Room for events and candidate pairs before the buffers grow (rows; they double when full).
 _INITIAL_ROWS = 1024
-# The candidate list is made with every reach box grown by a margin (px) and kept until some object
-# has drifted that far from where it was made: a few of the fastest steps, within these bounds.
-_MARGIN_STEPS = 8
-_MARGIN_MIN_PX = 2
-_MARGIN_MAX_PX = 32
+# The candidate list is made with each object's reach box grown by its own margin (px, per axis):
+# the farthest its counter lets it move in the next _WINDOW_TICKS ticks (its step times the steps
+# its counter fires in them), at most _MARGIN_MAX_PX; the list is kept until some object has moved
+# past its margin from where it was when the list was made (its *fence*). A slow object's box
+# grows little, an object that will not step in the window not at all, and one fast object makes
+# only its own box large, not everyone's.
+_WINDOW_TICKS = 8
+_MARGIN_MAX_PX = 128
 # Reach boxes are kept in int32 when the world, steps and sides keep them within this (px).
 REACH_INT32_MAX = 2**30
 
@@ -110,13 +113,14 @@ _kernel = njit(cache=True, _nrt=False)
 
 
 @njit(cache=True, inline="always")
-def _move(pos, step, period, count, disp, anchor, room):
+def _move(pos, step, period, count, disp, fence, room):
     """Counters rise by one; a component whose counter reaches its period moves by its step.
 
-    room (n, 2) = world side - box side. Returns (how far, px, anything now is from `anchor` at
-    most; whether any box left the world).
+    room (n, 2) = world side - box side; fence (n, 4) = [x lo, x hi, y lo, y hi], the positions
+    each object may hold while the candidate list lasts. Returns (whether any object is now past
+    its fence; whether any box left the world).
     """
-    drift = 0
+    strayed = False
     left = False
     for i in range(pos.shape[0]):
         for ax in range(2):
@@ -127,9 +131,9 @@ def _move(pos, step, period, count, disp, anchor, room):
             p = pos[i, ax] + d
             pos[i, ax] = p
             disp[i, ax] = d
-            drift = max(drift, abs(p - anchor[i, ax]))
+            strayed |= (p < fence[i, 2 * ax]) | (p > fence[i, 2 * ax + 1])
             left |= (p < 0) | (p > room[i, ax])
-    return drift, left
+    return strayed, left
 
 
 @njit(cache=True, inline="always")
@@ -154,15 +158,28 @@ def _walls(pos, room, step, disp, tick, log, ev, n_ev, st):
 
 
 @njit(cache=True)
-def _relist(pos, size, disp, movable, margin, finder, cell, order, lo, hi, keys, ws):
-    """List the pairs whose reach boxes, grown by `margin` px on every side, overlap (keys
+def _relist(pos, size, step, period, count, disp, fence, movable, window, cap, finder, cell,
+            order, lo, hi, keys, ws):
+    """List the pairs whose reach boxes, each grown by its object's margin, overlap (keys
     a << KEY_SHIFT | b, a < b, in no particular order); pairs of two immovable objects are left
-    out. Returns how many there are; only as many as `keys` holds are written."""
+    out. Returns how many there are; only as many as `keys` holds are written.
+
+    An object's margin on an axis is how far its counter can move it in the next _WINDOW_TICKS
+    ticks, |V| x the steps it fires in them (a pair or a wall only reverses or takes a step back),
+    at most _MARGIN_MAX_PX, from either end of this tick's step (the pair stage may take it
+    back); its fence is that range of positions. While every object stays within its fence, every
+    box it holds lies in its grown reach box, so every pair that can overlap is listed."""
     for i in range(pos.shape[0]):
         for ax in range(2):
             d = disp[i, ax]
-            lo[i, ax] = pos[i, ax] - max(d, 0) - margin
-            hi[i, ax] = pos[i, ax] - min(d, 0) + size[i, ax] + margin
+            p = pos[i, ax]
+            margin = min(abs(step[i, ax]) * ((count[i, ax] + window) // period[i, ax]), cap)
+            low = p - max(d, 0) - margin
+            high = p - min(d, 0) + margin
+            fence[i, 2 * ax] = low
+            fence[i, 2 * ax + 1] = high
+            lo[i, ax] = low
+            hi[i, ax] = high + size[i, ax]
     return find(finder, lo, hi, movable, cell, order, keys, ws)
 
 
@@ -229,12 +246,14 @@ def _run(pos, size, room, step, period, count, movable, stop, log, st, bp, ev, w
     """Run stage after stage until st[_S_TICK] * _N_STAGES + st[_S_STAGE] = stop (advance: ticks
     done x _N_STAGES, a tick's end); returns _DONE, or _LOG_FULL / _KEYS_FULL when `ev` or the
     candidate buffers need more room (grow them and call again: the tick resumes at the stage it
-    stopped). st: the scalar state (see _S_*); bp = (order, anchor, keys, near, disp, lo, hi,
-    params, finder, reach) with params = [margin px, method, grid cell px] (float64) and finder the
+    stopped). st: the scalar state (see _S_*); bp = (order, fence, keys, near, disp, lo, hi,
+    params, finder, reach) with params = [window ticks, method, grid cell px, largest margin px]
+    (float64) and finder the
     method's marker (broadphase.marker: only that pair finder is compiled)."""
-    order, anchor, keys, near, disp, lo, hi, params, finder, reach = bp
-    margin = int(params[0])
+    order, fence, keys, near, disp, lo, hi, params, finder, reach = bp
     cell = params[2]
+    window = int(params[0])
+    cap = int(params[3])
     n = pos.shape[0]
     n_ev = st[_S_EVENTS]
     while st[_S_TICK] * _N_STAGES + st[_S_STAGE] < stop:
@@ -242,8 +261,8 @@ def _run(pos, size, room, step, period, count, movable, stop, log, st, bp, ev, w
         stage = st[_S_STAGE]
         if stage == _STAGE_MOVE:
             # move: counters fire, this tick's displacement is kept to be taken back
-            drift, left = _move(pos, step, period, count, disp, anchor, room)
-            st[_S_DRIFT] = drift
+            strayed, left = _move(pos, step, period, count, disp, fence, room)
+            st[_S_DRIFT] = strayed
             st[_S_LEFT] = left
         elif stage == _STAGE_WALLS:
             # walls: reverse and take back what left the world moving outward
@@ -252,24 +271,24 @@ def _run(pos, size, room, step, period, count, movable, stop, log, st, bp, ev, w
                     st[_S_EVENTS] = n_ev
                     return _LOG_FULL
                 n_ev = _walls(pos, room, step, disp, tick, log, ev, n_ev, st)
-            # the list is made anew once anything drifted a margin from where it was made
-            # (drift is measured before the walls take steps back, which only errs early)
-            st[_S_RELIST] = st[_S_KEYS] < 0 or st[_S_DRIFT] >= margin
+            # the list is made anew once an object is past its fence (checked before the walls
+            # take steps back, which only errs early)
+            st[_S_RELIST] = st[_S_KEYS] < 0 or st[_S_DRIFT]
         elif not st[_S_PAIRS]:
             pass  # no pair can happen: the pair stages do nothing
         elif stage == _STAGE_BROAD:
             # broad: the candidate list, when it is to be made anew
             if st[_S_RELIST]:
-                k = _relist(pos, size, disp, movable, margin, finder, cell, order, lo, hi, keys, ws)
+                k = _relist(
+                    pos, size, step, period, count, disp, fence, movable, window, cap, finder,
+                    cell, order, lo, hi, keys, ws,
+                )
                 if k > keys.shape[0]:
                     st[_S_NEEDED] = k
                     st[_S_EVENTS] = n_ev
                     return _KEYS_FULL
                 st[_S_KEYS] = k
                 st[_S_RELIST] = 0
-                for i in range(n):
-                    anchor[i, 0] = pos[i, 0]
-                    anchor[i, 1] = pos[i, 1]
         elif stage == _STAGE_NARROW:
             # narrow: the listed pairs whose reach boxes overlap, in (a, b) order
             st[_S_NEAR] = _near(pos, size, disp, keys, st[_S_KEYS], near, reach)
@@ -313,13 +332,13 @@ class Model:
         self._st = np.zeros(_S_SIZE, np.int64)
         self._st[_S_KEYS] = -1
         self._st[_S_PAIRS] = n >= 2 and (bool(self.movable.any()) or not skip)
-        margin = _margin(self.step)
-        method, cell = choose(world.width, world.height, self.size + 2 * margin, broadphase)
-        params = np.array([margin, method, cell], np.float64)
+        grown = self.size + 2 * _margins(self.step, self.period)
+        method, cell = choose(world.width, world.height, grown, broadphase)
+        params = np.array([_WINDOW_TICKS, method, cell, _MARGIN_MAX_PX], np.float64)
         keys = max(_INITIAL_ROWS, 2 * n)
         self._bp = (
             np.argsort(self.pos[:, 0], kind="stable").astype(np.int64),  # sweep order
-            self.pos.copy(),  # anchor
+            np.zeros((n, 4), np.int64),  # fences (made with the list)
             np.empty(keys, np.int64),  # candidate keys
             np.empty(keys, np.int64),  # near pairs
             np.zeros((n, 2), np.int64),  # this tick's displacement
@@ -420,10 +439,10 @@ def _reach_dtype(world: WorldSpec, size: np.ndarray, step: np.ndarray):
     return np.int32 if far <= REACH_INT32_MAX else np.int64
 
 
-def _margin(step: np.ndarray) -> int:
-    """The candidate list's margin in px: a few of the fastest steps, within set bounds."""
-    fastest = int(np.abs(step).max()) if step.size else 0
-    return int(min(max(_MARGIN_STEPS * fastest, _MARGIN_MIN_PX), _MARGIN_MAX_PX))
+def _margins(step: np.ndarray, period: np.ndarray) -> np.ndarray:
+    """Each object's margins (n, 2) px as a list made at a random moment would give them on
+    average (|V| x _WINDOW_TICKS / P, at most _MARGIN_MAX_PX), for choosing the broad phase."""
+    return np.minimum(np.abs(step) * _WINDOW_TICKS / period, _MARGIN_MAX_PX)
 
 
 def _whole(values: np.ndarray, what: str) -> np.ndarray:
