@@ -78,24 +78,25 @@ _INITIAL_ROWS = 1024
 # past its margin from where it was when the list was made (its *fence*). A slow object's box
 # grows little, an object that will not step in the window not at all, and one fast object makes
 # only its own box large, not everyone's.
-_WINDOW_TICKS = 8
-_MARGIN_MAX_PX = 128
+_WINDOW_TICKS = 16
+_MARGIN_MAX_PX = 32
 # Reach boxes are kept in int32 when the world, steps and sides keep them within this (px).
 REACH_INT32_MAX = 2**30
 
 # The kernel's scalar state (int64): ticks done, the stage of the next tick to run, candidates
-# listed (-1: none yet), this tick's drift (px) and whether a box left the world, whether the list
-# is to be made anew this tick, event rows written in this `advance`, the candidates a too small
-# buffer needed, whether pairs can happen at all, wall events and pair events so far (logged or
-# not), this tick's overlapping candidate pairs.
-_S_TICK, _S_STAGE, _S_KEYS, _S_DRIFT, _S_LEFT, _S_RELIST, _S_EVENTS, _S_NEEDED, _S_PAIRS = range(9)
-_S_WALLS, _S_PAIR_EVENTS, _S_NEAR = 9, 10, 11
-_S_SIZE = 12
-# The stages of a tick, in the order `_run` runs them (it can stop after any of them).
-_STAGE_MOVE, _STAGE_WALLS, _STAGE_BROAD, _STAGE_NARROW, _STAGE_RESPONSE = range(5)
-_N_STAGES = 5
+# listed (-1: none yet), whether the list is to be made anew this tick (an object is past its
+# fence), event rows written in this `advance`, the candidates a too small buffer needed, whether
+# pairs can happen at all, wall events and pair events so far (logged or not), this tick's
+# overlapping candidate pairs.
+_S_TICK, _S_STAGE, _S_KEYS, _S_RELIST, _S_EVENTS, _S_NEEDED, _S_PAIRS = range(7)
+_S_WALLS, _S_PAIR_EVENTS, _S_NEAR = 7, 8, 9
+_S_SIZE = 10
+# The stages of a tick, in the order `_run` runs them (it can stop after any of them): move takes
+# the walls too, object by object.
+_STAGE_MOVE, _STAGE_BROAD, _STAGE_NARROW, _STAGE_RESPONSE = range(4)
+_N_STAGES = 4
 # The stages `Model.profile` times, each by name with the stage it runs up to (_N_STAGES: the
-# tick's end): move and walls count as "move".
+# tick's end).
 STAGES = (
     ("move", _STAGE_BROAD),
     ("broad", _STAGE_NARROW),
@@ -113,15 +114,18 @@ _kernel = njit(cache=True, _nrt=False)
 
 
 @njit(cache=True, inline="always")
-def _move(pos, step, period, count, disp, fence, room):
-    """Counters rise by one; a component whose counter reaches its period moves by its step.
+def _move(pos, size, step, period, count, disp, fence, room, reach, tick, log, ev, n_ev, st):
+    """Move and walls, object by object, in id order (SPEC 3.1): counters rise by one and a
+    component whose counter reaches its period moves by its step; one that left the world moving
+    outward reverses and takes that step back (a wall event).
 
     room (n, 2) = world side - box side; fence (n, 4) = [x lo, x hi, y lo, y hi], the positions
-    each object may hold while the candidate list lasts. Returns (whether any object is now past
-    its fence; whether any box left the world).
+    each object may hold while the candidate list lasts; reach (n, 4) receives each object's reach
+    box, [x lo, x hi, y lo, y hi]: the hull of its box before and after this tick's step, all the
+    pair stage can put it at (so that testing a pair reads one row of each object). Returns (event
+    rows, whether any object is now past its fence).
     """
     strayed = False
-    left = False
     for i in range(pos.shape[0]):
         for ax in range(2):
             c = count[i, ax] + 1
@@ -129,32 +133,24 @@ def _move(pos, step, period, count, disp, fence, room):
             count[i, ax] = 0 if fire else c
             d = step[i, ax] if fire else 0
             p = pos[i, ax] + d
+            if ((d < 0) & (p < 0)) | ((d > 0) & (p > room[i, ax])):
+                if d < 0:
+                    side = SIDE_LEFT if ax == 0 else SIDE_TOP
+                else:
+                    side = SIDE_RIGHT if ax == 0 else SIDE_BOTTOM
+                step[i, ax] = -d
+                p -= d
+                d = 0
+                st[_S_WALLS] += 1
+                if log:
+                    n_ev = put_row(ev, n_ev, tick, EV_WALL, i, -1, side, -1, -1)
             pos[i, ax] = p
             disp[i, ax] = d
             strayed |= (p < fence[i, 2 * ax]) | (p > fence[i, 2 * ax + 1])
-            left |= (p < 0) | (p > room[i, ax])
-    return strayed, left
-
-
-@njit(cache=True, inline="always")
-def _walls(pos, room, step, disp, tick, log, ev, n_ev, st):
-    """Reverse and take back each component that left the world moving outward (SPEC 3.1)."""
-    for i in range(pos.shape[0]):
-        for ax in range(2):
-            d = disp[i, ax]
-            if d < 0 and pos[i, ax] < 0:
-                side = SIDE_LEFT if ax == 0 else SIDE_TOP
-            elif d > 0 and pos[i, ax] > room[i, ax]:
-                side = SIDE_RIGHT if ax == 0 else SIDE_BOTTOM
-            else:
-                continue
-            step[i, ax] = -step[i, ax]
-            pos[i, ax] -= d
-            disp[i, ax] = 0
-            st[_S_WALLS] += 1
-            if log:
-                n_ev = put_row(ev, n_ev, tick, EV_WALL, i, -1, side, -1, -1)
-    return n_ev
+            low = p - max(d, 0)
+            reach[i, 2 * ax] = low
+            reach[i, 2 * ax + 1] = low + abs(d) + size[i, ax]
+    return n_ev, strayed
 
 
 @njit(cache=True)
@@ -184,17 +180,9 @@ def _relist(pos, size, step, period, count, disp, fence, movable, window, cap, f
 
 
 @njit(cache=True, inline="always")
-def _near(pos, size, disp, keys, n_keys, near, reach):
-    """The listed pairs whose reach boxes overlap now, into `near` (as long as `keys`), sorted by
-    (a, b); returns how many. The reach boxes are first written side by side in one row per
-    object, reach (n, 4) = [x lo, x hi, y lo, y hi], so that testing a pair reads one row of each
-    object rather than its position, displacement and size from three arrays."""
-    for i in range(pos.shape[0]):
-        for ax in range(2):
-            d = disp[i, ax]
-            lo = pos[i, ax] - max(d, 0)
-            reach[i, 2 * ax] = lo
-            reach[i, 2 * ax + 1] = lo + abs(d) + size[i, ax]
+def _near(keys, n_keys, near, reach):
+    """The listed pairs whose reach boxes (written by `_move`) overlap now, into `near` (as long
+    as `keys`), sorted by (a, b); returns how many."""
     k = np.int64(0)  # not the literal 0, which would compile sort_keys once more for it
     for c in range(n_keys):
         a = keys[c] >> KEY_SHIFT
@@ -248,8 +236,8 @@ def _run(pos, size, room, step, period, count, movable, stop, log, st, bp, ev, w
     candidate buffers need more room (grow them and call again: the tick resumes at the stage it
     stopped). st: the scalar state (see _S_*); bp = (order, fence, keys, near, disp, lo, hi,
     params, finder, reach) with params = [window ticks, method, grid cell px, largest margin px]
-    (float64) and finder the
-    method's marker (broadphase.marker: only that pair finder is compiled)."""
+    (float64) and finder the method's marker (broadphase.marker: only that pair finder is
+    compiled)."""
     order, fence, keys, near, disp, lo, hi, params, finder, reach = bp
     cell = params[2]
     window = int(params[0])
@@ -260,20 +248,16 @@ def _run(pos, size, room, step, period, count, movable, stop, log, st, bp, ev, w
         tick = st[_S_TICK] + 1
         stage = st[_S_STAGE]
         if stage == _STAGE_MOVE:
-            # move: counters fire, this tick's displacement is kept to be taken back
-            strayed, left = _move(pos, step, period, count, disp, fence, room)
-            st[_S_DRIFT] = strayed
-            st[_S_LEFT] = left
-        elif stage == _STAGE_WALLS:
-            # walls: reverse and take back what left the world moving outward
-            if st[_S_LEFT]:
-                if log and n_ev + 2 * n > ev.shape[0]:
-                    st[_S_EVENTS] = n_ev
-                    return _LOG_FULL
-                n_ev = _walls(pos, room, step, disp, tick, log, ev, n_ev, st)
-            # the list is made anew once an object is past its fence (checked before the walls
-            # take steps back, which only errs early)
-            st[_S_RELIST] = st[_S_KEYS] < 0 or st[_S_DRIFT]
+            # move and walls: counters fire, what left the world moving outward reverses and
+            # takes its step back; the displacement kept is what a pair takes back
+            if log and n_ev + 2 * n > ev.shape[0]:
+                st[_S_EVENTS] = n_ev
+                return _LOG_FULL
+            n_ev, strayed = _move(
+                pos, size, step, period, count, disp, fence, room, reach, tick, log, ev, n_ev, st
+            )
+            # the list is made anew once an object is past its fence
+            st[_S_RELIST] = st[_S_KEYS] < 0 or strayed
         elif not st[_S_PAIRS]:
             pass  # no pair can happen: the pair stages do nothing
         elif stage == _STAGE_BROAD:
@@ -291,7 +275,7 @@ def _run(pos, size, room, step, period, count, movable, stop, log, st, bp, ev, w
                 st[_S_RELIST] = 0
         elif stage == _STAGE_NARROW:
             # narrow: the listed pairs whose reach boxes overlap, in (a, b) order
-            st[_S_NEAR] = _near(pos, size, disp, keys, st[_S_KEYS], near, reach)
+            st[_S_NEAR] = _near(keys, st[_S_KEYS], near, reach)
         else:
             # response: the rule on each of them
             if log and n_ev + st[_S_NEAR] > ev.shape[0]:
@@ -336,9 +320,10 @@ class Model:
         method, cell = choose(world.width, world.height, grown, broadphase)
         params = np.array([_WINDOW_TICKS, method, cell, _MARGIN_MAX_PX], np.float64)
         keys = max(_INITIAL_ROWS, 2 * n)
+        small = _reach_dtype(world, self.size, self.step)
         self._bp = (
             np.argsort(self.pos[:, 0], kind="stable").astype(np.int64),  # sweep order
-            np.zeros((n, 4), np.int64),  # fences (made with the list)
+            np.zeros((n, 4), small),  # fences (made with the list)
             np.empty(keys, np.int64),  # candidate keys
             np.empty(keys, np.int64),  # near pairs
             np.zeros((n, 2), np.int64),  # this tick's displacement
@@ -346,7 +331,7 @@ class Model:
             np.empty((n, 2), np.int64),
             params,
             marker(method),
-            np.empty((n, 4), _reach_dtype(world, self.size, self.step)),  # for the narrow stage
+            np.empty((n, 4), small),  # reach boxes of this tick, for the narrow stage
         )
         self._ws = workspace(n, np.int64)
 
@@ -431,10 +416,10 @@ class Model:
 
 
 def _reach_dtype(world: WorldSpec, size: np.ndarray, step: np.ndarray):
-    """int32 for the narrow stage's reach boxes when every value they can hold (a position in the
-    world, less or plus a step, plus a side) fits it with room to spare, so that they take half
-    the cache; else int64."""
-    far = max(int(world.width), int(world.height))
+    """int32 for the reach boxes and fences when every value they can hold (a position in the
+    world, less or plus a step and a margin, plus a side) fits it with room to spare, so that they
+    take half the cache; else int64."""
+    far = max(int(world.width), int(world.height)) + _MARGIN_MAX_PX
     far += 2 * (int(np.abs(step).max()) if step.size else 0) + (int(size.max()) if size.size else 0)
     return np.int32 if far <= REACH_INT32_MAX else np.int64
 
