@@ -42,6 +42,8 @@ import numpy as np
 from collide2d.engine.broadphase import (
     KEY_MASK,
     KEY_SHIFT,
+    METHOD_CELLS,
+    cell_candidates_split_into,
     choose,
     find,
     marker,
@@ -63,9 +65,10 @@ from collide2d.engine.events import (
     new_log,
     put_row,
 )
-from collide2d.engine.jit import njit
+from collide2d.engine.jit import njit, overload, prange
 from collide2d.engine.motion import paper_rate
 from collide2d.engine.sort import sort_keys
+from collide2d.engine.threads import chunks_for, join_shares
 from collide2d.engine.world import Bodies, WorldSpec
 
 # The kernel writes the event log of events.py without its times: `t` is added in Python as the
@@ -114,19 +117,22 @@ _kernel = njit(cache=True, _nrt=False)
 
 
 @njit(cache=True, inline="always")
-def _move(pos, size, step, period, count, disp, fence, room, reach, tick, log, ev, n_ev, st):
-    """Move and walls, object by object, in id order (SPEC 3.1): counters rise by one and a
-    component whose counter reaches its period moves by its step; one that left the world moving
-    outward reverses and takes that step back (a wall event).
+def _move(pos, size, step, period, count, disp, fence, room, reach, first, last, tick, log, ev,
+          n_ev):
+    """Move and walls for objects first ... last-1, object by object in id order (SPEC 3.1):
+    counters rise by one and a component whose counter reaches its period moves by its step; one
+    that left the world moving outward reverses and takes that step back (a wall event, logged
+    from row n_ev on).
 
     room (n, 2) = world side - box side; fence (n, 4) = [x lo, x hi, y lo, y hi], the positions
     each object may hold while the candidate list lasts; reach (n, 4) receives each object's reach
     box, [x lo, x hi, y lo, y hi]: the hull of its box before and after this tick's step, all the
     pair stage can put it at (so that testing a pair reads one row of each object). Returns (event
-    rows, whether any object is now past its fence).
+    rows, whether any object is now past its fence, wall events).
     """
     strayed = False
-    for i in range(pos.shape[0]):
+    walls = 0
+    for i in range(first, last):
         for ax in range(2):
             c = count[i, ax] + 1
             fire = c >= period[i, ax]
@@ -141,7 +147,7 @@ def _move(pos, size, step, period, count, disp, fence, room, reach, tick, log, e
                 step[i, ax] = -d
                 p -= d
                 d = 0
-                st[_S_WALLS] += 1
+                walls += 1
                 if log:
                     n_ev = put_row(ev, n_ev, tick, EV_WALL, i, -1, side, -1, -1)
             pos[i, ax] = p
@@ -150,12 +156,73 @@ def _move(pos, size, step, period, count, disp, fence, room, reach, tick, log, e
             low = p - max(d, 0)
             reach[i, 2 * ax] = low
             reach[i, 2 * ax + 1] = low + abs(d) + size[i, ax]
-    return n_ev, strayed
+    return n_ev, strayed, walls
+
+
+@njit(cache=True, parallel=True)
+def _move_split(pos, size, step, period, count, disp, fence, room, reach, tick, log, ev, n_ev,
+                found):
+    """`_move` with the objects cut into len(found) contiguous runs, one per thread: run c logs
+    its walls from row n_ev + 2 x its first object (an object meets at most two walls a tick),
+    then the rows are moved together in run order, as one thread writes them. Returns what
+    `_move` returns for all objects; found (chunks, 3) int64 is scratch."""
+    n = pos.shape[0]
+    chunks = found.shape[0]
+    for c in prange(chunks):
+        first = c * n // chunks
+        row = n_ev + 2 * first
+        end, strayed, walls = _move(
+            pos, size, step, period, count, disp, fence, room, reach, first,
+            (c + 1) * n // chunks, tick, log, ev, row,
+        )
+        found[c, 0] = end - row
+        found[c, 1] = strayed
+        found[c, 2] = walls
+    k = n_ev
+    strayed = False
+    walls = 0
+    for c in range(chunks):
+        row = n_ev + 2 * (c * n // chunks)
+        for r in range(found[c, 0]):
+            if k != row + r:
+                for col in range(ev.shape[1]):
+                    ev[k, col] = ev[row + r, col]
+            k += 1
+        strayed |= found[c, 1] != 0
+        walls += found[c, 2]
+    return k, strayed, walls
+
+
+def _candidates(finder, lo, hi, movable, cell, order, keys, ws, found):
+    """broadphase.find by the method the marker `finder` names, its pair tests split among
+    len(found) threads for the cells method when more than one (the same keys in the same order;
+    found is scratch). A kernel compiles only the finder its marker names (this body runs only
+    without the JIT)."""
+    if found.shape[0] > 1 and finder.dtype == marker(METHOD_CELLS).dtype:
+        return cell_candidates_split_into(lo, hi, movable, cell, order, keys, ws, found)
+    return find(finder, lo, hi, movable, cell, order, keys, ws)
+
+
+@overload(_candidates)
+def _candidates_of(finder, lo, hi, movable, cell, order, keys, ws, found):
+    if finder.dtype.bitwidth == 32:  # the cells method's marker (broadphase.marker)
+
+        def cells(finder, lo, hi, movable, cell, order, keys, ws, found):
+            if found.shape[0] > 1:
+                return cell_candidates_split_into(lo, hi, movable, cell, order, keys, ws, found)
+            return find(finder, lo, hi, movable, cell, order, keys, ws)
+
+        return cells
+
+    def one(finder, lo, hi, movable, cell, order, keys, ws, found):
+        return find(finder, lo, hi, movable, cell, order, keys, ws)
+
+    return one
 
 
 @njit(cache=True)
 def _relist(pos, size, step, period, count, disp, fence, movable, window, cap, finder, cell,
-            order, lo, hi, keys, ws):
+            order, lo, hi, keys, ws, found):
     """List the pairs whose reach boxes, each grown by its object's margin, overlap (keys
     a << KEY_SHIFT | b, a < b, in no particular order); pairs of two immovable objects are left
     out. Returns how many there are; only as many as `keys` holds are written.
@@ -176,15 +243,15 @@ def _relist(pos, size, step, period, count, disp, fence, movable, window, cap, f
             fence[i, 2 * ax + 1] = high
             lo[i, ax] = low
             hi[i, ax] = high + size[i, ax]
-    return find(finder, lo, hi, movable, cell, order, keys, ws)
+    return _candidates(finder, lo, hi, movable, cell, order, keys, ws, found)
 
 
 @njit(cache=True, inline="always")
-def _near(keys, n_keys, near, reach):
-    """The listed pairs whose reach boxes (written by `_move`) overlap now, into `near` (as long
-    as `keys`), sorted by (a, b); returns how many."""
-    k = np.int64(0)  # not the literal 0, which would compile sort_keys once more for it
-    for c in range(n_keys):
+def _near_range(keys, first, last, near, base, reach):
+    """The pairs keys[first:last] whose reach boxes (written by `_move`) overlap now, into
+    near[base:], in the order listed; returns how many."""
+    k = 0
+    for c in range(first, last):
         a = keys[c] >> KEY_SHIFT
         b = keys[c] & KEY_MASK
         meet = (
@@ -193,8 +260,33 @@ def _near(keys, n_keys, near, reach):
             & (reach[b, 2] < reach[a, 3])
             & (reach[a, 2] < reach[b, 3])
         )
-        near[k] = keys[c]
+        near[base + k] = keys[c]
         k += meet
+    return k
+
+
+@njit(cache=True, inline="always")
+def _near(keys, n_keys, near, reach):
+    """The listed pairs whose reach boxes overlap now, into `near` (as long as `keys`), sorted by
+    (a, b); returns how many."""
+    k = np.int64(_near_range(keys, 0, n_keys, near, 0, reach))  # np.int64: one sort_keys
+    sort_keys(near, k)
+    return k
+
+
+@njit(cache=True, parallel=True)
+def _near_split(keys, n_keys, near, reach, found):
+    """`_near` with the listed pairs cut into len(found) contiguous runs, one per thread, each
+    into its own share of `near` (at least n_keys + len(found) long); the shares are moved
+    together and sorted, the same pairs in the same order as `_near`. found (chunks,) int64 is
+    scratch."""
+    chunks = found.shape[0]
+    share = (n_keys + chunks - 1) // chunks
+    for c in prange(chunks):
+        found[c] = _near_range(
+            keys, c * n_keys // chunks, (c + 1) * n_keys // chunks, near, c * share, reach
+        )
+    k = join_shares(found, share, near)
     sort_keys(near, k)
     return k
 
@@ -235,13 +327,15 @@ def _run(pos, size, room, step, period, count, movable, stop, log, st, bp, ev, w
     done x _N_STAGES, a tick's end); returns _DONE, or _LOG_FULL / _KEYS_FULL when `ev` or the
     candidate buffers need more room (grow them and call again: the tick resumes at the stage it
     stopped). st: the scalar state (see _S_*); bp = (order, fence, keys, near, disp, lo, hi,
-    params, finder, reach) with params = [window ticks, method, grid cell px, largest margin px]
-    (float64) and finder the method's marker (broadphase.marker: only that pair finder is
-    compiled)."""
-    order, fence, keys, near, disp, lo, hi, params, finder, reach = bp
+    params, found, finder, reach) with params = [window ticks, method, grid cell px, largest
+    margin px, chunks] (float64; chunks: threads.chunks_for, 1 for no split), found (chunks, 3)
+    the split stages' scratch and finder the method's marker (broadphase.marker: only that pair
+    finder is compiled)."""
+    order, fence, keys, near, disp, lo, hi, params, found, finder, reach = bp
     cell = params[2]
     window = int(params[0])
     cap = int(params[3])
+    chunks = int(params[4])
     n = pos.shape[0]
     n_ev = st[_S_EVENTS]
     while st[_S_TICK] * _N_STAGES + st[_S_STAGE] < stop:
@@ -253,9 +347,17 @@ def _run(pos, size, room, step, period, count, movable, stop, log, st, bp, ev, w
             if log and n_ev + 2 * n > ev.shape[0]:
                 st[_S_EVENTS] = n_ev
                 return _LOG_FULL
-            n_ev, strayed = _move(
-                pos, size, step, period, count, disp, fence, room, reach, tick, log, ev, n_ev, st
-            )
+            if chunks > 1:
+                n_ev, strayed, walls = _move_split(
+                    pos, size, step, period, count, disp, fence, room, reach, tick, log, ev,
+                    n_ev, found,
+                )
+            else:
+                n_ev, strayed, walls = _move(
+                    pos, size, step, period, count, disp, fence, room, reach, 0, n, tick, log,
+                    ev, n_ev,
+                )
+            st[_S_WALLS] += walls
             # the list is made anew once an object is past its fence
             st[_S_RELIST] = st[_S_KEYS] < 0 or strayed
         elif not st[_S_PAIRS]:
@@ -265,7 +367,7 @@ def _run(pos, size, room, step, period, count, movable, stop, log, st, bp, ev, w
             if st[_S_RELIST]:
                 k = _relist(
                     pos, size, step, period, count, disp, fence, movable, window, cap, finder,
-                    cell, order, lo, hi, keys, ws,
+                    cell, order, lo, hi, keys, ws, found[:, 0],
                 )
                 if k > keys.shape[0]:
                     st[_S_NEEDED] = k
@@ -275,7 +377,10 @@ def _run(pos, size, room, step, period, count, movable, stop, log, st, bp, ev, w
                 st[_S_RELIST] = 0
         elif stage == _STAGE_NARROW:
             # narrow: the listed pairs whose reach boxes overlap, in (a, b) order
-            st[_S_NEAR] = _near(keys, st[_S_KEYS], near, reach)
+            if chunks > 1:
+                st[_S_NEAR] = _near_split(keys, st[_S_KEYS], near, reach, found[:, 0])
+            else:
+                st[_S_NEAR] = _near(keys, st[_S_KEYS], near, reach)
         else:
             # response: the rule on each of them
             if log and n_ev + st[_S_NEAR] > ev.shape[0]:
@@ -318,18 +423,20 @@ class Model:
         self._st[_S_PAIRS] = n >= 2 and (bool(self.movable.any()) or not skip)
         grown = self.size + 2 * _margins(self.step, self.period)
         method, cell = choose(world.width, world.height, grown, broadphase)
-        params = np.array([_WINDOW_TICKS, method, cell, _MARGIN_MAX_PX], np.float64)
+        chunks = chunks_for(n)
+        params = np.array([_WINDOW_TICKS, method, cell, _MARGIN_MAX_PX, chunks], np.float64)
         keys = max(_INITIAL_ROWS, 2 * n)
         small = _reach_dtype(world, self.size, self.step)
         self._bp = (
             np.argsort(self.pos[:, 0], kind="stable").astype(np.int64),  # sweep order
             np.zeros((n, 4), small),  # fences (made with the list)
             np.empty(keys, np.int64),  # candidate keys
-            np.empty(keys, np.int64),  # near pairs
+            np.empty(keys + chunks, np.int64),  # near pairs (room for each thread's share)
             np.zeros((n, 2), np.int64),  # this tick's displacement
             np.empty((n, 2), np.int64),  # reach boxes
             np.empty((n, 2), np.int64),
             params,
+            np.zeros((chunks, 3), np.int64),  # what each thread of a split stage found
             marker(method),
             np.empty((n, 4), small),  # reach boxes of this tick, for the narrow stage
         )
@@ -400,9 +507,10 @@ class Model:
                 self._ev = grown(self._ev, 2 * self.pos.shape[0])
             else:
                 rows = 2 * int(self._st[_S_NEEDED])
+                chunks = int(self._bp[7][4])
                 self._bp = (
                     self._bp[:2]
-                    + (np.empty(rows, np.int64), np.empty(rows, np.int64))
+                    + (np.empty(rows, np.int64), np.empty(rows + chunks, np.int64))
                     + self._bp[4:]
                 )
         self.tick = int(self._st[_S_TICK])
