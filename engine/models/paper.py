@@ -236,7 +236,8 @@ def _relist(pos, size, step, period, count, disp, fence, movable, window, cap, f
         for ax in range(2):
             d = disp[i, ax]
             p = pos[i, ax]
-            margin = min(abs(step[i, ax]) * ((count[i, ax] + window) // period[i, ax]), cap)
+            fires = (count[i, ax] + window) // period[i, ax]
+            margin = min(min(abs(step[i, ax]), cap) * fires, cap)  # no product past int32
             low = p - max(d, 0) - margin
             high = p - min(d, 0) + margin
             fence[i, 2 * ax] = low
@@ -409,14 +410,20 @@ class Model:
         self.world = world
         self.fps = int(world.fps)
         self.tick = 0
-        self.pos = _whole(bodies.pos, "positions")
-        self.size = _whole(bodies.size, "sizes")
-        self.step, self.period = _rates(bodies.vel, self.fps)
+        pos = _whole(bodies.pos, "positions")
+        size = _whole(bodies.size, "sizes")
+        step, period = _rates(bodies.vel, self.fps)
+        # the state in int32 when the world allows (half the memory each tick streams through)
+        small = _reach_dtype(world, size, step)
+        if pos.size and int(np.abs(pos).max()) > REACH_INT32_MAX // 2:
+            small = np.int64  # objects placed far outside the world
+        self.pos, self.size, self.step = pos.astype(small), size.astype(small), step.astype(small)
+        self.period = period.astype(small)
         self.count = np.zeros_like(self.step)
         n = self.pos.shape[0]
         self.movable = ~np.asarray(bodies.static, bool) if skip else np.ones(n, bool)
         limit = np.array([world.width, world.height], np.int64)
-        self._room = np.ascontiguousarray(limit - self.size)
+        self._room = np.ascontiguousarray(limit - size).astype(small)
         self._ev = new_log(True, _INITIAL_ROWS)[0]
         self._st = np.zeros(_S_SIZE, np.int64)
         self._st[_S_KEYS] = -1
@@ -426,13 +433,12 @@ class Model:
         chunks = chunks_for(n)
         params = np.array([_WINDOW_TICKS, method, cell, _MARGIN_MAX_PX, chunks], np.float64)
         keys = max(_INITIAL_ROWS, 2 * n)
-        small = _reach_dtype(world, self.size, self.step)
         self._bp = (
             np.argsort(self.pos[:, 0], kind="stable").astype(np.int64),  # sweep order
             np.zeros((n, 4), small),  # fences (made with the list)
             np.empty(keys, np.int64),  # candidate keys
             np.empty(keys + chunks, np.int64),  # near pairs (room for each thread's share)
-            np.zeros((n, 2), np.int64),  # this tick's displacement
+            np.zeros((n, 2), small),  # this tick's displacement
             np.empty((n, 2), np.int64),  # reach boxes
             np.empty((n, 2), np.int64),
             params,
@@ -524,9 +530,9 @@ class Model:
 
 
 def _reach_dtype(world: WorldSpec, size: np.ndarray, step: np.ndarray):
-    """int32 for the reach boxes and fences when every value they can hold (a position in the
-    world, less or plus a step and a margin, plus a side) fits it with room to spare, so that they
-    take half the cache; else int64."""
+    """int32 for the state, reach boxes and fences when every value they can hold (a position in
+    the world, less or plus a step and a margin, plus a side; a period) fits it with room to
+    spare, so that they take half the cache; else int64."""
     far = max(int(world.width), int(world.height)) + _MARGIN_MAX_PX
     far += 2 * (int(np.abs(step).max()) if step.size else 0) + (int(size.max()) if size.size else 0)
     return np.int32 if far <= REACH_INT32_MAX else np.int64
