@@ -83,6 +83,12 @@ _INITIAL_ROWS = 1024
 # only its own box large, not everyone's.
 _WINDOW_TICKS = 16
 _MARGIN_MAX_PX = 32
+# A step longer than _MARGIN_MAX_PX takes its object past its fence, so the list is made anew at
+# every tick such a step fires. Counters all start at 0 and only ever count ticks, so those ticks
+# are known (the multiples of those steps' periods): when the next one is at most
+# _WINDOW_MAX_TICKS ticks away, the window reaches just up to it instead, which saves making the
+# list once more shortly before it.
+_WINDOW_MAX_TICKS = 24
 # Reach boxes are kept in int32 when the world, steps and sides keep them within this (px).
 REACH_INT32_MAX = 2**30
 
@@ -248,6 +254,18 @@ def _relist(pos, size, step, period, count, disp, fence, movable, window, cap, f
 
 
 @njit(cache=True, inline="always")
+def _window(tick, forced, window, longest):
+    """The window (ticks) of a list made at `tick`: up to the tick before the next at which a step
+    of one of the periods `forced` fires (the multiples of each), when that is at most `longest`
+    ticks on, else `window`."""
+    ahead = longest + 1
+    for p in range(forced.shape[0]):
+        every = forced[p]
+        ahead = min(ahead, (tick // every + 1) * every - tick - 1)
+    return ahead if ahead <= longest else window
+
+
+@njit(cache=True, inline="always")
 def _near_range(keys, first, last, near, base, reach):
     """The pairs keys[first:last] whose reach boxes (written by `_move`) overlap now, into
     near[base:], in the order listed; returns how many."""
@@ -328,15 +346,17 @@ def _run(pos, size, room, step, period, count, movable, stop, log, st, bp, ev, w
     done x _N_STAGES, a tick's end); returns _DONE, or _LOG_FULL / _KEYS_FULL when `ev` or the
     candidate buffers need more room (grow them and call again: the tick resumes at the stage it
     stopped). st: the scalar state (see _S_*); bp = (order, fence, keys, near, disp, lo, hi,
-    params, found, finder, reach) with params = [window ticks, method, grid cell px, largest
-    margin px, chunks] (float64; chunks: threads.chunks_for, 1 for no split), found (chunks, 3)
-    the split stages' scratch and finder the method's marker (broadphase.marker: only that pair
-    finder is compiled)."""
-    order, fence, keys, near, disp, lo, hi, params, found, finder, reach = bp
+    params, found, forced, finder, reach) with params = [window ticks, method, grid cell px,
+    largest margin px, chunks, longest window ticks] (float64; chunks: threads.chunks_for, 1 for
+    no split), found (chunks, 3) the split stages' scratch, forced the periods of the steps
+    longer than the largest margin (see _WINDOW_MAX_TICKS) and finder the method's marker
+    (broadphase.marker: only that pair finder is compiled)."""
+    order, fence, keys, near, disp, lo, hi, params, found, forced, finder, reach = bp
     cell = params[2]
     window = int(params[0])
     cap = int(params[3])
     chunks = int(params[4])
+    longest = int(params[5])
     n = pos.shape[0]
     n_ev = st[_S_EVENTS]
     while st[_S_TICK] * _N_STAGES + st[_S_STAGE] < stop:
@@ -367,8 +387,9 @@ def _run(pos, size, room, step, period, count, movable, stop, log, st, bp, ev, w
             # broad: the candidate list, when it is to be made anew
             if st[_S_RELIST]:
                 k = _relist(
-                    pos, size, step, period, count, disp, fence, movable, window, cap, finder,
-                    cell, order, lo, hi, keys, ws, found[:, 0],
+                    pos, size, step, period, count, disp, fence, movable,
+                    _window(tick, forced, window, longest), cap, finder, cell, order, lo, hi,
+                    keys, ws, found[:, 0],
                 )
                 if k > keys.shape[0]:
                     st[_S_NEEDED] = k
@@ -431,7 +452,10 @@ class Model:
         grown = self.size + 2 * _margins(self.step, self.period)
         method, cell = choose(world.width, world.height, grown, broadphase)
         chunks = chunks_for(n)
-        params = np.array([_WINDOW_TICKS, method, cell, _MARGIN_MAX_PX, chunks], np.float64)
+        params = np.array(
+            [_WINDOW_TICKS, method, cell, _MARGIN_MAX_PX, chunks, _WINDOW_MAX_TICKS], np.float64
+        )
+        long_steps = np.abs(self.step) > _MARGIN_MAX_PX
         keys = max(_INITIAL_ROWS, 2 * n)
         self._bp = (
             np.argsort(self.pos[:, 0], kind="stable").astype(np.int64),  # sweep order
@@ -443,6 +467,7 @@ class Model:
             np.empty((n, 2), np.int64),
             params,
             np.zeros((chunks, 3), np.int64),  # what each thread of a split stage found
+            np.unique(period[long_steps]).astype(np.int64),  # periods of the long steps
             marker(method),
             np.empty((n, 4), small),  # reach boxes of this tick, for the narrow stage
         )
