@@ -19,18 +19,26 @@ Broad phase without changing the rule: during the pair stage each coordinate of 
 where it was before the tick or where it moved to (taking back is the only change), so two objects
 can overlap at some point of the stage only if their *reach boxes* — the hull of both positions —
 overlap. The broad phase (broadphase.py: sort-and-sweep or a grid, chosen by the scene) lists the
-pairs whose reach boxes, grown by a margin, overlap, and the list is kept until some object has
-drifted that margin from where it was when the list was made (every position held since then lies
-in the grown box). Each tick then keeps the listed pairs whose reach boxes overlap now, sorts those
-few by (a, b) and applies the rule to them in that order, testing each on the current positions:
-exactly the all-pairs loop of the paper. Pairs of two static objects are never listed, and with no
-movable object the pair stage is skipped (`skip=False` turns both skips off; `broadphase`,
-"sweep", "grid" or "cells", forces a method instead of the scene's choice).
+pairs whose reach boxes, each grown by its object's own margin, overlap. An object's margin on an
+axis is how far its counter can carry it in the next few ticks (|V| x the steps it fires in them:
+a pair or a wall only reverses a step or takes it back), at most _MARGIN_MAX_PX, so a slow object's
+box grows little and one that will not step in that window not at all; the range of positions its
+grown box allows is its *fence*. The list is kept until some object is past its fence (every
+position held since then lies in its grown box), and only then made anew, whole. Each tick then
+keeps the listed pairs whose reach boxes overlap now, sorts those few by (a, b) and applies the
+rule to them in that order, testing each on the current positions: exactly the all-pairs loop of
+the paper. Pairs of two static objects are never listed, and with no movable object the pair stage
+is skipped (`skip=False` turns both skips off; `broadphase`, "sweep", "grid" or "cells", forces a
+method instead of the scene's choice).
 
 The tick loop is one numba kernel run without reference counting (it allocates nothing); when the
 event log or the candidate list needs more room it stops at a stage boundary, the buffer grows in
 Python, and the next call resumes the same tick where it stopped. `Model.profile` runs the same
-kernel one stage at a time (STAGES) to time each.
+kernel one stage at a time (STAGES) to time each. For scenes of threads.PARALLEL_MIN_OBJECTS
+objects or more the move stage (with the walls), the pair tests of the cells broad phase and the
+narrow stage split their work among threads in fixed contiguous chunks joined in chunk order (the
+wall events in id order, the near pairs sorted), so any thread count gives the same bytes. The
+state is int32 when the world allows it (half the memory each tick streams through).
 """
 
 from __future__ import annotations
@@ -498,11 +506,11 @@ class Model:
 
     def profile(self, ticks: int) -> dict[str, float]:
         """Run `ticks` ticks with the event log off, one stage of `_run` at a time, and return the
-        seconds spent in each (STAGES): "move" (counters and walls), "broad" (making the candidate
-        list), "narrow" (keeping the listed pairs whose reach boxes overlap), "response" (the flip
-        rule). The state ends exactly as `advance(ticks, log=False)` would leave it. Each stage is
-        timed from Python, so each count includes a call's overhead (microseconds), which
-        dominates in small scenes."""
+        seconds spent in each (STAGES): "move" (counters, walls, reach boxes), "broad" (making
+        the candidate list), "narrow" (keeping the listed pairs whose reach boxes overlap),
+        "response" (the flip rule). The state ends exactly as `advance(ticks, log=False)` would
+        leave it. Each stage is timed from Python, so each count includes a call's overhead
+        (microseconds), which dominates in small scenes."""
         spent = {name: 0.0 for name, _ in STAGES}
         clock = time.perf_counter
         for _ in range(int(ticks)):
