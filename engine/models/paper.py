@@ -131,18 +131,15 @@ _kernel = njit(cache=True, _nrt=False)
 
 
 @njit(cache=True, inline="always")
-def _move(pos, size, step, period, count, disp, fence, room, reach, first, last, tick, log, ev,
-          n_ev):
+def _move(pos, step, period, count, disp, fence, room, first, last, tick, log, ev, n_ev):
     """Move and walls for objects first ... last-1, object by object in id order (SPEC 3.1):
     counters rise by one and a component whose counter reaches its period moves by its step; one
     that left the world moving outward reverses and takes that step back (a wall event, logged
     from row n_ev on).
 
     room (n, 2) = world side - box side; fence (n, 4) = [x lo, x hi, y lo, y hi], the positions
-    each object may hold while the candidate list lasts; reach (n, 4) receives each object's reach
-    box, [x lo, x hi, y lo, y hi]: the hull of its box before and after this tick's step, all the
-    pair stage can put it at (so that testing a pair reads one row of each object). Returns (event
-    rows, whether any object is now past its fence, wall events).
+    each object may hold while the candidate list lasts. Returns (event rows, whether any object is
+    now past its fence, wall events).
     """
     strayed = False
     walls = 0
@@ -167,15 +164,11 @@ def _move(pos, size, step, period, count, disp, fence, room, reach, first, last,
             pos[i, ax] = p
             disp[i, ax] = d
             strayed |= (p < fence[i, 2 * ax]) | (p > fence[i, 2 * ax + 1])
-            low = p - max(d, 0)
-            reach[i, 2 * ax] = low
-            reach[i, 2 * ax + 1] = low + abs(d) + size[i, ax]
     return n_ev, strayed, walls
 
 
 @njit(cache=True, parallel=True)
-def _move_split(pos, size, step, period, count, disp, fence, room, reach, tick, log, ev, n_ev,
-                found):
+def _move_split(pos, step, period, count, disp, fence, room, tick, log, ev, n_ev, found):
     """`_move` with the objects cut into len(found) contiguous runs, one per thread: run c logs
     its walls from row n_ev + 2 x its first object (an object meets at most two walls a tick),
     then the rows are moved together in run order, as one thread writes them. Returns what
@@ -186,8 +179,8 @@ def _move_split(pos, size, step, period, count, disp, fence, room, reach, tick, 
         first = c * n // chunks
         row = n_ev + 2 * first
         end, strayed, walls = _move(
-            pos, size, step, period, count, disp, fence, room, reach, first,
-            (c + 1) * n // chunks, tick, log, ev, row,
+            pos, step, period, count, disp, fence, room, first, (c + 1) * n // chunks, tick, log,
+            ev, row,
         )
         found[c, 0] = end - row
         found[c, 1] = strayed
@@ -274,9 +267,23 @@ def _window(tick, forced, window, longest):
 
 
 @njit(cache=True, inline="always")
+def _reach(pos, size, disp, reach, first, last):
+    """The reach boxes of objects first ... last-1 into reach (n, 4) = [x lo, x hi, y lo, y hi]:
+    the hull of each box before and after this tick's step, all the pair stage can put it at,
+    side by side in one row per object, so that testing a pair reads one row of each object
+    rather than its position, displacement and size from three arrays."""
+    for i in range(first, last):
+        for ax in range(2):
+            d = disp[i, ax]
+            low = pos[i, ax] - max(d, 0)
+            reach[i, 2 * ax] = low
+            reach[i, 2 * ax + 1] = low + abs(d) + size[i, ax]
+
+
+@njit(cache=True, inline="always")
 def _near_range(keys, first, last, near, base, reach):
-    """The pairs keys[first:last] whose reach boxes (written by `_move`) overlap now, into
-    near[base:], in the order listed; returns how many."""
+    """The pairs keys[first:last] whose reach boxes overlap, into near[base:], in the order
+    listed; returns how many."""
     k = 0
     for c in range(first, last):
         a = keys[c] >> KEY_SHIFT
@@ -293,21 +300,25 @@ def _near_range(keys, first, last, near, base, reach):
 
 
 @njit(cache=True, inline="always")
-def _near(keys, n_keys, near, reach):
+def _near(pos, size, disp, keys, n_keys, near, reach):
     """The listed pairs whose reach boxes overlap now, into `near` (as long as `keys`), sorted by
-    (a, b); returns how many."""
+    (a, b); returns how many. reach (n, 4) receives the reach boxes (`_reach`)."""
+    _reach(pos, size, disp, reach, 0, pos.shape[0])
     k = np.int64(_near_range(keys, 0, n_keys, near, 0, reach))  # np.int64: one sort_keys
     sort_keys(near, k)
     return k
 
 
 @njit(cache=True, parallel=True)
-def _near_split(keys, n_keys, near, reach, found):
-    """`_near` with the listed pairs cut into len(found) contiguous runs, one per thread, each
-    into its own share of `near` (at least n_keys + len(found) long); the shares are moved
-    together and sorted, the same pairs in the same order as `_near`. found (chunks,) int64 is
-    scratch."""
+def _near_split(pos, size, disp, keys, n_keys, near, reach, found):
+    """`_near` with the objects, then the listed pairs, cut into len(found) contiguous runs, one
+    per thread, each pair run into its own share of `near` (at least n_keys + len(found) long);
+    the shares are moved together and sorted, the same pairs in the same order as `_near`.
+    found (chunks,) int64 is scratch."""
     chunks = found.shape[0]
+    n = pos.shape[0]
+    for c in prange(chunks):
+        _reach(pos, size, disp, reach, c * n // chunks, (c + 1) * n // chunks)
     share = (n_keys + chunks - 1) // chunks
     for c in prange(chunks):
         found[c] = _near_range(
@@ -378,13 +389,11 @@ def _run(pos, size, room, step, period, count, movable, stop, log, st, bp, ev, w
                 return _LOG_FULL
             if chunks > 1:
                 n_ev, strayed, walls = _move_split(
-                    pos, size, step, period, count, disp, fence, room, reach, tick, log, ev,
-                    n_ev, found,
+                    pos, step, period, count, disp, fence, room, tick, log, ev, n_ev, found
                 )
             else:
                 n_ev, strayed, walls = _move(
-                    pos, size, step, period, count, disp, fence, room, reach, 0, n, tick, log,
-                    ev, n_ev,
+                    pos, step, period, count, disp, fence, room, 0, n, tick, log, ev, n_ev
                 )
             st[_S_WALLS] += walls
             # the list is made anew once an object is past its fence
@@ -408,9 +417,11 @@ def _run(pos, size, room, step, period, count, movable, stop, log, st, bp, ev, w
         elif stage == _STAGE_NARROW:
             # narrow: the listed pairs whose reach boxes overlap, in (a, b) order
             if chunks > 1:
-                st[_S_NEAR] = _near_split(keys, st[_S_KEYS], near, reach, found[:, 0])
+                st[_S_NEAR] = _near_split(
+                    pos, size, disp, keys, st[_S_KEYS], near, reach, found[:, 0]
+                )
             else:
-                st[_S_NEAR] = _near(keys, st[_S_KEYS], near, reach)
+                st[_S_NEAR] = _near(pos, size, disp, keys, st[_S_KEYS], near, reach)
         else:
             # response: the rule on each of them
             if log and n_ev + st[_S_NEAR] > ev.shape[0]:
@@ -506,7 +517,7 @@ class Model:
 
     def profile(self, ticks: int) -> dict[str, float]:
         """Run `ticks` ticks with the event log off, one stage of `_run` at a time, and return the
-        seconds spent in each (STAGES): "move" (counters, walls, reach boxes), "broad" (making
+        seconds spent in each (STAGES): "move" (counters and walls), "broad" (making
         the candidate list), "narrow" (keeping the listed pairs whose reach boxes overlap),
         "response" (the flip rule). The state ends exactly as `advance(ticks, log=False)` would
         leave it. Each stage is timed from Python, so each count includes a call's overhead
