@@ -168,11 +168,14 @@ def _move(pos, step, period, count, disp, fence, room, first, last, tick, log, e
 
 
 @njit(cache=True, parallel=True)
-def _move_split(pos, step, period, count, disp, fence, room, tick, log, ev, n_ev, found):
+def _move_split(pos, size, step, period, count, disp, fence, room, reach, tick, log, ev, n_ev,
+                found):
     """`_move` with the objects cut into len(found) contiguous runs, one per thread: run c logs
     its walls from row n_ev + 2 x its first object (an object meets at most two walls a tick),
-    then the rows are moved together in run order, as one thread writes them. Returns what
-    `_move` returns for all objects; found (chunks, 3) int64 is scratch."""
+    then the rows are moved together in run order, as one thread writes them. Each run also
+    writes its objects' reach boxes (`_reach`) for the narrow stage, so that the threads start
+    once less a tick. Returns what `_move` returns for all objects; found (chunks, 3) int64 is
+    scratch."""
     n = pos.shape[0]
     chunks = found.shape[0]
     for c in prange(chunks):
@@ -182,6 +185,7 @@ def _move_split(pos, step, period, count, disp, fence, room, tick, log, ev, n_ev
             pos, step, period, count, disp, fence, room, first, (c + 1) * n // chunks, tick, log,
             ev, row,
         )
+        _reach(pos, size, disp, reach, first, (c + 1) * n // chunks)
         found[c, 0] = end - row
         found[c, 1] = strayed
         found[c, 2] = walls
@@ -310,15 +314,12 @@ def _near(pos, size, disp, keys, n_keys, near, reach):
 
 
 @njit(cache=True, parallel=True)
-def _near_split(pos, size, disp, keys, n_keys, near, reach, found):
-    """`_near` with the objects, then the listed pairs, cut into len(found) contiguous runs, one
-    per thread, each pair run into its own share of `near` (at least n_keys + len(found) long);
-    the shares are moved together and sorted, the same pairs in the same order as `_near`.
-    found (chunks,) int64 is scratch."""
+def _near_split(keys, n_keys, near, reach, found):
+    """`_near` on the reach boxes `_move_split` wrote, with the listed pairs cut into len(found)
+    contiguous runs, one per thread, each into its own share of `near` (at least n_keys +
+    len(found) long); the shares are moved together and sorted, the same pairs in the same order
+    as `_near`. found (chunks,) int64 is scratch."""
     chunks = found.shape[0]
-    n = pos.shape[0]
-    for c in prange(chunks):
-        _reach(pos, size, disp, reach, c * n // chunks, (c + 1) * n // chunks)
     share = (n_keys + chunks - 1) // chunks
     for c in prange(chunks):
         found[c] = _near_range(
@@ -389,7 +390,8 @@ def _run(pos, size, room, step, period, count, movable, stop, log, st, bp, ev, w
                 return _LOG_FULL
             if chunks > 1:
                 n_ev, strayed, walls = _move_split(
-                    pos, step, period, count, disp, fence, room, tick, log, ev, n_ev, found
+                    pos, size, step, period, count, disp, fence, room, reach, tick, log, ev,
+                    n_ev, found,
                 )
             else:
                 n_ev, strayed, walls = _move(
@@ -417,9 +419,7 @@ def _run(pos, size, room, step, period, count, movable, stop, log, st, bp, ev, w
         elif stage == _STAGE_NARROW:
             # narrow: the listed pairs whose reach boxes overlap, in (a, b) order
             if chunks > 1:
-                st[_S_NEAR] = _near_split(
-                    pos, size, disp, keys, st[_S_KEYS], near, reach, found[:, 0]
-                )
+                st[_S_NEAR] = _near_split(keys, st[_S_KEYS], near, reach, found[:, 0])
             else:
                 st[_S_NEAR] = _near(pos, size, disp, keys, st[_S_KEYS], near, reach)
         else:
