@@ -97,7 +97,8 @@ _MARGIN_MAX_PX = 32
 # _WINDOW_MAX_TICKS ticks away, the window reaches just up to it instead, which saves making the
 # list once more shortly before it.
 _WINDOW_MAX_TICKS = 24
-# Reach boxes are kept in int32 when the world, steps and sides keep them within this (px).
+# The state, reach boxes and fences are kept in int32 when the world, steps, margins and sides keep
+# them within this (px).
 REACH_INT32_MAX = 2**30
 
 # The kernel's scalar state (int64): ticks done, the stage of the next tick to run, candidates
@@ -238,9 +239,9 @@ def _relist(pos, size, step, period, count, disp, fence, movable, window, cap, f
     a << KEY_SHIFT | b, a < b, in no particular order); pairs of two immovable objects are left
     out. Returns how many there are; only as many as `keys` holds are written.
 
-    An object's margin on an axis is how far its counter can move it in the next _WINDOW_TICKS
-    ticks, |V| x the steps it fires in them (a pair or a wall only reverses or takes a step back),
-    at most _MARGIN_MAX_PX, from either end of this tick's step (the pair stage may take it
+    An object's margin on an axis is how far its counter can move it in the next `window` ticks
+    (`_window`), |V| x the steps it fires in them (a pair or a wall only reverses or takes a step
+    back), at most `cap` px, from either end of this tick's step (the pair stage may take it
     back); its fence is that range of positions. While every object stays within its fence, every
     box it holds lies in its grown reach box, so every pair that can overlap is listed."""
     for i in range(pos.shape[0]):
