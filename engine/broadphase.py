@@ -351,14 +351,14 @@ def _cell_pairs(s0, s1, order, key, start, box, movable, nx, ny, out, base, room
 
 
 @njit(cache=True, parallel=True)
-def _cell_pairs_split(order, key, start, box, movable, nx, ny, out, n, chunks):
-    """`_cell_pairs` over all n slots cut into `chunks` contiguous runs, one per thread, each
+def _cell_pairs_split(order, key, start, box, movable, nx, ny, out, n, found):
+    """`_cell_pairs` over all n slots cut into len(found) contiguous runs, one per thread, each
     writing into its own share of `out`; the shares are then moved together in run order, so the
     keys come in the order one thread gives. When a share is too small the count returned is
-    more than `out` holds (the caller grows it and asks again)."""
+    more than `out` holds (the caller grows it and asks again). found (chunks,) int64: scratch."""
+    chunks = found.shape[0]
     room = out.shape[0]
     share = room // chunks
-    found = np.zeros(chunks, np.int64)
     for c in prange(chunks):
         found[c] = _cell_pairs(
             c * n // chunks, (c + 1) * n // chunks, order, key, start, box, movable, nx, ny,
@@ -374,13 +374,22 @@ def _cell_pairs_split(order, key, start, box, movable, nx, ny, out, n, chunks):
 def cell_candidates_split(lo, hi, movable, cell, order, out, ws, chunks):
     """`cell_candidates` with its pair tests split among `chunks` threads: the same keys in the
     same order (or, when `out` is too small for a share, a count past its size)."""
+    return cell_candidates_split_into(
+        lo, hi, movable, cell, order, out, ws, np.zeros(chunks, np.int64)
+    )
+
+
+@njit(cache=True)
+def cell_candidates_split_into(lo, hi, movable, cell, order, out, ws, found):
+    """`cell_candidates_split` among len(found) threads with `found` (chunks,) int64 as its
+    scratch, allocating nothing (for kernels compiled without reference counting)."""
     n = lo.shape[0]
     for i in range(n):
         order[i] = i
     if n < 2:
         return 0
     nx, ny = _cell_grid(lo, hi, cell, order, ws)
-    return _cell_pairs_split(order, ws[2], ws[3], ws[4], movable, nx, ny, out, n, chunks)
+    return _cell_pairs_split(order, ws[2], ws[3], ws[4], movable, nx, ny, out, n, found)
 
 
 

@@ -19,18 +19,26 @@ Broad phase without changing the rule: during the pair stage each coordinate of 
 where it was before the tick or where it moved to (taking back is the only change), so two objects
 can overlap at some point of the stage only if their *reach boxes* — the hull of both positions —
 overlap. The broad phase (broadphase.py: sort-and-sweep or a grid, chosen by the scene) lists the
-pairs whose reach boxes, grown by a margin, overlap, and the list is kept until some object has
-drifted that margin from where it was when the list was made (every position held since then lies
-in the grown box). Each tick then keeps the listed pairs whose reach boxes overlap now, sorts those
-few by (a, b) and applies the rule to them in that order, testing each on the current positions:
-exactly the all-pairs loop of the paper. Pairs of two static objects are never listed, and with no
-movable object the pair stage is skipped (`skip=False` turns both skips off; `broadphase`,
-"sweep", "grid" or "cells", forces a method instead of the scene's choice).
+pairs whose reach boxes, each grown by its object's own margin, overlap. An object's margin on an
+axis is how far its counter can carry it in the next few ticks (|V| x the steps it fires in them:
+a pair or a wall only reverses a step or takes it back), at most _MARGIN_MAX_PX, so a slow object's
+box grows little and one that will not step in that window not at all; the range of positions its
+grown box allows is its *fence*. The list is kept until some object is past its fence (every
+position held since then lies in its grown box), and only then made anew, whole. Each tick then
+keeps the listed pairs whose reach boxes overlap now, sorts those few by (a, b) and applies the
+rule to them in that order, testing each on the current positions: exactly the all-pairs loop of
+the paper. Pairs of two static objects are never listed, and with no movable object the pair stage
+is skipped (`skip=False` turns both skips off; `broadphase`, "sweep", "grid" or "cells", forces a
+method instead of the scene's choice).
 
 The tick loop is one numba kernel run without reference counting (it allocates nothing); when the
 event log or the candidate list needs more room it stops at a stage boundary, the buffer grows in
 Python, and the next call resumes the same tick where it stopped. `Model.profile` runs the same
-kernel one stage at a time (STAGES) to time each.
+kernel one stage at a time (STAGES) to time each. For scenes of threads.PARALLEL_MIN_OBJECTS
+objects or more the move stage (with the walls), the pair tests of the cells broad phase and the
+narrow stage split their work among threads in fixed contiguous chunks joined in chunk order (the
+wall events in id order, the near pairs sorted), so any thread count gives the same bytes. The
+state is int32 when the world allows it (half the memory each tick streams through).
 """
 
 from __future__ import annotations
@@ -42,6 +50,8 @@ import numpy as np
 from collide2d.engine.broadphase import (
     KEY_MASK,
     KEY_SHIFT,
+    METHOD_CELLS,
+    cell_candidates_split_into,
     choose,
     find,
     marker,
@@ -63,36 +73,48 @@ from collide2d.engine.events import (
     new_log,
     put_row,
 )
-from collide2d.engine.jit import njit
+from collide2d.engine.jit import njit, overload, prange
 from collide2d.engine.motion import paper_rate
 from collide2d.engine.sort import sort_keys
+from collide2d.engine.threads import chunks_for, join_shares
 from collide2d.engine.world import Bodies, WorldSpec
 
 # The kernel writes the event log of events.py without its times: `t` is added in Python as the
 # tick's end, tick / fps.
 # Room for events and candidate pairs before the buffers grow (rows; they double when full).
 _INITIAL_ROWS = 1024
-# The candidate list is made with every reach box grown by a margin (px) and kept until some object
-# has drifted that far from where it was made: a few of the fastest steps, within these bounds.
-_MARGIN_STEPS = 8
-_MARGIN_MIN_PX = 2
+# The candidate list is made with each object's reach box grown by its own margin (px, per axis):
+# the farthest its counter lets it move in the next _WINDOW_TICKS ticks (its step times the steps
+# its counter fires in them), at most _MARGIN_MAX_PX; the list is kept until some object has moved
+# past its margin from where it was when the list was made (its *fence*). A slow object's box
+# grows little, an object that will not step in the window not at all, and one fast object makes
+# only its own box large, not everyone's.
+_WINDOW_TICKS = 16
 _MARGIN_MAX_PX = 32
-# Reach boxes are kept in int32 when the world, steps and sides keep them within this (px).
+# A step longer than _MARGIN_MAX_PX takes its object past its fence, so the list is made anew at
+# every tick such a step fires. Counters all start at 0 and only ever count ticks, so those ticks
+# are known (the multiples of those steps' periods): when the next one is at most
+# _WINDOW_MAX_TICKS ticks away, the window reaches just up to it instead, which saves making the
+# list once more shortly before it.
+_WINDOW_MAX_TICKS = 24
+# The state, reach boxes and fences are kept in int32 when the world, steps, margins and sides keep
+# them within this (px).
 REACH_INT32_MAX = 2**30
 
 # The kernel's scalar state (int64): ticks done, the stage of the next tick to run, candidates
-# listed (-1: none yet), this tick's drift (px) and whether a box left the world, whether the list
-# is to be made anew this tick, event rows written in this `advance`, the candidates a too small
-# buffer needed, whether pairs can happen at all, wall events and pair events so far (logged or
-# not), this tick's overlapping candidate pairs.
-_S_TICK, _S_STAGE, _S_KEYS, _S_DRIFT, _S_LEFT, _S_RELIST, _S_EVENTS, _S_NEEDED, _S_PAIRS = range(9)
-_S_WALLS, _S_PAIR_EVENTS, _S_NEAR = 9, 10, 11
-_S_SIZE = 12
-# The stages of a tick, in the order `_run` runs them (it can stop after any of them).
-_STAGE_MOVE, _STAGE_WALLS, _STAGE_BROAD, _STAGE_NARROW, _STAGE_RESPONSE = range(5)
-_N_STAGES = 5
+# listed (-1: none yet), whether the list is to be made anew this tick (an object is past its
+# fence), event rows written in this `advance`, the candidates a too small buffer needed, whether
+# pairs can happen at all, wall events and pair events so far (logged or not), this tick's
+# overlapping candidate pairs.
+_S_TICK, _S_STAGE, _S_KEYS, _S_RELIST, _S_EVENTS, _S_NEEDED, _S_PAIRS = range(7)
+_S_WALLS, _S_PAIR_EVENTS, _S_NEAR = 7, 8, 9
+_S_SIZE = 10
+# The stages of a tick, in the order `_run` runs them (it can stop after any of them): move takes
+# the walls too, object by object.
+_STAGE_MOVE, _STAGE_BROAD, _STAGE_NARROW, _STAGE_RESPONSE = range(4)
+_N_STAGES = 4
 # The stages `Model.profile` times, each by name with the stage it runs up to (_N_STAGES: the
-# tick's end): move and walls count as "move".
+# tick's end).
 STAGES = (
     ("move", _STAGE_BROAD),
     ("broad", _STAGE_NARROW),
@@ -110,76 +132,165 @@ _kernel = njit(cache=True, _nrt=False)
 
 
 @njit(cache=True, inline="always")
-def _move(pos, step, period, count, disp, anchor, room):
-    """Counters rise by one; a component whose counter reaches its period moves by its step.
+def _move(pos, step, period, count, disp, fence, room, first, last, tick, log, ev, n_ev):
+    """Move and walls for objects first ... last-1, object by object in id order (SPEC 3.1):
+    counters rise by one and a component whose counter reaches its period moves by its step; one
+    that left the world moving outward reverses and takes that step back (a wall event, logged
+    from row n_ev on).
 
-    room (n, 2) = world side - box side. Returns (how far, px, anything now is from `anchor` at
-    most; whether any box left the world).
+    room (n, 2) = world side - box side; fence (n, 4) = [x lo, x hi, y lo, y hi], the positions
+    each object may hold while the candidate list lasts. Returns (event rows, whether any object is
+    now past its fence, wall events).
     """
-    drift = 0
-    left = False
-    for i in range(pos.shape[0]):
+    strayed = False
+    walls = 0
+    for i in range(first, last):
         for ax in range(2):
             c = count[i, ax] + 1
             fire = c >= period[i, ax]
             count[i, ax] = 0 if fire else c
             d = step[i, ax] if fire else 0
             p = pos[i, ax] + d
+            if ((d < 0) & (p < 0)) | ((d > 0) & (p > room[i, ax])):
+                if d < 0:
+                    side = SIDE_LEFT if ax == 0 else SIDE_TOP
+                else:
+                    side = SIDE_RIGHT if ax == 0 else SIDE_BOTTOM
+                step[i, ax] = -d
+                p -= d
+                d = 0
+                walls += 1
+                if log:
+                    n_ev = put_row(ev, n_ev, tick, EV_WALL, i, -1, side, -1, -1)
             pos[i, ax] = p
             disp[i, ax] = d
-            drift = max(drift, abs(p - anchor[i, ax]))
-            left |= (p < 0) | (p > room[i, ax])
-    return drift, left
+            strayed |= (p < fence[i, 2 * ax]) | (p > fence[i, 2 * ax + 1])
+    return n_ev, strayed, walls
 
 
-@njit(cache=True, inline="always")
-def _walls(pos, room, step, disp, tick, log, ev, n_ev, st):
-    """Reverse and take back each component that left the world moving outward (SPEC 3.1)."""
-    for i in range(pos.shape[0]):
-        for ax in range(2):
-            d = disp[i, ax]
-            if d < 0 and pos[i, ax] < 0:
-                side = SIDE_LEFT if ax == 0 else SIDE_TOP
-            elif d > 0 and pos[i, ax] > room[i, ax]:
-                side = SIDE_RIGHT if ax == 0 else SIDE_BOTTOM
-            else:
-                continue
-            step[i, ax] = -step[i, ax]
-            pos[i, ax] -= d
-            disp[i, ax] = 0
-            st[_S_WALLS] += 1
-            if log:
-                n_ev = put_row(ev, n_ev, tick, EV_WALL, i, -1, side, -1, -1)
-    return n_ev
+@njit(cache=True, parallel=True)
+def _move_split(pos, size, step, period, count, disp, fence, room, reach, tick, log, ev, n_ev,
+                found):
+    """`_move` with the objects cut into len(found) contiguous runs, one per thread: run c logs
+    its walls from row n_ev + 2 x its first object (an object meets at most two walls a tick),
+    then the rows are moved together in run order, as one thread writes them. Each run also
+    writes its objects' reach boxes (`_reach`) for the narrow stage, so that the threads start
+    once less a tick. Returns what `_move` returns for all objects; found (chunks, 3) int64 is
+    scratch."""
+    n = pos.shape[0]
+    chunks = found.shape[0]
+    for c in prange(chunks):
+        first = c * n // chunks
+        row = n_ev + 2 * first
+        end, strayed, walls = _move(
+            pos, step, period, count, disp, fence, room, first, (c + 1) * n // chunks, tick, log,
+            ev, row,
+        )
+        _reach(pos, size, disp, reach, first, (c + 1) * n // chunks)
+        found[c, 0] = end - row
+        found[c, 1] = strayed
+        found[c, 2] = walls
+    k = n_ev
+    strayed = False
+    walls = 0
+    for c in range(chunks):
+        row = n_ev + 2 * (c * n // chunks)
+        for r in range(found[c, 0]):
+            if k != row + r:
+                for col in range(ev.shape[1]):
+                    ev[k, col] = ev[row + r, col]
+            k += 1
+        strayed |= found[c, 1] != 0
+        walls += found[c, 2]
+    return k, strayed, walls
 
 
-@njit(cache=True)
-def _relist(pos, size, disp, movable, margin, finder, cell, order, lo, hi, keys, ws):
-    """List the pairs whose reach boxes, grown by `margin` px on every side, overlap (keys
-    a << KEY_SHIFT | b, a < b, in no particular order); pairs of two immovable objects are left
-    out. Returns how many there are; only as many as `keys` holds are written."""
-    for i in range(pos.shape[0]):
-        for ax in range(2):
-            d = disp[i, ax]
-            lo[i, ax] = pos[i, ax] - max(d, 0) - margin
-            hi[i, ax] = pos[i, ax] - min(d, 0) + size[i, ax] + margin
+def _candidates(finder, lo, hi, movable, cell, order, keys, ws, found):
+    """broadphase.find by the method the marker `finder` names, its pair tests split among
+    len(found) threads for the cells method when more than one (the same keys in the same order;
+    found is scratch). A kernel compiles only the finder its marker names (this body runs only
+    without the JIT)."""
+    if found.shape[0] > 1 and finder.dtype == marker(METHOD_CELLS).dtype:
+        return cell_candidates_split_into(lo, hi, movable, cell, order, keys, ws, found)
     return find(finder, lo, hi, movable, cell, order, keys, ws)
 
 
-@njit(cache=True, inline="always")
-def _near(pos, size, disp, keys, n_keys, near, reach):
-    """The listed pairs whose reach boxes overlap now, into `near` (as long as `keys`), sorted by
-    (a, b); returns how many. The reach boxes are first written side by side in one row per
-    object, reach (n, 4) = [x lo, x hi, y lo, y hi], so that testing a pair reads one row of each
-    object rather than its position, displacement and size from three arrays."""
+@overload(_candidates)
+def _candidates_of(finder, lo, hi, movable, cell, order, keys, ws, found):
+    if finder.dtype.bitwidth == 32:  # the cells method's marker (broadphase.marker)
+
+        def cells(finder, lo, hi, movable, cell, order, keys, ws, found):
+            if found.shape[0] > 1:
+                return cell_candidates_split_into(lo, hi, movable, cell, order, keys, ws, found)
+            return find(finder, lo, hi, movable, cell, order, keys, ws)
+
+        return cells
+
+    def one(finder, lo, hi, movable, cell, order, keys, ws, found):
+        return find(finder, lo, hi, movable, cell, order, keys, ws)
+
+    return one
+
+
+@njit(cache=True)
+def _relist(pos, size, step, period, count, disp, fence, movable, window, cap, finder, cell,
+            order, lo, hi, keys, ws, found):
+    """List the pairs whose reach boxes, each grown by its object's margin, overlap (keys
+    a << KEY_SHIFT | b, a < b, in no particular order); pairs of two immovable objects are left
+    out. Returns how many there are; only as many as `keys` holds are written.
+
+    An object's margin on an axis is how far its counter can move it in the next `window` ticks
+    (`_window`), |V| x the steps it fires in them (a pair or a wall only reverses or takes a step
+    back), at most `cap` px, from either end of this tick's step (the pair stage may take it
+    back); its fence is that range of positions. While every object stays within its fence, every
+    box it holds lies in its grown reach box, so every pair that can overlap is listed."""
     for i in range(pos.shape[0]):
         for ax in range(2):
             d = disp[i, ax]
-            lo = pos[i, ax] - max(d, 0)
-            reach[i, 2 * ax] = lo
-            reach[i, 2 * ax + 1] = lo + abs(d) + size[i, ax]
-    k = np.int64(0)  # not the literal 0, which would compile sort_keys once more for it
-    for c in range(n_keys):
+            p = pos[i, ax]
+            fires = (count[i, ax] + window) // period[i, ax]
+            margin = min(min(abs(step[i, ax]), cap) * fires, cap)  # no product past int32
+            low = p - max(d, 0) - margin
+            high = p - min(d, 0) + margin
+            fence[i, 2 * ax] = low
+            fence[i, 2 * ax + 1] = high
+            lo[i, ax] = low
+            hi[i, ax] = high + size[i, ax]
+    return _candidates(finder, lo, hi, movable, cell, order, keys, ws, found)
+
+
+@njit(cache=True, inline="always")
+def _window(tick, forced, window, longest):
+    """The window (ticks) of a list made at `tick`: up to the tick before the next at which a step
+    of one of the periods `forced` fires (the multiples of each), when that is at most `longest`
+    ticks on, else `window`."""
+    ahead = longest + 1
+    for p in range(forced.shape[0]):
+        every = forced[p]
+        ahead = min(ahead, (tick // every + 1) * every - tick - 1)
+    return ahead if ahead <= longest else window
+
+
+@njit(cache=True, inline="always")
+def _reach(pos, size, disp, reach, first, last):
+    """The reach boxes of objects first ... last-1 into reach (n, 4) = [x lo, x hi, y lo, y hi]:
+    the hull of each box before and after this tick's step, all the pair stage can put it at,
+    side by side in one row per object, so that testing a pair reads one row of each object
+    rather than its position, displacement and size from three arrays."""
+    for i in range(first, last):
+        for ax in range(2):
+            d = disp[i, ax]
+            low = pos[i, ax] - max(d, 0)
+            reach[i, 2 * ax] = low
+            reach[i, 2 * ax + 1] = low + abs(d) + size[i, ax]
+
+
+@njit(cache=True, inline="always")
+def _near_range(keys, first, last, near, base, reach):
+    """The pairs keys[first:last] whose reach boxes overlap, into near[base:], in the order
+    listed; returns how many."""
+    k = 0
+    for c in range(first, last):
         a = keys[c] >> KEY_SHIFT
         b = keys[c] & KEY_MASK
         meet = (
@@ -188,8 +299,34 @@ def _near(pos, size, disp, keys, n_keys, near, reach):
             & (reach[b, 2] < reach[a, 3])
             & (reach[a, 2] < reach[b, 3])
         )
-        near[k] = keys[c]
+        near[base + k] = keys[c]
         k += meet
+    return k
+
+
+@njit(cache=True, inline="always")
+def _near(pos, size, disp, keys, n_keys, near, reach):
+    """The listed pairs whose reach boxes overlap now, into `near` (as long as `keys`), sorted by
+    (a, b); returns how many. reach (n, 4) receives the reach boxes (`_reach`)."""
+    _reach(pos, size, disp, reach, 0, pos.shape[0])
+    k = np.int64(_near_range(keys, 0, n_keys, near, 0, reach))  # np.int64: one sort_keys
+    sort_keys(near, k)
+    return k
+
+
+@njit(cache=True, parallel=True)
+def _near_split(keys, n_keys, near, reach, found):
+    """`_near` on the reach boxes `_move_split` wrote, with the listed pairs cut into len(found)
+    contiguous runs, one per thread, each into its own share of `near` (at least n_keys +
+    len(found) long); the shares are moved together and sorted, the same pairs in the same order
+    as `_near`. found (chunks,) int64 is scratch."""
+    chunks = found.shape[0]
+    share = (n_keys + chunks - 1) // chunks
+    for c in prange(chunks):
+        found[c] = _near_range(
+            keys, c * n_keys // chunks, (c + 1) * n_keys // chunks, near, c * share, reach
+        )
+    k = join_shares(found, share, near)
     sort_keys(near, k)
     return k
 
@@ -229,50 +366,63 @@ def _run(pos, size, room, step, period, count, movable, stop, log, st, bp, ev, w
     """Run stage after stage until st[_S_TICK] * _N_STAGES + st[_S_STAGE] = stop (advance: ticks
     done x _N_STAGES, a tick's end); returns _DONE, or _LOG_FULL / _KEYS_FULL when `ev` or the
     candidate buffers need more room (grow them and call again: the tick resumes at the stage it
-    stopped). st: the scalar state (see _S_*); bp = (order, anchor, keys, near, disp, lo, hi,
-    params, finder, reach) with params = [margin px, method, grid cell px] (float64) and finder the
-    method's marker (broadphase.marker: only that pair finder is compiled)."""
-    order, anchor, keys, near, disp, lo, hi, params, finder, reach = bp
-    margin = int(params[0])
+    stopped). st: the scalar state (see _S_*); bp = (order, fence, keys, near, disp, lo, hi,
+    params, found, forced, finder, reach) with params = [window ticks, method, grid cell px,
+    largest margin px, chunks, longest window ticks] (float64; chunks: threads.chunks_for, 1 for
+    no split), found (chunks, 3) the split stages' scratch, forced the periods of the steps
+    longer than the largest margin (see _WINDOW_MAX_TICKS) and finder the method's marker
+    (broadphase.marker: only that pair finder is compiled)."""
+    order, fence, keys, near, disp, lo, hi, params, found, forced, finder, reach = bp
     cell = params[2]
+    window = int(params[0])
+    cap = int(params[3])
+    chunks = int(params[4])
+    longest = int(params[5])
     n = pos.shape[0]
     n_ev = st[_S_EVENTS]
     while st[_S_TICK] * _N_STAGES + st[_S_STAGE] < stop:
         tick = st[_S_TICK] + 1
         stage = st[_S_STAGE]
         if stage == _STAGE_MOVE:
-            # move: counters fire, this tick's displacement is kept to be taken back
-            drift, left = _move(pos, step, period, count, disp, anchor, room)
-            st[_S_DRIFT] = drift
-            st[_S_LEFT] = left
-        elif stage == _STAGE_WALLS:
-            # walls: reverse and take back what left the world moving outward
-            if st[_S_LEFT]:
-                if log and n_ev + 2 * n > ev.shape[0]:
-                    st[_S_EVENTS] = n_ev
-                    return _LOG_FULL
-                n_ev = _walls(pos, room, step, disp, tick, log, ev, n_ev, st)
-            # the list is made anew once anything drifted a margin from where it was made
-            # (drift is measured before the walls take steps back, which only errs early)
-            st[_S_RELIST] = st[_S_KEYS] < 0 or st[_S_DRIFT] >= margin
+            # move and walls: counters fire, what left the world moving outward reverses and
+            # takes its step back; the displacement kept is what a pair takes back
+            if log and n_ev + 2 * n > ev.shape[0]:
+                st[_S_EVENTS] = n_ev
+                return _LOG_FULL
+            if chunks > 1:
+                n_ev, strayed, walls = _move_split(
+                    pos, size, step, period, count, disp, fence, room, reach, tick, log, ev,
+                    n_ev, found,
+                )
+            else:
+                n_ev, strayed, walls = _move(
+                    pos, step, period, count, disp, fence, room, 0, n, tick, log, ev, n_ev
+                )
+            st[_S_WALLS] += walls
+            # the list is made anew once an object is past its fence
+            st[_S_RELIST] = st[_S_KEYS] < 0 or strayed
         elif not st[_S_PAIRS]:
             pass  # no pair can happen: the pair stages do nothing
         elif stage == _STAGE_BROAD:
             # broad: the candidate list, when it is to be made anew
             if st[_S_RELIST]:
-                k = _relist(pos, size, disp, movable, margin, finder, cell, order, lo, hi, keys, ws)
+                k = _relist(
+                    pos, size, step, period, count, disp, fence, movable,
+                    _window(tick, forced, window, longest), cap, finder, cell, order, lo, hi,
+                    keys, ws, found[:, 0],
+                )
                 if k > keys.shape[0]:
                     st[_S_NEEDED] = k
                     st[_S_EVENTS] = n_ev
                     return _KEYS_FULL
                 st[_S_KEYS] = k
                 st[_S_RELIST] = 0
-                for i in range(n):
-                    anchor[i, 0] = pos[i, 0]
-                    anchor[i, 1] = pos[i, 1]
         elif stage == _STAGE_NARROW:
             # narrow: the listed pairs whose reach boxes overlap, in (a, b) order
-            st[_S_NEAR] = _near(pos, size, disp, keys, st[_S_KEYS], near, reach)
+            if chunks > 1:
+                st[_S_NEAR] = _near_split(keys, st[_S_KEYS], near, reach, found[:, 0])
+            else:
+                st[_S_NEAR] = _near(pos, size, disp, keys, st[_S_KEYS], near, reach)
         else:
             # response: the rule on each of them
             if log and n_ev + st[_S_NEAR] > ev.shape[0]:
@@ -301,33 +451,45 @@ class Model:
         self.world = world
         self.fps = int(world.fps)
         self.tick = 0
-        self.pos = _whole(bodies.pos, "positions")
-        self.size = _whole(bodies.size, "sizes")
-        self.step, self.period = _rates(bodies.vel, self.fps)
+        pos = _whole(bodies.pos, "positions")
+        size = _whole(bodies.size, "sizes")
+        step, period = _rates(bodies.vel, self.fps)
+        # the state in int32 when the world allows (half the memory each tick streams through)
+        small = _reach_dtype(world, size, step)
+        if pos.size and int(np.abs(pos).max()) > REACH_INT32_MAX // 2:
+            small = np.int64  # objects placed far outside the world
+        self.pos, self.size, self.step = pos.astype(small), size.astype(small), step.astype(small)
+        self.period = period.astype(small)
         self.count = np.zeros_like(self.step)
         n = self.pos.shape[0]
         self.movable = ~np.asarray(bodies.static, bool) if skip else np.ones(n, bool)
         limit = np.array([world.width, world.height], np.int64)
-        self._room = np.ascontiguousarray(limit - self.size)
+        self._room = np.ascontiguousarray(limit - size).astype(small)
         self._ev = new_log(True, _INITIAL_ROWS)[0]
         self._st = np.zeros(_S_SIZE, np.int64)
         self._st[_S_KEYS] = -1
         self._st[_S_PAIRS] = n >= 2 and (bool(self.movable.any()) or not skip)
-        margin = _margin(self.step)
-        method, cell = choose(world.width, world.height, self.size + 2 * margin, broadphase)
-        params = np.array([margin, method, cell], np.float64)
+        grown = self.size + 2 * _margins(self.step, self.period)
+        method, cell = choose(world.width, world.height, grown, broadphase)
+        chunks = chunks_for(n)
+        params = np.array(
+            [_WINDOW_TICKS, method, cell, _MARGIN_MAX_PX, chunks, _WINDOW_MAX_TICKS], np.float64
+        )
+        long_steps = np.abs(self.step) > _MARGIN_MAX_PX
         keys = max(_INITIAL_ROWS, 2 * n)
         self._bp = (
             np.argsort(self.pos[:, 0], kind="stable").astype(np.int64),  # sweep order
-            self.pos.copy(),  # anchor
+            np.zeros((n, 4), small),  # fences (made with the list)
             np.empty(keys, np.int64),  # candidate keys
-            np.empty(keys, np.int64),  # near pairs
-            np.zeros((n, 2), np.int64),  # this tick's displacement
+            np.empty(keys + chunks, np.int64),  # near pairs (room for each thread's share)
+            np.zeros((n, 2), small),  # this tick's displacement
             np.empty((n, 2), np.int64),  # reach boxes
             np.empty((n, 2), np.int64),
             params,
+            np.zeros((chunks, 3), np.int64),  # what each thread of a split stage found
+            np.unique(period[long_steps]).astype(np.int64),  # periods of the long steps
             marker(method),
-            np.empty((n, 4), _reach_dtype(world, self.size, self.step)),  # for the narrow stage
+            np.empty((n, 4), small),  # reach boxes of this tick, for the narrow stage
         )
         self._ws = workspace(n, np.int64)
 
@@ -356,11 +518,11 @@ class Model:
 
     def profile(self, ticks: int) -> dict[str, float]:
         """Run `ticks` ticks with the event log off, one stage of `_run` at a time, and return the
-        seconds spent in each (STAGES): "move" (counters and walls), "broad" (making the candidate
-        list), "narrow" (keeping the listed pairs whose reach boxes overlap), "response" (the flip
-        rule). The state ends exactly as `advance(ticks, log=False)` would leave it. Each stage is
-        timed from Python, so each count includes a call's overhead (microseconds), which
-        dominates in small scenes."""
+        seconds spent in each (STAGES): "move" (counters and walls), "broad" (making
+        the candidate list), "narrow" (keeping the listed pairs whose reach boxes overlap),
+        "response" (the flip rule). The state ends exactly as `advance(ticks, log=False)` would
+        leave it. Each stage is timed from Python, so each count includes a call's overhead
+        (microseconds), which dominates in small scenes."""
         spent = {name: 0.0 for name, _ in STAGES}
         clock = time.perf_counter
         for _ in range(int(ticks)):
@@ -396,9 +558,10 @@ class Model:
                 self._ev = grown(self._ev, 2 * self.pos.shape[0])
             else:
                 rows = 2 * int(self._st[_S_NEEDED])
+                chunks = int(self._bp[7][4])
                 self._bp = (
                     self._bp[:2]
-                    + (np.empty(rows, np.int64), np.empty(rows, np.int64))
+                    + (np.empty(rows, np.int64), np.empty(rows + chunks, np.int64))
                     + self._bp[4:]
                 )
         self.tick = int(self._st[_S_TICK])
@@ -412,18 +575,18 @@ class Model:
 
 
 def _reach_dtype(world: WorldSpec, size: np.ndarray, step: np.ndarray):
-    """int32 for the narrow stage's reach boxes when every value they can hold (a position in the
-    world, less or plus a step, plus a side) fits it with room to spare, so that they take half
-    the cache; else int64."""
-    far = max(int(world.width), int(world.height))
+    """int32 for the state, reach boxes and fences when every value they can hold (a position in
+    the world, less or plus a step and a margin, plus a side; a period) fits it with room to
+    spare, so that they take half the cache; else int64."""
+    far = max(int(world.width), int(world.height)) + _MARGIN_MAX_PX
     far += 2 * (int(np.abs(step).max()) if step.size else 0) + (int(size.max()) if size.size else 0)
     return np.int32 if far <= REACH_INT32_MAX else np.int64
 
 
-def _margin(step: np.ndarray) -> int:
-    """The candidate list's margin in px: a few of the fastest steps, within set bounds."""
-    fastest = int(np.abs(step).max()) if step.size else 0
-    return int(min(max(_MARGIN_STEPS * fastest, _MARGIN_MIN_PX), _MARGIN_MAX_PX))
+def _margins(step: np.ndarray, period: np.ndarray) -> np.ndarray:
+    """Each object's margins (n, 2) px as a list made at a random moment would give them on
+    average (|V| x _WINDOW_TICKS / P, at most _MARGIN_MAX_PX), for choosing the broad phase."""
+    return np.minimum(np.abs(step) * _WINDOW_TICKS / period, _MARGIN_MAX_PX)
 
 
 def _whole(values: np.ndarray, what: str) -> np.ndarray:
