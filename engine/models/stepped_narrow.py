@@ -9,9 +9,9 @@ order, so the result is the same whatever order the objects are kept in inside.
 
 A pair is in contact when its boxes overlap now with positive area, or overlapped during the step
 (swept back on straight lines, both objects clear of the walls this step: a corner passed through
-within it). Most listed pairs are far apart: a cheap reach test (contact.box_reach) drops them
-before any sweep. Large scenes cut the keys into contiguous runs, one per thread, each writing
-its own share of `near`, joined in run order before the sort.
+within it). Most listed pairs are far apart: a cheap reach test (contact.box_reach, without
+branches: `_axis_reach`) drops them before any sweep. Large scenes cut the keys into contiguous
+runs, one per thread, each writing its own share of `near`, joined in run order before the sort.
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ import math
 import numpy as np
 
 from collide2d.engine.broadphase import KEY_MASK, KEY_SHIFT
-from collide2d.engine.contact import box_clip, box_reach, box_sweep
+from collide2d.engine.contact import box_clip, box_sweep
 from collide2d.engine.jit import njit, prange
 from collide2d.engine.models.stepped_motion import B_H, B_SX, B_SY, B_VX, B_VY, B_W, B_X, B_Y
 from collide2d.engine.sort import sort_by_time
@@ -37,6 +37,19 @@ def _swept_back(body, i, dt):
     return 0.0 <= x <= max(body[i, B_SX], 0.0) and 0.0 <= y <= max(body[i, B_SY], 0.0)
 
 
+@njit(cache=True, inline="always")
+def _axis_reach(q, u, lo, hi, dt):
+    """contact.box_reach on one axis, without a branch: False when on this axis the boxes are
+    apart (q outside [lo, hi]) and not closing, or too far apart to close the gap in dt s. The
+    same test, to the bit; computed on every listed pair, most of them far apart, where branches
+    that go either way at random cost more than the arithmetic."""
+    above = q > hi
+    below = q < lo
+    gap = q - hi if above else lo - q
+    closing = -u if above else u
+    return (not (above | below)) | ((closing > 0.0) & (not (gap > closing * dt)))
+
+
 @njit(cache=True)
 def _contact_range(body, ext, keys, first, last, near, when, base, room, dt):
     """The listed pairs keys[first:last] in contact during the step of dt s just taken, written
@@ -49,10 +62,13 @@ def _contact_range(body, ext, keys, first, last, near, when, base, room, dt):
         qx = body[b, B_X] - body[a, B_X]
         qy = body[b, B_Y] - body[a, B_Y]
         wa, ha, wb, hb = body[a, B_W], body[a, B_H], body[b, B_W], body[b, B_H]
-        now = -wb < qx < wa and -hb < qy < ha
+        now = (-wb < qx) & (qx < wa) & (-hb < qy) & (qy < ha)
         ux = body[b, B_VX] - body[a, B_VX]
         uy = body[b, B_VY] - body[a, B_VY]
-        if not (now or box_reach(qx - ux * dt, qy - uy * dt, ux, uy, wa, ha, wb, hb, dt)):
+        # box_reach, from where the pair was as the step began
+        reach = _axis_reach(qx - ux * dt, ux, -wb, wa, dt)
+        reach = reach & _axis_reach(qy - uy * dt, uy, -hb, ha, dt)
+        if not (now | reach):  # most pairs: one branch, nearly always taken
             continue
         t_enter, _, _, _, _ = box_sweep(qx - ux * dt, qy - uy * dt, ux, uy, wa, ha, wb, hb)
         if not now and not (
