@@ -221,6 +221,11 @@ class Model:
         return out
 
 
+def _reorder_scratch(n: int) -> tuple:
+    """The reorder's scratch (stepped_list._reorder): rows, ids, flags, inverse masses."""
+    return (np.empty((n, BODY_COLUMNS)), np.empty(n, np.int64), np.empty(n, np.uint8), np.empty(n))
+
+
 def _broad_phase(world, pos, vel, size, movable, substeps, skip, broadphase):
     """The candidate list's state and scratch (see `stepped_step.run`): its margin from the
     fastest step and the box sizes, the method and cell from the scene or `broadphase`
@@ -248,5 +253,5 @@ def _broad_phase(world, pos, vel, size, movable, substeps, skip, broadphase):
         workspace(n),
         np.empty(max(16, n)),  # when
         marker(method),  # finder: the kernels compile only this method's pair finder
-        (np.empty((n, BODY_COLUMNS)), np.empty(n, np.int64), np.empty(n, bool)),  # reorder's
+        _reorder_scratch(n),
     )

@@ -28,7 +28,7 @@ from collide2d.engine.broadphase import (
     find,
     marker,
 )
-from collide2d.engine.jit import njit, overload
+from collide2d.engine.jit import njit, overload, prange
 from collide2d.engine.models.stepped_motion import B_H, B_VX, B_VY, B_W, B_X, B_Y
 
 # Where the model's `state` array keeps the keys listed (-1: no list yet), the method, whether
@@ -41,56 +41,111 @@ P_MARGIN, P_CELL, P_SLACK, P_DRIFT = range(4)
 
 
 @njit(cache=True)
-def _gather_rows(a, order, tmp):
-    """a[:] = a[order] along the first axis, through the scratch tmp (at least a's shape)."""
-    n = order.shape[0]
-    for s in range(n):
-        for c in range(a.shape[1]):
-            tmp[s, c] = a[order[s], c]
-    for s in range(n):
-        for c in range(a.shape[1]):
-            a[s, c] = tmp[s, c]
+def _grow_range(body, lo, hi, margin, dt, first, last):
+    """The boxes of objects first ... last-1 over the step of dt s just taken (swept back on a
+    straight line), grown by margin px, into lo, hi."""
+    for i in range(first, last):
+        x = body[i, B_X]
+        y = body[i, B_Y]
+        bx = x - body[i, B_VX] * dt
+        by = y - body[i, B_VY] * dt
+        lo[i, 0] = min(x, bx) - margin
+        lo[i, 1] = min(y, by) - margin
+        hi[i, 0] = max(x, bx) + body[i, B_W] + margin
+        hi[i, 1] = max(y, by) + body[i, B_H] + margin
 
 
 @njit(cache=True)
-def _gather(a, order, tmp):
-    """a[:] = a[order], through the scratch tmp (a's shape)."""
-    for s in range(order.shape[0]):
-        tmp[s] = a[order[s]]
-    for s in range(order.shape[0]):
-        a[s] = tmp[s]
+def _gather_range(body, inv_mass, static, movable, ext, order, scratch, first, last):
+    """Slots first ... last-1 of the state put in `order`, into the scratch (rows, ids, flags,
+    masses: the body rows, the ids, static | movable << 1, the inverse masses)."""
+    rows, inv, flags, masses = scratch
+    for s in range(first, last):
+        o = order[s]
+        for c in range(body.shape[1]):
+            rows[s, c] = body[o, c]
+        masses[s] = inv_mass[o]
+        inv[s] = ext[o]
+        flags[s] = static[o] | (movable[o] << 1)
 
 
 @njit(cache=True)
-def _reorder(body, inv_mass, static, movable, ext, rank, order, scratch, keys, n_keys):
-    """Put the objects inside in `order` (a permutation of the indices inside) and rename the
-    n_keys keys to match (each as low index, high index); then order is the identity.
-    scratch = (rows (n, 8) float64, inv (n,) int64, flags (n,) bool)."""
-    rows, inv, flags = scratch
-    n = order.shape[0]
-    identity = True
-    for s in range(n):
-        if order[s] != s:
-            identity = False
-            break
-    if identity:
-        return
-    _gather_rows(body, order, rows)
-    for s in range(n):
-        rows[s, 0] = inv_mass[order[s]]
-    for s in range(n):
-        inv_mass[s] = rows[s, 0]
-    _gather(static, order, flags)
-    _gather(movable, order, flags)
-    _gather(ext, order, inv)
-    for s in range(n):
-        inv[order[s]] = s
-        rank[ext[s]] = s
-        order[s] = s
-    for c in range(n_keys):
+def _place_range(body, inv_mass, static, movable, ext, rank, anchor, order, scratch, first, last):
+    """Slots first ... last-1 copied back from the scratch; each anchored where it is."""
+    rows, inv, flags, masses = scratch
+    for s in range(first, last):
+        for c in range(body.shape[1]):
+            body[s, c] = rows[s, c]
+        inv_mass[s] = masses[s]
+        ext[s] = inv[s]
+        static[s] = flags[s] & 1
+        movable[s] = flags[s] >> 1
+        rank[inv[s]] = s
+        anchor[s, 0] = rows[s, B_X]
+        anchor[s, 1] = rows[s, B_Y]
+
+
+@njit(cache=True)
+def _rename_range(keys, order, inv, first, last):
+    """Keys first ... last-1 renamed from the old indices inside to the new (inv: old to new),
+    each as low index, high index."""
+    for c in range(first, last):
         a = inv[keys[c] >> KEY_SHIFT]
         b = inv[keys[c] & KEY_MASK]
         keys[c] = (min(a, b) << KEY_SHIFT) | max(a, b)
+
+
+@njit(cache=True)
+def _reorder(S, order, scratch, keys, n_keys, chunks):
+    """Put the objects inside in `order` (a permutation of the indices inside), anchor each where
+    it is and rename the n_keys keys to match; then order is the identity. The work is cut into
+    `chunks` contiguous runs, on threads when more than one (`_reorder_split`)."""
+    if chunks > 1:
+        _reorder_split(S, order, scratch, keys, n_keys, chunks)
+        return
+    body, inv_mass, static, movable, ext, rank, anchor = S
+    n = order.shape[0]
+    _gather_range(body, inv_mass, static, movable, ext, order, scratch, 0, n)
+    _place_range(body, inv_mass, static, movable, ext, rank, anchor, order, scratch, 0, n)
+    inv = scratch[1]
+    for s in range(n):
+        inv[order[s]] = s
+        order[s] = s
+    _rename_range(keys, order, inv, 0, n_keys)
+
+
+@njit(cache=True, parallel=True)
+def _reorder_split(S, order, scratch, keys, n_keys, chunks):
+    """`_reorder` on `chunks` threads: the same state and keys."""
+    body, inv_mass, static, movable, ext, rank, anchor = S
+    n = order.shape[0]
+    for c in prange(chunks):
+        _gather_range(
+            body, inv_mass, static, movable, ext, order, scratch, c * n // chunks,
+            (c + 1) * n // chunks,
+        )
+    for c in prange(chunks):
+        _place_range(
+            body, inv_mass, static, movable, ext, rank, anchor, order, scratch, c * n // chunks,
+            (c + 1) * n // chunks,
+        )
+    inv = scratch[1]
+    for c in prange(chunks):
+        for s in range(c * n // chunks, (c + 1) * n // chunks):
+            inv[order[s]] = s
+    for c in prange(chunks):
+        for s in range(c * n // chunks, (c + 1) * n // chunks):
+            order[s] = s
+    for c in prange(chunks):
+        _rename_range(keys, order, inv, c * n_keys // chunks, (c + 1) * n_keys // chunks)
+
+
+@njit(cache=True, parallel=True)
+def _grow_split(body, lo, hi, margin, dt, chunks):
+    """`_grow_range` over every object, on `chunks` threads."""
+    n = body.shape[0]
+    for c in prange(chunks):
+        _grow_range(body, lo, hi, margin, dt, c * n // chunks, (c + 1) * n // chunks)
 
 
 @njit(cache=True)
@@ -102,28 +157,23 @@ def relist(S, dt, bp):
     body, inv_mass, static, movable, ext, rank, anchor = S
     keys, near, order, lo, hi, folds, state, params, ws, when, finder, scratch = bp
     margin = params[P_MARGIN]
-    n = body.shape[0]
-    for i in range(n):
-        # the box over the step just taken (swept back on a straight line), grown by margin
-        x = body[i, B_X]
-        y = body[i, B_Y]
-        bx = x - body[i, B_VX] * dt
-        by = y - body[i, B_VY] * dt
-        lo[i, 0] = min(x, bx) - margin
-        lo[i, 1] = min(y, by) - margin
-        hi[i, 0] = max(x, bx) + body[i, B_W] + margin
-        hi[i, 1] = max(y, by) + body[i, B_H] + margin
-    cell = params[P_CELL]
     chunks = state[ST_CHUNKS]
+    n = body.shape[0]
+    if chunks > 1:
+        _grow_split(body, lo, hi, margin, dt, chunks)
+    else:
+        _grow_range(body, lo, hi, margin, dt, 0, n)
+    cell = params[P_CELL]
     k = _candidates(finder, lo, hi, movable, cell, order, keys, ws, chunks)
     while k > keys.shape[0]:
         keys = np.empty(2 * k, np.int64)
         k = _candidates(finder, lo, hi, movable, cell, order, keys, ws, chunks)
     if state[ST_METHOD] != METHOD_GRID:
-        _reorder(body, inv_mass, static, movable, ext, rank, order, scratch, keys, k)
-    for i in range(n):
-        anchor[i, 0] = body[i, B_X]
-        anchor[i, 1] = body[i, B_Y]
+        _reorder(S, order, scratch, keys, k, chunks)
+    else:
+        for i in range(n):
+            anchor[i, 0] = body[i, B_X]
+            anchor[i, 1] = body[i, B_Y]
     return keys, k
 
 
