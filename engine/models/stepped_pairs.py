@@ -58,19 +58,34 @@ def _contact(a, b, ea, eb, body, dt, exact, shape, radius, start, verts, normals
 
 @njit(cache=True)
 def respond(
-    S, dt, width, height, exact, cores, near, n_near, tick, t, log, rows, times, n_ev, state
+    S, dt, width, height, exact, cores, near, n_near, inside, tick, t, log, rows, times, n_ev, state
 ):
     """Respond to every overlapping, approaching pair of `near` (ascending keys of ids) in order,
-    after a step of dt s; count each in state[ST_PAIRS], log it when `log`."""
+    after a step of dt s; count each in state[ST_PAIRS], log it when `log`. inside (k, 3) int64
+    is scratch (the move's fold rows, free by now)."""
     body, inv_mass, static, movable, ext, rank, anchor = S
     shape, radius, start, verts, normals = cores
     pos = body  # its columns 0, 1: the corners, as response.separate reads them
     size = body[:, B_W : B_H + 1]
+    # First each pair's rows inside and a read of each row, in a short loop whose iterations do
+    # not wait on each other: the reads from memory that a large scene needs (the pairs come in
+    # the order of time, scattered over the state) then overlap instead of following one another.
+    ahead = min(n_near, inside.shape[0])
+    for m in range(ahead):
+        a = rank[near[m] >> KEY_SHIFT]
+        b = rank[near[m] & KEY_MASK]
+        inside[m, 0] = a
+        inside[m, 1] = b
+        inside[m, 2] = (body[a, B_X] < body[b, B_X]) + (inv_mass[a] < inv_mass[b])
     for m in range(n_near):
         ea = near[m] >> KEY_SHIFT
         eb = near[m] & KEY_MASK
-        a = rank[ea]
-        b = rank[eb]
+        if m < ahead:
+            a = inside[m, 0]
+            b = inside[m, 1]
+        else:
+            a = rank[ea]
+            b = rank[eb]
         depth, depth_y, code, nx, ny = _contact(
             a, b, ea, eb, body, dt, exact, shape, radius, start, verts, normals
         )

@@ -85,6 +85,7 @@ def step(first, last, S, dt, width, height, exact, cores, tick, t, log, rows, ti
             cores,
             near,
             state[ST_NEAR],
+            folds,
             tick,
             t,
             log,
