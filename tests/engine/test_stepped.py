@@ -7,11 +7,13 @@ from engine_refs import random_boxes
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from collide2d.engine.broadphase import KEY_SHIFT
 from collide2d.engine.contact import box_clip, box_step_contact, box_sweep
 from collide2d.engine.events import AXIS_NAMES, EV_PAIR, EV_WALL, SIDE_LEFT, SIDE_RIGHT
 from collide2d.engine.invariants import kinetic_energy, momentum
 from collide2d.engine.models import make
 from collide2d.engine.models.stepped import STAGES
+from collide2d.engine.models.stepped_list import ST_KEYS
 from collide2d.engine.response import exchange, fold, separate
 from collide2d.engine.world import KIND_CIRCLE, Bodies, Looks, WorldSpec
 
@@ -371,6 +373,26 @@ def test_a_large_crowd_through_each_method_gives_the_same_bytes():
     runs.append((events.tobytes(), chunked.positions().tobytes(), chunked.velocities().tobytes()))
     assert all(r == runs[0] for r in runs)
     assert len(np.frombuffer(runs[0][0], dtype=events.dtype)) > 100
+
+
+@pytest.mark.parametrize("broadphase", ["sweep", "cells"])
+def test_the_candidate_list_reads_the_objects_front_to_back(broadphase):
+    # each time the list is made the objects inside are put in the broad phase's order and the
+    # listed pairs renamed to match, so that the pair tests read the state as one stream: the
+    # first (lower) index of the listed pairs never goes back, whatever the objects did since
+    world = WorldSpec(1600, 1200, 30)
+    bodies = crowd(2000, 7, world, statics=0.05, sizes=(3.0, 6.0, 9.0))
+    model = make("stepped", world, bodies, broadphase=broadphase)
+    ids = []
+    for ticks in (1, 5, 40):
+        model.advance(ticks)
+        keys, state = model._bp[0], model._bp[6]
+        first = keys[: state[ST_KEYS]] >> KEY_SHIFT
+        assert len(first) > 500
+        assert (np.diff(first) >= 0).all()
+        ids.append(model._S.ext.copy())
+    assert not np.array_equal(ids[0], np.arange(2000))  # not the id order
+    assert not np.array_equal(ids[0], ids[2])  # the order followed the objects
 
 
 def test_exact_shapes_keep_their_ids_whatever_the_order_inside():
