@@ -56,6 +56,7 @@ from collide2d.engine.models.stepped_list import (  # noqa: F401  (_candidates: 
     ST_CHUNKS,
     ST_PAIRS,
     ST_WALLS,
+    STATE_SIZE,
     _candidates,
 )
 from collide2d.engine.models.stepped_motion import BODY_COLUMNS
@@ -69,7 +70,7 @@ __all__ = ["STAGES", "Model", "State"]
 # The candidate list's margin, px: this many of the fastest object's step (|v|·dt), within
 # [MARGIN_MIN_PX, MARGIN_MAX_SIDES x the median box side]. A wider margin remakes the list less
 # often but lists more pairs; tuned on the standard scene of `collide2d bench`.
-MARGIN_STEPS = 5.0
+MARGIN_STEPS = 7.0
 MARGIN_MIN_PX = 0.5
 MARGIN_MAX_SIDES = 1.5
 # The list is remade once an object has drifted within this much (px, and this share of the
@@ -238,6 +239,8 @@ def _broad_phase(world, pos, vel, size, movable, substeps, skip, broadphase):
     margin = max(margin, MARGIN_MIN_PX) if np.isfinite(margin) else MARGIN_MIN_PX
     method, cell = choose(world.width, world.height, size + 2.0 * margin, broadphase)
     slack = DRIFT_SLACK_PX + DRIFT_SLACK_REL * max(world.width, world.height)
+    state = np.zeros(STATE_SIZE, np.int64)  # ST_*
+    state[: ST_CHUNKS + 1] = [-1, method, int(possible), 0, 0, 0, chunks_for(n)]
     order = np.arange(n, dtype=np.int64)
     if method == METHOD_SWEEP:
         order = np.argsort(pos[:, 0], kind="stable").astype(np.int64)
@@ -248,10 +251,11 @@ def _broad_phase(world, pos, vel, size, movable, substeps, skip, broadphase):
         np.empty_like(pos),  # lo
         np.empty_like(pos),  # hi
         np.empty((2 * n, 4), np.int64),  # folds
-        np.array([-1, method, int(possible), 0, 0, 0, chunks_for(n)], np.int64),  # ST_*
+        state,
         np.array([margin, cell, slack, 0.0]),  # P_*
         workspace(n),
         np.empty(max(16, n)),  # when
         marker(method),  # finder: the kernels compile only this method's pair finder
         _reorder_scratch(n),
+        np.empty(max(16, CANDIDATES_PER_OBJECT * n), np.int64),  # spare keys
     )

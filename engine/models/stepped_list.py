@@ -32,9 +32,17 @@ from collide2d.engine.jit import njit, overload, prange
 from collide2d.engine.models.stepped_motion import B_H, B_VX, B_VY, B_W, B_X, B_Y
 
 # Where the model's `state` array keeps the keys listed (-1: no list yet), the method, whether
-# pairs can happen at all, the wall and pair event counters, this step's overlapping pairs and
-# how many chunks (threads) the move and narrow stages split into (1: none).
-ST_KEYS, ST_METHOD, ST_POSSIBLE, ST_WALLS, ST_PAIRS, ST_NEAR, ST_CHUNKS = range(7)
+# pairs can happen at all, the wall and pair event counters, this step's overlapping pairs, how
+# many chunks (threads) the move and narrow stages split into (1: none), and from ST_BANDS on
+# where each band of the list begins (BANDS + 1 entries; see `within_reach`).
+ST_KEYS, ST_METHOD, ST_POSSIBLE, ST_WALLS, ST_PAIRS, ST_NEAR, ST_CHUNKS, ST_BANDS = range(8)
+# The listed pairs come in this many bands by how far apart their boxes were when the list was
+# made, nearest first: a band whose pairs were farther apart than any two objects have drifted
+# since cannot touch yet, and the narrow phase skips it.
+BANDS = 8
+STATE_SIZE = ST_BANDS + BANDS + 1
+# A pair's distance is taken this much (px) short when its band is chosen: room for rounding.
+BAND_SLACK_PX = 1e-6
 # Where its `params` array keeps the margin, the grid's cell, the drift slack (px) and this
 # step's drift (px).
 P_MARGIN, P_CELL, P_SLACK, P_DRIFT = range(4)
@@ -148,14 +156,62 @@ def _grow_split(body, lo, hi, margin, dt, chunks):
         _grow_range(body, lo, hi, margin, dt, c * n // chunks, (c + 1) * n // chunks)
 
 
+@njit(cache=True, inline="always")
+def _band(lo, hi, key, margin):
+    """The band of a listed pair (keys of indices into lo, hi: the boxes grown by margin): how
+    far apart the boxes were on the axis they were farthest apart on, in steps of 2 x margin /
+    BANDS (band 0 for boxes that overlap), after BAND_SLACK_PX taken off."""
+    a = key >> KEY_SHIFT
+    b = key & KEY_MASK
+    gap = max(lo[b, 0] - hi[a, 0], lo[a, 0] - hi[b, 0], lo[b, 1] - hi[a, 1], lo[a, 1] - hi[b, 1])
+    apart = (gap + 2.0 * margin - BAND_SLACK_PX) * (BANDS / (2.0 * margin))
+    return min(max(int(apart), 0), BANDS - 1) if apart > 0.0 else 0
+
+
+@njit(cache=True)
+def _by_band(lo, hi, keys, spare, k, margin, state):
+    """Put keys[:k] into spare by band, nearest band first, each band in the order it had (a
+    counting sort); state[ST_BANDS + j] is where band j begins."""
+    for j in range(BANDS + 1):
+        state[ST_BANDS + j] = 0
+    for c in range(k):
+        state[ST_BANDS + _band(lo, hi, keys[c], margin) + 1] += 1
+    for j in range(BANDS):
+        state[ST_BANDS + j + 1] += state[ST_BANDS + j]
+    for c in range(k):
+        j = _band(lo, hi, keys[c], margin)
+        spare[state[ST_BANDS + j]] = keys[c]
+        state[ST_BANDS + j] += 1
+    for j in range(BANDS, 0, -1):  # each band's end back to its start
+        state[ST_BANDS + j] = state[ST_BANDS + j - 1]
+    state[ST_BANDS] = 0
+
+
+@njit(cache=True)
+def within_reach(state, params):
+    """How many of the listed pairs (a prefix, by band) the narrow phase tests this step: the
+    bands whose pairs were at most twice the drift (plus slack) apart when the list was made.
+    Any other pair was farther apart than two objects can have closed by drifting since, so it
+    cannot touch yet (the argument that lets the list stand while the drift is below the
+    margin, pair by pair)."""
+    reach = 2.0 * (params[P_DRIFT] + params[P_SLACK])
+    step = 2.0 * params[P_MARGIN] / BANDS
+    j = BANDS
+    for b in range(BANDS):
+        if b * step > reach:
+            j = b
+            break
+    return state[ST_BANDS + j]
+
+
 @njit(cache=True)
 def relist(S, dt, bp):
     """Make the candidate list anew from the boxes grown by the margin, each over the step of dt
-    s just taken (so that a pair that cut a corner within it is listed), put the objects inside
-    in the broad phase's order (sweep and cells) and anchor every object where it is. Returns
-    (the key buffer, possibly grown; how many keys)."""
+    s just taken (so that a pair that cut a corner within it is listed), sort it by band, put
+    the objects inside in the broad phase's order (sweep and cells) and anchor every object where
+    it is. Returns (the key buffers, possibly grown: the list and a spare; how many keys)."""
     body, inv_mass, static, movable, ext, rank, anchor = S
-    keys, near, order, lo, hi, folds, state, params, ws, when, finder, scratch = bp
+    keys, near, order, lo, hi, folds, state, params, ws, when, finder, scratch, spare = bp
     margin = params[P_MARGIN]
     chunks = state[ST_CHUNKS]
     n = body.shape[0]
@@ -168,13 +224,18 @@ def relist(S, dt, bp):
     while k > keys.shape[0]:
         keys = np.empty(2 * k, np.int64)
         k = _candidates(finder, lo, hi, movable, cell, order, keys, ws, chunks)
+    if spare.shape[0] < keys.shape[0]:
+        spare = np.empty(keys.shape[0], np.int64)
+    _by_band(lo, hi, keys, spare, k, margin, state)
+    keys, spare = spare, keys
     if state[ST_METHOD] != METHOD_GRID:
         _reorder(S, order, scratch, keys, k, chunks)
     else:
         for i in range(n):
             anchor[i, 0] = body[i, B_X]
             anchor[i, 1] = body[i, B_Y]
-    return keys, k
+    params[P_DRIFT] = 0.0  # every object is at its anchor
+    return keys, spare, k
 
 
 def _candidates(finder, lo, hi, movable, cell, order, keys, ws, chunks):

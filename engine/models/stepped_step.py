@@ -27,6 +27,7 @@ from collide2d.engine.models.stepped_list import (
     ST_POSSIBLE,
     ST_WALLS,
     relist,
+    within_reach,
 )
 from collide2d.engine.models.stepped_motion import log_walls, move_walls
 from collide2d.engine.models.stepped_narrow import narrow
@@ -49,7 +50,7 @@ def step(first, last, S, dt, width, height, exact, cores, tick, t, log, rows, ti
     events, bp): the buffers that grew replace the caller's. What a stage hands the next waits
     in bp between calls: the drift in params[P_DRIFT], the overlapping pairs in state[ST_NEAR]."""
     body, inv_mass, static, movable, ext, rank, anchor = S
-    keys, near, order, lo, hi, folds, state, params, ws, when, finder, scratch = bp
+    keys, near, order, lo, hi, folds, state, params, ws, when, finder, scratch, spare = bp
     chunks = state[ST_CHUNKS]
     if first <= _MOVE < last:
         # move, walls: every object; the walls' events in id order; how far anything drifted
@@ -65,16 +66,18 @@ def step(first, last, S, dt, width, height, exact, cores, tick, t, log, rows, ti
     if first <= _BROAD < last:
         # the candidate list made anew once an object drifted its margin
         if state[ST_KEYS] < 0 or params[P_DRIFT] >= params[P_MARGIN] - params[P_SLACK]:
-            keys, state[ST_KEYS] = relist(S, dt, bp)
-            bp = (keys, near, order, lo, hi, folds, state, params, ws, when, finder, scratch)
+            keys, spare, state[ST_KEYS] = relist(S, dt, bp)
+            bp = (keys, near, order, lo, hi, folds, state, params, ws, when, finder, scratch, spare)
     if first <= _NARROW < last:
-        # the listed pairs in contact this step, in the order their contacts began
-        state[ST_NEAR] = narrow(body, ext, keys, state[ST_KEYS], near, when, dt, chunks)
+        # the listed pairs in contact this step, in the order their contacts began, from the
+        # bands near enough to touch by now
+        n_keys = within_reach(state, params)
+        state[ST_NEAR] = narrow(body, ext, keys, n_keys, near, when, dt, chunks)
         while state[ST_NEAR] > near.shape[0]:
             near = np.empty(2 * state[ST_NEAR], np.int64)
             when = np.empty(2 * state[ST_NEAR])
-            bp = (keys, near, order, lo, hi, folds, state, params, ws, when, finder, scratch)
-            state[ST_NEAR] = narrow(body, ext, keys, state[ST_KEYS], near, when, dt, chunks)
+            bp = (keys, near, order, lo, hi, folds, state, params, ws, when, finder, scratch, spare)
+            state[ST_NEAR] = narrow(body, ext, keys, n_keys, near, when, dt, chunks)
     if first <= _RESPONSE < last:
         rows, times, n_ev = respond(
             S,
@@ -103,11 +106,13 @@ def run(world, substeps, tick0, ticks, log, S, exact, cores, rows, times, bp):
     many events, bp): the buffers that grew replace the caller's.
 
     S: the state arrays (a `stepped.State`). bp = (keys, near, order, lo, hi, folds, state,
-    params, ws, when, finder, scratch): the candidate list kept between calls and scratch
+    params, ws, when, finder, scratch, spare): the candidate list kept between calls (sorted by
+    band, stepped_list.within_reach) and scratch
     (`near`, `when`: this step's pairs in contact and the times their contacts began; `order`,
     `lo`, `hi`, `ws`: the broad phase's; `folds`: the move's fold rows; `finder`: the marker of
     the method, broadphase.marker, so that a kernel compiles only that pair finder; `scratch`:
-    the reorder's, stepped_list); state and params as stepped_list names their slots (ST_*,
+    the reorder's, stepped_list; `spare`: a second key buffer the relist sorts into); state and
+    params as stepped_list names their slots (ST_*,
     P_*).
     """
     width, height, fps = world

@@ -9,11 +9,20 @@ from hypothesis import strategies as st
 
 from collide2d.engine.broadphase import KEY_SHIFT
 from collide2d.engine.contact import box_clip, box_step_contact, box_sweep
-from collide2d.engine.events import AXIS_NAMES, EV_PAIR, EV_WALL, SIDE_LEFT, SIDE_RIGHT
+from collide2d.engine.events import (
+    AXIS_NAMES,
+    EV_PAIR,
+    EV_WALL,
+    SIDE_LEFT,
+    SIDE_RIGHT,
+    new_log,
+)
 from collide2d.engine.invariants import kinetic_energy, momentum
 from collide2d.engine.models import make
 from collide2d.engine.models.stepped import STAGES
-from collide2d.engine.models.stepped_list import ST_KEYS
+from collide2d.engine.models.stepped_list import BANDS, ST_BANDS, ST_KEYS, within_reach
+from collide2d.engine.models.stepped_narrow import narrow
+from collide2d.engine.models.stepped_step import step
 from collide2d.engine.response import exchange, fold, separate
 from collide2d.engine.world import KIND_CIRCLE, Bodies, Looks, WorldSpec
 
@@ -378,8 +387,8 @@ def test_a_large_crowd_through_each_method_gives_the_same_bytes():
 @pytest.mark.parametrize("broadphase", ["sweep", "cells"])
 def test_the_candidate_list_reads_the_objects_front_to_back(broadphase):
     # each time the list is made the objects inside are put in the broad phase's order and the
-    # listed pairs renamed to match, so that the pair tests read the state as one stream: the
-    # first (lower) index of the listed pairs never goes back, whatever the objects did since
+    # listed pairs renamed to match, so that the pair tests read the state as one stream: within
+    # each band of the list the first (lower) index never goes back, whatever the objects did
     world = WorldSpec(1600, 1200, 30)
     bodies = crowd(2000, 7, world, statics=0.05, sizes=(3.0, 6.0, 9.0))
     model = make("stepped", world, bodies, broadphase=broadphase)
@@ -387,12 +396,45 @@ def test_the_candidate_list_reads_the_objects_front_to_back(broadphase):
     for ticks in (1, 5, 40):
         model.advance(ticks)
         keys, state = model._bp[0], model._bp[6]
-        first = keys[: state[ST_KEYS]] >> KEY_SHIFT
-        assert len(first) > 500
-        assert (np.diff(first) >= 0).all()
+        starts = state[ST_BANDS : ST_BANDS + BANDS + 1]
+        assert starts[0] == 0 and starts[-1] == state[ST_KEYS] > 500
+        for j in range(BANDS):
+            first = keys[starts[j] : starts[j + 1]] >> KEY_SHIFT
+            assert (np.diff(first) >= 0).all()
         ids.append(model._S.ext.copy())
     assert not np.array_equal(ids[0], np.arange(2000))  # not the id order
     assert not np.array_equal(ids[0], ids[2])  # the order followed the objects
+
+
+def test_the_bands_skipped_hold_no_pair_in_contact():
+    # at every step, as the narrow phase sees the state (moved, list made), testing the whole
+    # candidate list finds exactly the pairs that testing only the bands near enough to touch by
+    # now finds; right after a relist only the nearest band is tested, and the share tested grows
+    # with the drift
+    world = WorldSpec(900, 700, 30)
+    bodies = crowd(1500, 11, world, statics=0.05, sizes=(4.0, 8.0, 12.0))
+    model = make("stepped", world, bodies)
+    dt = 1.0 / world.fps
+    rows, times = new_log(False)
+    shares = []
+    contacts = 0
+    for tick in range(1, 61):
+        for first, last in ((0, 2), (2, 4)):  # move and broad; narrow and response
+            if first == 2:
+                keys, state, params = model._bp[0], model._bp[6], model._bp[7]
+                found = []
+                for n_keys in (state[ST_KEYS], within_reach(state, params)):
+                    near, when = np.empty(4000, np.int64), np.empty(4000)
+                    k = narrow(model._S.body, model._S.ext, keys, n_keys, near, when, dt, 1)
+                    found.append(near[:k].tolist())
+                assert found[0] == found[1]
+                contacts += len(found[0])
+                shares.append(within_reach(state, params) / state[ST_KEYS])
+            rows, times, _, model._bp = step(
+                first, last, model._S, dt, 900.0, 700.0, False, model._cores, tick, tick * dt,
+                False, rows, times, 0, model._bp,
+            )  # fmt: skip
+    assert contacts > 100 and min(shares) < 0.3 and max(shares) > 1.5 * min(shares)
 
 
 def test_exact_shapes_keep_their_ids_whatever_the_order_inside():
