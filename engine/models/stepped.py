@@ -50,9 +50,10 @@ from typing import NamedTuple
 
 import numpy as np
 
-from collide2d.engine.broadphase import METHOD_SWEEP, choose, marker, workspace
+from collide2d.engine.broadphase import KEY_SHIFT, METHOD_SWEEP, choose, marker, workspace
 from collide2d.engine.events import event_records, new_log
 from collide2d.engine.models.stepped_list import (  # noqa: F401  (_candidates: tests)
+    BAND_SHIFT,
     ST_CHUNKS,
     ST_PAIRS,
     ST_WALLS,
@@ -108,6 +109,8 @@ class Model:
         skip: bool = True,
         broadphase: str | None = None,
     ):
+        if bodies.n >= 1 << (BAND_SHIFT - KEY_SHIFT):
+            raise ValueError(f"at most {(1 << (BAND_SHIFT - KEY_SHIFT)) - 1} objects")
         if int(substeps) != substeps or substeps < 1:
             raise ValueError(f"substeps must be a whole number >= 1, got {substeps!r}")
         geometry = "box" if geometry is None else geometry

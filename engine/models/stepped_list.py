@@ -17,6 +17,8 @@ order inside: events, their order and the pairs' order go by object id.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from collide2d.engine.broadphase import (
@@ -43,6 +45,14 @@ BANDS = 8
 STATE_SIZE = ST_BANDS + BANDS + 1
 # A pair's distance is taken this much (px) short when its band is chosen: room for rounding.
 BAND_SLACK_PX = 1e-6
+# While the list is sorted by band, a key holds its band above BAND_SHIFT.
+BAND_SHIFT = 60
+PAIR_MASK = (1 << BAND_SHIFT) - 1
+# The objects inside are put back in the broad phase's order once they have strayed from it by
+# more than this many rows of the grid on average (a row holds about sqrt(n) objects in a
+# squarish world): a few rows apart still share the cache, and a reorder costs a pass over the
+# state.
+REORDER_ROWS = 0.5
 # Where its `params` array keeps the margin, the grid's cell, the drift slack (px) and this
 # step's drift (px).
 P_MARGIN, P_CELL, P_SLACK, P_DRIFT = range(4)
@@ -174,13 +184,15 @@ def _by_band(lo, hi, keys, spare, k, margin, state):
     counting sort); state[ST_BANDS + j] is where band j begins."""
     for j in range(BANDS + 1):
         state[ST_BANDS + j] = 0
-    for c in range(k):
-        state[ST_BANDS + _band(lo, hi, keys[c], margin) + 1] += 1
+    for c in range(k):  # each key's band kept in its top bits (indices stay below 2**28)
+        j = _band(lo, hi, keys[c], margin)
+        state[ST_BANDS + j + 1] += 1
+        keys[c] |= j << BAND_SHIFT
     for j in range(BANDS):
         state[ST_BANDS + j + 1] += state[ST_BANDS + j]
     for c in range(k):
-        j = _band(lo, hi, keys[c], margin)
-        spare[state[ST_BANDS + j]] = keys[c]
+        j = keys[c] >> BAND_SHIFT
+        spare[state[ST_BANDS + j]] = keys[c] & PAIR_MASK
         state[ST_BANDS + j] += 1
     for j in range(BANDS, 0, -1):  # each band's end back to its start
         state[ST_BANDS + j] = state[ST_BANDS + j - 1]
@@ -202,6 +214,17 @@ def within_reach(state, params):
             j = b
             break
     return state[ST_BANDS + j]
+
+
+@njit(cache=True)
+def _strayed(order):
+    """Whether the objects inside have strayed from the broad phase's `order` by more than
+    REORDER_ROWS rows of a square grid on average (a row holds about sqrt(n) objects)."""
+    n = order.shape[0]
+    stray = 0
+    for s in range(n):
+        stray += abs(order[s] - s)
+    return stray > REORDER_ROWS * math.sqrt(n) * n
 
 
 @njit(cache=True)
@@ -228,7 +251,7 @@ def relist(S, dt, bp):
         spare = np.empty(keys.shape[0], np.int64)
     _by_band(lo, hi, keys, spare, k, margin, state)
     keys, spare = spare, keys
-    if state[ST_METHOD] != METHOD_GRID:
+    if state[ST_METHOD] != METHOD_GRID and _strayed(order):
         _reorder(S, order, scratch, keys, k, chunks)
     else:
         for i in range(n):
