@@ -28,7 +28,9 @@ object has drifted that margin from where it was when the list was made. While n
 pair overlapping now was on the list (each box moved less than the margin), so each step only
 tests the listed pairs on the current boxes (and their sweeps over the step: each box's path lies
 within its margin too), sorts the few in contact, and takes them in that order: exactly the
-pairs, in exactly the order, of testing every pair. Pairs of two static
+pairs, in exactly the order, of testing every pair. The same argument pair by pair lets a step
+skip the listed pairs that were farther apart than twice the drift so far: the list is kept in
+bands by that distance (stepped_list.within_reach). Pairs of two static
 objects are never listed, and with no movable object (or fewer than two objects) the pair stage is
 skipped; the `skip=False` option turns both skips off, and `broadphase` ("sweep", "grid",
 "cells") forces a method instead of the scene's choice (for tests and `collide2d bench`).

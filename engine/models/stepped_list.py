@@ -1,18 +1,24 @@
 """The stepped model's candidate list (a Verlet list): the pairs that could touch until some
-object has drifted its margin, made anew only then, and the order the objects are kept in.
+object has drifted its margin, made anew only then, kept in bands by distance, and the order the
+objects are kept in.
 
 Input: the state (`stepped.State`), the step just taken, the margin (px) and the broad phase's
 method, cell and scratch (the `bp` tuple the model keeps, see `stepped_step.run`). Output: the
-candidate keys (pairs of indices inside, `broadphase.KEY_SHIFT`), each object anchored where it
-is, and the state put in the broad phase's order.
+candidate keys (pairs of indices inside, `broadphase.KEY_SHIFT`) sorted by band, where each band
+begins (in the model's `state`), each object anchored where it is, and the state put back in the
+broad phase's order when it strayed from it.
 
 The broad phase (broadphase.py) lists the pairs whose boxes, each grown by the margin over the
-step just taken, overlap. Each time the list is made the objects are put in the order the broad
-phase found them in (the cells' row-by-row order, or the sweep's order on x), and the keys are
-renamed to match: objects near in space are then near in memory, so the pair tests that follow
-read two streams of rows instead of scattered ones, which keeps a large scene in the cache. The
-grid method (mixed sizes) keeps the order it has. Nothing that reaches the outside depends on the
-order inside: events, their order and the pairs' order go by object id.
+step just taken, overlap. The list is sorted into BANDS bands by how far apart each pair's boxes
+were (nearest first, each band in the broad phase's order): a pair farther apart than twice the
+largest drift since cannot touch yet, so a step tests only a prefix of the list
+(`within_reach`). When the objects have strayed from the order the broad phase found them in
+(the cells' row-by-row order, or the sweep's order on x) by more than REORDER_ROWS rows on
+average, they are put back in it and the keys renamed to match: objects near in space are then
+near in memory, so the pair tests that follow read streams of rows instead of scattered ones,
+which keeps a large scene in the cache. The grid method (mixed sizes) keeps the order it has.
+Nothing that reaches the outside depends on the order inside: events, their order and the pairs'
+order go by object id.
 """
 
 from __future__ import annotations
