@@ -266,16 +266,17 @@ def cell_candidates(lo, hi, movable, cell, order, out, ws):
     if n < 2:
         return 0
     nx, ny = _cell_grid(lo, hi, cell, order, ws)  # the counting sort by cell
-    key, start, box = ws[2], ws[3], ws[4]
-    return _cell_pairs(0, n, order, key, start, box, movable, nx, ny, out, 0, out.shape[0])
+    cxy, start, box = ws[5], ws[3], ws[4]
+    return _cell_pairs(0, n, order, cxy, start, box, movable, nx, ny, out, 0, out.shape[0])
 
 
 @njit(cache=True)
 def _cell_grid(lo, hi, cell, order, ws):
     """The counting sort of `cell_candidates`: (nx, ny) of its grid; order, ws[2] (each box's
-    cell), ws[3] (cell starts) and ws[4] (boxes by slot) filled."""
+    cell), ws[3] (cell starts), ws[4] (boxes by slot) and ws[5] (each box's column and row, in
+    its first two columns, so that the pair tests need no division) filled."""
     n = lo.shape[0]
-    key, start, box = ws[2], ws[3], ws[4]
+    key, start, box, cxy = ws[2], ws[3], ws[4], ws[5]
     x0, y0, x1, y1, side = _bounds(lo, hi)
     span_x = x1 - x0
     span_y = y1 - y0
@@ -291,7 +292,11 @@ def _cell_grid(lo, hi, cell, order, ws):
     for c in range(nx * ny + 2):
         start[c] = 0
     for i in range(n):
-        c = _cell_of(lo[i, 1], y0, inv, ny - 1) * nx + _cell_of(lo[i, 0], x0, inv, nx - 1)
+        cx = _cell_of(lo[i, 0], x0, inv, nx - 1)
+        cy = _cell_of(lo[i, 1], y0, inv, ny - 1)
+        cxy[i, 0] = cx
+        cxy[i, 1] = cy
+        c = cy * nx + cx
         key[i] = c
         start[c + 1] += 1
     for c in range(nx * ny):
@@ -310,16 +315,16 @@ def _cell_grid(lo, hi, cell, order, ws):
 
 
 @njit(cache=True)
-def _cell_pairs(s0, s1, order, key, start, box, movable, nx, ny, out, base, room):
-    """The pairs of `cell_candidates` for the boxes in slots s0 ... s1-1, written to
-    out[base:base + room] while they fit; returns how many."""
+def _cell_pairs(s0, s1, order, cxy, start, box, movable, nx, ny, out, base, room):
+    """The pairs of `cell_candidates` for the boxes in slots s0 ... s1-1 (cxy: each box's
+    column and row), written to out[base:base + room] while they fit; returns how many."""
     k = 0
     m = room
     for s in range(s0, s1):
         a = order[s]
-        c = key[a]
-        cx = c % nx
-        cy = c // nx
+        cx = cxy[a, 0]
+        cy = cxy[a, 1]
+        c = cy * nx + cx
         ma = movable[a]
         lax, lay, hax, hay = box[s, 0], box[s, 1], box[s, 2], box[s, 3]
         # two runs of slots: the later boxes of its own cell and those of the cell to its right
@@ -351,7 +356,7 @@ def _cell_pairs(s0, s1, order, key, start, box, movable, nx, ny, out, base, room
 
 
 @njit(cache=True, parallel=True)
-def _cell_pairs_split(order, key, start, box, movable, nx, ny, out, n, found):
+def _cell_pairs_split(order, cxy, start, box, movable, nx, ny, out, n, found):
     """`_cell_pairs` over all n slots cut into len(found) contiguous runs, one per thread, each
     writing into its own share of `out`; the shares are then moved together in run order, so the
     keys come in the order one thread gives. When a share is too small the count returned is
@@ -361,7 +366,7 @@ def _cell_pairs_split(order, key, start, box, movable, nx, ny, out, n, found):
     share = room // chunks
     for c in prange(chunks):
         found[c] = _cell_pairs(
-            c * n // chunks, (c + 1) * n // chunks, order, key, start, box, movable, nx, ny,
+            c * n // chunks, (c + 1) * n // chunks, order, cxy, start, box, movable, nx, ny,
             out, c * share, share,
         )
     total = shares_total(found, share, room)
@@ -389,9 +394,7 @@ def cell_candidates_split_into(lo, hi, movable, cell, order, out, ws, found):
     if n < 2:
         return 0
     nx, ny = _cell_grid(lo, hi, cell, order, ws)
-    return _cell_pairs_split(order, ws[2], ws[3], ws[4], movable, nx, ny, out, n, found)
-
-
+    return _cell_pairs_split(order, ws[5], ws[3], ws[4], movable, nx, ny, out, n, found)
 
 
 def choose(

@@ -1,11 +1,11 @@
 """How many threads the kernels may use, and from what size a stage splits its work among them.
 
-The stages that split their work (the stepped model's move and narrow phase, the rasteriser's full
-redraw) cut it into a fixed number of contiguous chunks, run the chunks on numba's threads
-(`prange`), and join the chunks' results in chunk order: every chunk does exactly the arithmetic
-one thread would do on its share, so results are the same bytes with one thread or many. A stage
-splits only for scenes of at least PARALLEL_MIN_OBJECTS objects (below that, starting the threads
-costs more than they save) and only when more than one thread is allowed.
+The stages that split their work (the stepped model's move, narrow phase and relist, the
+rasteriser's full redraw) cut it into a fixed number of contiguous chunks, run the chunks on
+numba's threads (`prange`), and join the chunks' results in chunk order: every chunk does exactly
+the arithmetic one thread would do on its share, so results are the same bytes with one thread or
+many. A stage splits only for scenes of at least PARALLEL_MIN_OBJECTS objects (below that,
+starting the threads costs more than they save) and only when more than one thread is allowed.
 
 `shares_total` and `join_shares` join a split stage's results: each chunk writes into its own
 share of one buffer, and the shares are moved together in chunk order.

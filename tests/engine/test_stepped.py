@@ -7,11 +7,28 @@ from engine_refs import random_boxes
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from collide2d.engine.broadphase import KEY_SHIFT
 from collide2d.engine.contact import box_clip, box_step_contact, box_sweep
-from collide2d.engine.events import AXIS_NAMES, EV_PAIR, EV_WALL, SIDE_LEFT, SIDE_RIGHT
+from collide2d.engine.events import (
+    AXIS_NAMES,
+    EV_PAIR,
+    EV_WALL,
+    SIDE_LEFT,
+    SIDE_RIGHT,
+    new_log,
+)
 from collide2d.engine.invariants import kinetic_energy, momentum
 from collide2d.engine.models import make
 from collide2d.engine.models.stepped import STAGES
+from collide2d.engine.models.stepped_list import (
+    BANDS,
+    REORDER_ROWS,
+    ST_BANDS,
+    ST_KEYS,
+    within_reach,
+)
+from collide2d.engine.models.stepped_narrow import narrow
+from collide2d.engine.models.stepped_step import step
 from collide2d.engine.response import exchange, fold, separate
 from collide2d.engine.world import KIND_CIRCLE, Bodies, Looks, WorldSpec
 
@@ -371,6 +388,60 @@ def test_a_large_crowd_through_each_method_gives_the_same_bytes():
     runs.append((events.tobytes(), chunked.positions().tobytes(), chunked.velocities().tobytes()))
     assert all(r == runs[0] for r in runs)
     assert len(np.frombuffer(runs[0][0], dtype=events.dtype)) > 100
+
+
+@pytest.mark.parametrize("broadphase", ["sweep", "cells"])
+def test_the_objects_inside_follow_the_broad_phases_order(broadphase):
+    # each time the list is made the objects inside are put back in the broad phase's order
+    # once they strayed from it by more than REORDER_ROWS rows on average, and the listed pairs
+    # renamed to match: the pair tests read the state as near-sequential streams
+    world = WorldSpec(1600, 1200, 30)
+    n = 2000
+    bodies = crowd(n, 7, world, statics=0.05, sizes=(3.0, 6.0, 9.0))
+    model = make("stepped", world, bodies, broadphase=broadphase)
+    ids = []
+    for ticks in (1, 5, 40, 60):
+        model.advance(ticks)
+        order = model._bp[2]
+        assert np.abs(order - np.arange(n)).sum() <= REORDER_ROWS * np.sqrt(n) * n
+        keys, state = model._bp[0], model._bp[6]
+        starts = state[ST_BANDS : ST_BANDS + BANDS + 1]
+        assert starts[0] == 0 and starts[-1] == state[ST_KEYS] > 500
+        pairs = keys[: state[ST_KEYS]]
+        assert (pairs >> KEY_SHIFT < (pairs & ((1 << KEY_SHIFT) - 1))).all()
+        ids.append(model._S.ext.copy())
+    assert not np.array_equal(ids[0], ids[-1])  # the order followed the objects
+
+
+def test_the_bands_skipped_hold_no_pair_in_contact():
+    # at every step, as the narrow phase sees the state (moved, list made), testing the whole
+    # candidate list finds exactly the pairs that testing only the bands near enough to touch by
+    # now finds; right after a relist only the nearest band is tested, and the share tested grows
+    # with the drift
+    world = WorldSpec(900, 700, 30)
+    bodies = crowd(1500, 11, world, statics=0.05, sizes=(4.0, 8.0, 12.0))
+    model = make("stepped", world, bodies)
+    dt = 1.0 / world.fps
+    rows, times = new_log(False)
+    shares = []
+    contacts = 0
+    for tick in range(1, 61):
+        for first, last in ((0, 2), (2, 4)):  # move and broad; narrow and response
+            if first == 2:
+                keys, state, params = model._bp[0], model._bp[6], model._bp[7]
+                found = []
+                for n_keys in (state[ST_KEYS], within_reach(state, params)):
+                    near, when = np.empty(4000, np.int64), np.empty(4000)
+                    k = narrow(model._S.body, model._S.ext, keys, n_keys, near, when, dt, 1)
+                    found.append(near[:k].tolist())
+                assert found[0] == found[1]
+                contacts += len(found[0])
+                shares.append(within_reach(state, params) / state[ST_KEYS])
+            rows, times, _, model._bp = step(
+                first, last, model._S, dt, 900.0, 700.0, False, model._cores, tick, tick * dt,
+                False, rows, times, 0, model._bp,
+            )  # fmt: skip
+    assert contacts > 100 and min(shares) < 0.3 and max(shares) > 1.5 * min(shares)
 
 
 def test_exact_shapes_keep_their_ids_whatever_the_order_inside():

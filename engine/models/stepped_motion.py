@@ -1,0 +1,141 @@
+"""The stepped model's first stage: every object moves for one step and folds back at the walls.
+
+Input: the model's state (`stepped.State`: one row of `body` per object, x, y, vx, vy, w, h and
+the room it has on each axis, in the broad phase's order) and the step dt. Output: the state moved
+in place, the wall folds as rows (object id and axis, folds at the low and the high wall, which
+came first) logged in id order, and how far any object now is from where the candidate list was
+made (its anchor), which tells the candidate list when to be made anew.
+
+Each object's row is read and written once, in order: a stream through memory. Scenes of many
+objects cut the objects into contiguous runs, one per thread (`engine.threads`), whose fold rows
+are joined in run order: the same rows, drift and state, to the bit, on any number of threads.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from collide2d.engine.events import EV_WALL, SIDE_BOTTOM, SIDE_LEFT, SIDE_RIGHT, SIDE_TOP, log_event
+from collide2d.engine.jit import njit, prange
+from collide2d.engine.response import fold
+from collide2d.engine.sort import heap_argsort
+
+# The columns of a row of the state's `body` (n, 8) float64: the top-left corner (px), the
+# velocity (px/s), the box's size (px) and its span, the world's side less the box's (px).
+B_X, B_Y, B_VX, B_VY, B_W, B_H, B_SX, B_SY = range(8)
+BODY_COLUMNS = 8
+
+
+@njit(cache=True, inline="always")
+def _fold_row(folds, n_folds, e, axis, low, high, first_low):
+    """Note that object e folded on `axis` (low, high folds; the low wall first)."""
+    if low + high == 0:
+        return n_folds
+    folds[n_folds, 0] = 2 * e + axis  # the order of the events: by id, x before y
+    folds[n_folds, 1] = low
+    folds[n_folds, 2] = high
+    folds[n_folds, 3] = first_low
+    return n_folds + 1
+
+
+@njit(cache=True)
+def _move_range(body, static, ext, anchor, first, last, dt, folds, n_folds):
+    """Move objects first ... last-1 (inside) for dt seconds and reflect each back into the
+    world; their fold rows go to folds from row n_folds. Returns (rows now, the farthest any of
+    them is from its anchor on an axis, px)."""
+    drift = 0.0
+    for i in range(first, last):
+        if static[i]:
+            continue
+        x = body[i, B_X] + body[i, B_VX] * dt
+        y = body[i, B_Y] + body[i, B_VY] * dt
+        sx = body[i, B_SX]
+        if not (sx > 0.0 and 0.0 <= x and x <= sx):  # inside, fold would change nothing
+            x, vx, low, high, first_low = fold(x, body[i, B_VX], sx)
+            body[i, B_VX] = vx
+            n_folds = _fold_row(folds, n_folds, ext[i], 0, low, high, first_low)
+        sy = body[i, B_SY]
+        if not (sy > 0.0 and 0.0 <= y and y <= sy):
+            y, vy, low, high, first_low = fold(y, body[i, B_VY], sy)
+            body[i, B_VY] = vy
+            n_folds = _fold_row(folds, n_folds, ext[i], 1, low, high, first_low)
+        body[i, B_X] = x
+        body[i, B_Y] = y
+        drift = max(drift, abs(x - anchor[i, 0]), abs(y - anchor[i, 1]))
+    return n_folds, drift
+
+
+@njit(cache=True)
+def move_walls(body, static, ext, anchor, dt, folds, chunks):
+    """Move every object for dt seconds, then reflect it back into the world, split among
+    `chunks` threads when more than one (`_move_chunks`). folds (2n, 4) int64 receives a row per
+    object and axis that folded. Returns (how many rows, the farthest any object now is from its
+    anchor on an axis, px)."""
+    if chunks > 1:
+        return _move_chunks(body, static, ext, anchor, dt, folds, chunks)
+    return _move_range(body, static, ext, anchor, 0, body.shape[0], dt, folds, 0)
+
+
+@njit(cache=True, parallel=True)
+def _move_chunks(body, static, ext, anchor, dt, folds, chunks):
+    """Run c of `chunks` writes its fold rows from row 2 x its first object (each object folds
+    on two axes at most); then the runs' rows are moved together in run order."""
+    n = body.shape[0]
+    rows = np.zeros(chunks, np.int64)
+    drifts = np.zeros(chunks)
+    for c in prange(chunks):
+        first = c * n // chunks
+        k, d = _move_range(
+            body, static, ext, anchor, first, (c + 1) * n // chunks, dt, folds, 2 * first
+        )
+        rows[c] = k - 2 * first
+        drifts[c] = d
+    n_folds = 0
+    drift = 0.0
+    for c in range(chunks):
+        first = 2 * (c * n // chunks)
+        for r in range(rows[c]):
+            for col in range(4):
+                folds[n_folds + r, col] = folds[first + r, col]
+        n_folds += rows[c]
+        drift = max(drift, drifts[c])
+    return n_folds, drift
+
+
+@njit(cache=True)
+def _log_folds(rows, times, n_ev, tick, t, i, low, high, first_low, side_low, side_high):
+    """Log one wall event per fold, alternating from the wall hit first."""
+    at_low = first_low
+    for _ in range(low + high):
+        rows, times = log_event(
+            rows, times, n_ev, tick, t, EV_WALL, i, -1, side_low if at_low else side_high
+        )
+        n_ev += 1
+        at_low = not at_low
+    return rows, times, n_ev
+
+
+@njit(cache=True)
+def log_walls(folds, n_folds, tick, t, rows, times, n_ev):
+    """Log the wall events of the fold rows in id order (x before y): one per fold, alternating
+    from the wall hit first."""
+    order = heap_argsort(folds[:n_folds, 0].copy())
+    for r in range(n_folds):
+        row = order[r]
+        e, axis = folds[row, 0] // 2, folds[row, 0] % 2
+        side_low = SIDE_LEFT if axis == 0 else SIDE_TOP
+        side_high = SIDE_RIGHT if axis == 0 else SIDE_BOTTOM
+        rows, times, n_ev = _log_folds(
+            rows,
+            times,
+            n_ev,
+            tick,
+            t,
+            e,
+            folds[row, 1],
+            folds[row, 2],
+            folds[row, 3] != 0,
+            side_low,
+            side_high,
+        )
+    return rows, times, n_ev

@@ -1,0 +1,115 @@
+"""The stepped model's response: each pair in contact after a step, in the order its contact
+began, gets the elastic exchange and is pushed apart.
+
+Input: the state (`stepped.State`), `near` from the narrow phase (keys of object ids, in order)
+and the step dt. Output: velocities and positions changed in place, each pair that responded
+counted and, when the log is on, logged.
+
+Each pair is tested again on the current state, so that it sees what the pairs before it
+changed. The normal is the axis along which the pair started overlapping, found from its relative
+velocity (contact.box_step_contact; for exact shapes the direction of approach,
+contact.step_contact); an approaching pair gets the exchange (response.exchange) and is pushed
+apart along it by twice the depth it went in since that instant (response.separate).
+"""
+
+from __future__ import annotations
+
+from collide2d.engine.broadphase import KEY_MASK, KEY_SHIFT
+from collide2d.engine.contact import box_step_contact, step_contact
+from collide2d.engine.events import EV_PAIR, log_event
+from collide2d.engine.jit import njit
+from collide2d.engine.models.stepped_list import ST_PAIRS
+from collide2d.engine.models.stepped_motion import B_H, B_VX, B_VY, B_W, B_X, B_Y
+from collide2d.engine.response import exchange, separate
+
+
+@njit(cache=True)
+def _contact(a, b, ea, eb, body, dt, exact, shape, radius, start, verts, normals):
+    """(push, push_y, code, nx, ny) of a pair after a step of dt s (a, b inside; ea, eb their
+    ids): the normal from the direction of approach, contact.box_step_contact / step_contact;
+    push <= 0 when they do not overlap."""
+    qx = body[b, B_X] - body[a, B_X]
+    qy = body[b, B_Y] - body[a, B_Y]
+    ux = body[b, B_VX] - body[a, B_VX]
+    uy = body[b, B_VY] - body[a, B_VY]
+    wa, ha, wb, hb = body[a, B_W], body[a, B_H], body[b, B_W], body[b, B_H]
+    if not exact:
+        return box_step_contact(qx, qy, ux, uy, wa, ha, wb, hb, dt)
+    return step_contact(
+        qx,
+        qy,
+        ux,
+        uy,
+        dt,
+        shape[ea],
+        wa,
+        ha,
+        radius[ea],
+        verts[start[ea] : start[ea + 1]],
+        normals[start[ea] : start[ea + 1]],
+        shape[eb],
+        wb,
+        hb,
+        radius[eb],
+        verts[start[eb] : start[eb + 1]],
+        normals[start[eb] : start[eb + 1]],
+    )
+
+
+@njit(cache=True)
+def respond(
+    S, dt, width, height, exact, cores, near, n_near, inside, tick, t, log, rows, times, n_ev, state
+):
+    """Respond to every overlapping, approaching pair of `near` (ascending keys of ids) in order,
+    after a step of dt s; count each in state[ST_PAIRS], log it when `log`. inside (k, 3) int64
+    is scratch (the move's fold rows, free by now)."""
+    body, inv_mass, static, movable, ext, rank, anchor = S
+    shape, radius, start, verts, normals = cores
+    pos = body  # its columns 0, 1: the corners, as response.separate reads them
+    size = body[:, B_W : B_H + 1]
+    # First each pair's rows inside and a read of each row, in a short loop whose iterations do
+    # not wait on each other: the reads from memory that a large scene needs (the pairs come in
+    # the order of time, scattered over the state) then overlap instead of following one another.
+    ahead = min(n_near, inside.shape[0])
+    for m in range(ahead):
+        a = rank[near[m] >> KEY_SHIFT]
+        b = rank[near[m] & KEY_MASK]
+        inside[m, 0] = a
+        inside[m, 1] = b
+        inside[m, 2] = (body[a, B_X] < body[b, B_X]) + (inv_mass[a] < inv_mass[b])
+    for m in range(n_near):
+        ea = near[m] >> KEY_SHIFT
+        eb = near[m] & KEY_MASK
+        if m < ahead:
+            a = inside[m, 0]
+            b = inside[m, 1]
+        else:
+            a = rank[ea]
+            b = rank[eb]
+        depth, depth_y, code, nx, ny = _contact(
+            a, b, ea, eb, body, dt, exact, shape, radius, start, verts, normals
+        )
+        if depth <= 0.0:
+            continue
+        vax, vay, vbx, vby, changed = exchange(
+            body[a, B_VX],
+            body[a, B_VY],
+            body[b, B_VX],
+            body[b, B_VY],
+            inv_mass[a],
+            inv_mass[b],
+            code,
+            nx,
+            ny,
+        )
+        if not changed:
+            continue
+        body[a, B_VX], body[a, B_VY], body[b, B_VX], body[b, B_VY] = vax, vay, vbx, vby
+        separate(
+            pos, size, a, b, inv_mass[a], inv_mass[b], code, nx, ny, depth, depth_y, width, height
+        )
+        state[ST_PAIRS] += 1
+        if log:
+            rows, times = log_event(rows, times, n_ev, tick, t, EV_PAIR, ea, eb, code)
+            n_ev += 1
+    return rows, times, n_ev
