@@ -376,18 +376,10 @@ def _cell_pairs_split(order, cxy, start, box, movable, nx, ny, out, n, found):
 
 
 @njit(cache=True)
-def cell_candidates_split(lo, hi, movable, cell, order, out, ws, chunks):
-    """`cell_candidates` with its pair tests split among `chunks` threads: the same keys in the
-    same order (or, when `out` is too small for a share, a count past its size)."""
-    return cell_candidates_split_into(
-        lo, hi, movable, cell, order, out, ws, np.zeros(chunks, np.int64)
-    )
-
-
-@njit(cache=True)
 def cell_candidates_split_into(lo, hi, movable, cell, order, out, ws, found):
-    """`cell_candidates_split` among len(found) threads with `found` (chunks,) int64 as its
-    scratch, allocating nothing (for kernels compiled without reference counting)."""
+    """`cell_candidates` with its pair tests split among len(found) threads, `found` (chunks,)
+    int64 its scratch: the same keys in the same order (or, when `out` is too small for a share,
+    a count past its size). Allocates nothing (for kernels compiled without reference counting)."""
     n = lo.shape[0]
     for i in range(n):
         order[i] = i
@@ -483,6 +475,33 @@ def _find(marker, lo, hi, movable, cell, order, out, ws):
         return cell_candidates(lo, hi, movable, cell, order, out, ws)
 
     return cells
+
+
+def find_split(finder, lo, hi, movable, cell, order, out, ws, found):
+    """`find`, the cells method's pair tests split among len(found) threads when more than one
+    (`cell_candidates_split_into`: the same keys in the same order; found (chunks,) int64 is its
+    scratch). A kernel compiles only the finder its marker names (this body runs only without the
+    JIT)."""
+    if found.shape[0] > 1 and finder.dtype == marker(METHOD_CELLS).dtype:
+        return cell_candidates_split_into(lo, hi, movable, cell, order, out, ws, found)
+    return find(finder, lo, hi, movable, cell, order, out, ws)
+
+
+@overload(find_split)
+def _find_split(finder, lo, hi, movable, cell, order, out, ws, found):
+    if finder.dtype.bitwidth == 32:  # the cells method's marker (`marker`)
+
+        def cells(finder, lo, hi, movable, cell, order, out, ws, found):
+            if found.shape[0] > 1:
+                return cell_candidates_split_into(lo, hi, movable, cell, order, out, ws, found)
+            return find(finder, lo, hi, movable, cell, order, out, ws)
+
+        return cells
+
+    def one(finder, lo, hi, movable, cell, order, out, ws, found):
+        return find(finder, lo, hi, movable, cell, order, out, ws)
+
+    return one
 
 
 def keys_to_pairs(keys: np.ndarray) -> np.ndarray:

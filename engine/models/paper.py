@@ -50,10 +50,8 @@ import numpy as np
 from collide2d.engine.broadphase import (
     KEY_MASK,
     KEY_SHIFT,
-    METHOD_CELLS,
-    cell_candidates_split_into,
     choose,
-    find,
+    find_split,
     marker,
     workspace,
 )
@@ -73,7 +71,7 @@ from collide2d.engine.events import (
     new_log,
     put_row,
 )
-from collide2d.engine.jit import njit, overload, prange
+from collide2d.engine.jit import njit, prange
 from collide2d.engine.motion import paper_rate
 from collide2d.engine.sort import sort_keys
 from collide2d.engine.threads import chunks_for, join_shares
@@ -205,33 +203,6 @@ def _move_split(pos, size, step, period, count, disp, fence, room, reach, tick, 
     return k, strayed, walls
 
 
-def _candidates(finder, lo, hi, movable, cell, order, keys, ws, found):
-    """broadphase.find by the method the marker `finder` names, its pair tests split among
-    len(found) threads for the cells method when more than one (the same keys in the same order;
-    found is scratch). A kernel compiles only the finder its marker names (this body runs only
-    without the JIT)."""
-    if found.shape[0] > 1 and finder.dtype == marker(METHOD_CELLS).dtype:
-        return cell_candidates_split_into(lo, hi, movable, cell, order, keys, ws, found)
-    return find(finder, lo, hi, movable, cell, order, keys, ws)
-
-
-@overload(_candidates)
-def _candidates_of(finder, lo, hi, movable, cell, order, keys, ws, found):
-    if finder.dtype.bitwidth == 32:  # the cells method's marker (broadphase.marker)
-
-        def cells(finder, lo, hi, movable, cell, order, keys, ws, found):
-            if found.shape[0] > 1:
-                return cell_candidates_split_into(lo, hi, movable, cell, order, keys, ws, found)
-            return find(finder, lo, hi, movable, cell, order, keys, ws)
-
-        return cells
-
-    def one(finder, lo, hi, movable, cell, order, keys, ws, found):
-        return find(finder, lo, hi, movable, cell, order, keys, ws)
-
-    return one
-
-
 @njit(cache=True)
 def _relist(pos, size, step, period, count, disp, fence, movable, window, cap, finder, cell,
             order, lo, hi, keys, ws, found):
@@ -256,7 +227,7 @@ def _relist(pos, size, step, period, count, disp, fence, movable, window, cap, f
             fence[i, 2 * ax + 1] = high
             lo[i, ax] = low
             hi[i, ax] = high + size[i, ax]
-    return _candidates(finder, lo, hi, movable, cell, order, keys, ws, found)
+    return find_split(finder, lo, hi, movable, cell, order, keys, ws, found)
 
 
 @njit(cache=True, inline="always")

@@ -54,13 +54,12 @@ import numpy as np
 
 from collide2d.engine.broadphase import KEY_SHIFT, METHOD_SWEEP, choose, marker, workspace
 from collide2d.engine.events import event_records, new_log
-from collide2d.engine.models.stepped_list import (  # noqa: F401  (_candidates: tests)
+from collide2d.engine.models.stepped_list import (
     BAND_SHIFT,
     ST_CHUNKS,
     ST_PAIRS,
     ST_WALLS,
     STATE_SIZE,
-    _candidates,
 )
 from collide2d.engine.models.stepped_motion import BODY_COLUMNS
 from collide2d.engine.models.stepped_step import STAGES, run, step

@@ -30,13 +30,10 @@ import numpy as np
 from collide2d.engine.broadphase import (
     KEY_MASK,
     KEY_SHIFT,
-    METHOD_CELLS,
     METHOD_GRID,
-    cell_candidates_split,
-    find,
-    marker,
+    find_split,
 )
-from collide2d.engine.jit import njit, overload, prange
+from collide2d.engine.jit import njit, prange
 from collide2d.engine.models.stepped_motion import B_H, B_VX, B_VY, B_W, B_X, B_Y
 
 # Where the model's `state` array keeps the keys listed (-1: no list yet), the method, whether
@@ -249,10 +246,11 @@ def relist(S, dt, bp):
     else:
         _grow_range(body, lo, hi, margin, dt, 0, n)
     cell = params[P_CELL]
-    k = _candidates(finder, lo, hi, movable, cell, order, keys, ws, chunks)
+    found = np.zeros(chunks, np.int64)
+    k = find_split(finder, lo, hi, movable, cell, order, keys, ws, found)
     while k > keys.shape[0]:
         keys = np.empty(2 * k, np.int64)
-        k = _candidates(finder, lo, hi, movable, cell, order, keys, ws, chunks)
+        k = find_split(finder, lo, hi, movable, cell, order, keys, ws, found)
     if spare.shape[0] < keys.shape[0]:
         spare = np.empty(keys.shape[0], np.int64)
     _by_band(lo, hi, keys, spare, k, margin, state)
@@ -267,27 +265,3 @@ def relist(S, dt, bp):
     return keys, spare, k
 
 
-def _candidates(finder, lo, hi, movable, cell, order, keys, ws, chunks):
-    """broadphase.find by the method the marker `finder` names, its pair tests split among
-    `chunks` threads for the cells method when more than one (the same keys in the same order).
-    A kernel compiles only the finder its marker names (this body runs only without the JIT)."""
-    if chunks > 1 and finder.dtype == marker(METHOD_CELLS).dtype:
-        return cell_candidates_split(lo, hi, movable, cell, order, keys, ws, chunks)
-    return find(finder, lo, hi, movable, cell, order, keys, ws)
-
-
-@overload(_candidates)
-def _candidates_of(finder, lo, hi, movable, cell, order, keys, ws, chunks):
-    if finder.dtype.bitwidth == 32:  # the cells method's marker (broadphase.marker)
-
-        def cells(finder, lo, hi, movable, cell, order, keys, ws, chunks):
-            if chunks > 1:
-                return cell_candidates_split(lo, hi, movable, cell, order, keys, ws, chunks)
-            return find(finder, lo, hi, movable, cell, order, keys, ws)
-
-        return cells
-
-    def one(finder, lo, hi, movable, cell, order, keys, ws, chunks):
-        return find(finder, lo, hi, movable, cell, order, keys, ws)
-
-    return one

@@ -136,7 +136,6 @@ import numpy as np
 from numba import njit
 from numba.core import event
 from collide2d.engine import broadphase as bp
-from collide2d.engine.models import stepped
 
 compiled = set()
 
@@ -153,8 +152,8 @@ event.register("numba:compile", Listen())
 
 
 @njit
-def stepped_candidates(finder, lo, hi, movable, cell, order, keys, ws, chunks):
-    return stepped._candidates(finder, lo, hi, movable, cell, order, keys, ws, chunks)
+def split_candidates(finder, lo, hi, movable, cell, order, keys, ws, found):
+    return bp.find_split(finder, lo, hi, movable, cell, order, keys, ws, found)
 
 
 lo = np.array([[0.0, 0.0], [5.0, 5.0], [50.0, 50.0]])
@@ -164,16 +163,18 @@ assert bp.find_pairs(bp.METHOD_SWEEP, lo, hi, movable).tolist() == [[0, 1]]
 keys = np.empty(16, np.int64)
 order = np.arange(3, dtype=np.int64)
 finder = bp.marker(bp.METHOD_SWEEP)
-assert stepped_candidates(finder, lo, hi, movable, 1.0, order, keys, bp.workspace(3), 2) == 1
-names = ("sweep_candidates", "grid_candidates", "cell_candidates", "cell_candidates_split")
+found = np.zeros(2, np.int64)
+assert split_candidates(finder, lo, hi, movable, 1.0, order, keys, bp.workspace(3), found) == 1
+names = ("sweep_candidates", "grid_candidates", "cell_candidates", "cell_candidates_split_into")
 print(*(name for name in names if name in compiled))
 """
 
 
 @pytest.mark.skipif(os.environ.get("NUMBA_DISABLE_JIT") == "1", reason="nothing compiles")
 def test_the_sweep_compiles_no_other_pair_finder(tmp_path):
-    """broadphase.find_pairs (the start-up overlap check) and the stepped model's pair stage
-    compile the one finder their method names, not the grid's and the cells' too."""
+    """broadphase.find_pairs (the start-up overlap check) and broadphase.find_split (the paper
+    and stepped models' pair stages) compile the one finder their method names, not the grid's
+    and the cells' too."""
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
     got = subprocess.run(
         [sys.executable, "-c", FINDERS], capture_output=True, text=True, env=env, check=True

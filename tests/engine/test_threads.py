@@ -160,14 +160,17 @@ def test_the_cells_broad_phase_split_gives_the_same_keys(chunks, room):
     one, split = np.empty(room, np.int64), np.empty(room, np.int64)
     order1, order2 = np.empty(700, np.int64), np.empty(700, np.int64)
     k1 = bp.cell_candidates(lo, hi, movable, 9.5, order1, one, ws)
-    k2 = bp.cell_candidates_split(lo, hi, movable, 9.5, order2, split, bp.workspace(700), chunks)
+    found, ws2 = np.zeros(chunks, np.int64), bp.workspace(700)
+    k2 = bp.cell_candidates_split_into(lo, hi, movable, 9.5, order2, split, ws2, found)
     assert order1.tobytes() == order2.tobytes()
     if k1 <= room and k2 <= room:
         assert k1 == k2 and one[:k1].tobytes() == split[:k2].tobytes() and k1 > 100
     else:  # too small: both ask for more, and then agree
         assert k2 > room
         big = np.empty(2 * max(k1, k2), np.int64)
-        k3 = bp.cell_candidates_split(lo, hi, movable, 9.5, order2, big, bp.workspace(700), chunks)
+        k3 = bp.cell_candidates_split_into(
+            lo, hi, movable, 9.5, order2, big, bp.workspace(700), found
+        )
         full = np.empty(2 * max(k1, k2), np.int64)
         k4 = bp.cell_candidates(lo, hi, movable, 9.5, order1, full, ws)
         assert k3 == k4 and big[:k3].tobytes() == full[:k4].tobytes()
