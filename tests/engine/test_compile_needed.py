@@ -131,11 +131,9 @@ def test_the_sorts_compile_once_not_again_for_a_literal_zero(tmp_path):
     ]
 
 
-FINDERS = """
-import numpy as np
-from numba import njit
+# A script's prefix that collects, in `compiled`, the names of the kernels numba compiles.
+LISTEN = """
 from numba.core import event
-from collide2d.engine import broadphase as bp
 
 compiled = set()
 
@@ -149,6 +147,12 @@ class Listen(event.Listener):
 
 
 event.register("numba:compile", Listen())
+"""
+
+FINDERS = LISTEN + """
+import numpy as np
+from numba import njit
+from collide2d.engine import broadphase as bp
 
 
 @njit
@@ -182,23 +186,9 @@ def test_the_sweep_compiles_no_other_pair_finder(tmp_path):
     assert got == ["sweep_candidates"]
 
 
-SPRITES = """
-from numba.core import event
+SPRITES = LISTEN + """
 from collide2d.engine.sprites import sprites
 from collide2d.runner.scenario import loads
-
-compiled = set()
-
-
-class Listen(event.Listener):
-    def on_start(self, ev):
-        compiled.add(ev.data["dispatcher"].py_func.__name__)
-
-    def on_end(self, ev):
-        pass
-
-
-event.register("numba:compile", Listen())
 scene = loads(
     "version: 1\\nworld: {width: 40, height: 30}\\nticks: 1\\nobjects:\\n"
     "  - {shape: box, size: [3, 2], position: [2, 2]}\\n"
