@@ -20,11 +20,6 @@ object: two static objects never become a pair (SPEC 3: static objects never mov
 - `choose` picks one of the three and its cell from the scene (object count, world size, box
   sizes); `candidates` dispatches to it; `find_pairs` and `sweep_pairs` give the answer as
   sorted (k, 2) pairs (`sweep_pairs` is the reference the tests hold the others to).
-- the exact model's grid: square cells of side `cell` px over the world, each moving object filed
-  by the cell of its box's centre. With the cell at least the largest moving box (plus a margin),
-  two moving objects that touch are in the same or adjacent cells, so an object predicts contacts
-  only against the 3×3 cells around its own. Static objects never move; each is filed in every
-  cell its closed box meets (`static_cells`), so a mover finds it the same way.
 
 The candidate finders write into a caller's key buffer and return how many keys there are; when
 that is more than the buffer holds, only the first keys were written and the caller grows the
@@ -66,16 +61,9 @@ GRID_CELL_PER_SIDE = 1.5
 GRID_CELLS_PER_OBJECT = 4.0
 GRID_FILINGS_PER_OBJECT = 16.0
 
-# The grid's cell is this much larger than the largest moving box, so that rounding at a cell
-# crossing (~1e-12 px) can never hide a touching neighbour two cells away.
+# A grid's cell is this much larger than the largest box it is sized for, so that rounding at a
+# cell crossing (~1e-12 px) can never hide a touching neighbour two cells away.
 CELL_MARGIN = 1.01
-# Aim for about this many moving objects per cell when they are sparse: larger cells mean fewer
-# cell crossings but more neighbours to test. Tuned on a gas of 10,000 boxes (`collide2d bench
-# --part exact`).
-TARGET_PER_CELL = 0.6
-# The grid never has more cells than this per moving object (and at least one cell).
-MAX_CELLS_PER_OBJECT = 4
-
 
 # --- candidate pairs ---------------------------------------------------------------------------
 
@@ -535,7 +523,7 @@ def _find_keys(finder, lo, hi, movable, cell, order, out, ws):
     return find(finder, lo, hi, movable, cell, order, out, ws)
 
 
-# --- the reference answer (tests) and the exact model's grid ------------------------------------
+# --- the reference answer (tests) ----------------------------------------------------------------
 
 
 @njit(cache=True)
@@ -574,59 +562,3 @@ def sweep_pairs(lo, hi, static):
         out[m, 0] = keys[sorted_keys[m]] // n
         out[m, 1] = keys[sorted_keys[m]] % n
     return out
-
-
-def grid_cell(width: float, height: float, size: np.ndarray, static: np.ndarray) -> float:
-    """Side of the exact model's grid cells, px.
-
-    At least CELL_MARGIN × the largest side of a moving box; larger when moving objects are sparse
-    (about TARGET_PER_CELL per cell); never so small that the grid exceeds MAX_CELLS_PER_OBJECT
-    cells per moving object.
-    """
-    moving = ~np.asarray(static, bool)
-    count = int(moving.sum())
-    extent = float(size[moving].max()) if count else 1.0
-    cell = max(extent * CELL_MARGIN, 1e-9)
-    if count:
-        cell = max(cell, math.sqrt(width * height * TARGET_PER_CELL / count))
-        cell = max(cell, math.sqrt(width * height / (MAX_CELLS_PER_OBJECT * count)))
-    return cell
-
-
-def grid_dims(width: float, height: float, cell: float) -> tuple[int, int]:
-    """(columns, rows) of cells of side `cell` covering [0, width) × [0, height)."""
-    return max(1, math.ceil(width / cell)), max(1, math.ceil(height / cell))
-
-
-@njit(cache=True)
-def static_cells(pos, size, static, cell, nx, ny):
-    """Cells each static object is filed in: every cell its closed box meets.
-
-    pos, size (n, 2) px; static (n,) bool; cell px; nx × ny cells. Returns (start, items): the
-    static objects of cell c (c = cy·nx + cx) are items[start[c]:start[c+1]], in id order.
-    """
-    n = pos.shape[0]
-    span = np.empty((n, 4), np.int64)
-    counts = np.zeros(nx * ny, np.int64)
-    for i in range(n):
-        span[i, 0] = min(max(int(pos[i, 0] // cell), 0), nx - 1)
-        span[i, 1] = min(max(int((pos[i, 0] + size[i, 0]) // cell), 0), nx - 1)
-        span[i, 2] = min(max(int(pos[i, 1] // cell), 0), ny - 1)
-        span[i, 3] = min(max(int((pos[i, 1] + size[i, 1]) // cell), 0), ny - 1)
-        if static[i]:
-            for cy in range(span[i, 2], span[i, 3] + 1):
-                for cx in range(span[i, 0], span[i, 1] + 1):
-                    counts[cy * nx + cx] += 1
-    start = np.zeros(nx * ny + 1, np.int64)
-    for c in range(nx * ny):
-        start[c + 1] = start[c] + counts[c]
-    items = np.empty(start[nx * ny], np.int64)
-    fill = start[:-1].copy()
-    for i in range(n):
-        if static[i]:
-            for cy in range(span[i, 2], span[i, 3] + 1):
-                for cx in range(span[i, 0], span[i, 1] + 1):
-                    c = cy * nx + cx
-                    items[fill[c]] = i
-                    fill[c] += 1
-    return start, items

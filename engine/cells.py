@@ -1,17 +1,23 @@
-"""The exact model's uniform grid: per-cell doubly linked lists of the moving objects.
+"""The exact model's uniform grid: its cell size, and per-cell doubly linked lists of the moving
+objects.
 
-Moving objects are filed by their box centre in cells of side `cell` px (gnx × gny cells);
-`cells` (gnx·gny, 2) int64 holds each cell's first object (-1: none) and count, N's NEXT and PREV
-columns the links, N's CELL column each object's cell. Static objects never move: they are filed
-once by broadphase.static_cells (every cell their box covers). `room_around` and `room_needed`
+Square cells of side `cell` px cover the world (`grid_cell`, `grid_dims`). With the cell at least
+the largest moving box (plus a margin), two moving objects that touch are in the same or adjacent
+cells, so an object predicts contacts only against the 3×3 cells around its own. Moving objects are
+filed by their box centre in cells of side `cell` px (gnx × gny cells); `cells` (gnx·gny, 2) int64
+holds each cell's first object (-1: none) and count, N's NEXT and PREV columns the links, N's CELL
+column each object's cell. Static objects never move: they are filed once by `static_cells` (every
+cell their closed box meets), so a mover finds them the same way. `room_around` and `room_needed`
 bound the heap entries one prediction or one event may push.
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-from collide2d.engine.broadphase import static_cells
+from collide2d.engine.broadphase import CELL_MARGIN
 from collide2d.engine.eventqueue import RANK_CROSS, RANK_PAIR
 from collide2d.engine.exactstate import (
     CELL,
@@ -30,6 +36,70 @@ from collide2d.engine.exactstate import (
     hot,
 )
 from collide2d.engine.jit import njit
+
+# Aim for about this many moving objects per cell when they are sparse: larger cells mean fewer
+# cell crossings but more neighbours to test. Tuned on a gas of 10,000 boxes (`collide2d bench
+# --part exact`).
+TARGET_PER_CELL = 0.6
+# The grid never has more cells than this per moving object (and at least one cell).
+MAX_CELLS_PER_OBJECT = 4
+
+
+def grid_cell(width: float, height: float, size: np.ndarray, static: np.ndarray) -> float:
+    """Side of the exact model's grid cells, px.
+
+    At least CELL_MARGIN × the largest side of a moving box; larger when moving objects are sparse
+    (about TARGET_PER_CELL per cell); never so small that the grid exceeds MAX_CELLS_PER_OBJECT
+    cells per moving object.
+    """
+    moving = ~np.asarray(static, bool)
+    count = int(moving.sum())
+    extent = float(size[moving].max()) if count else 1.0
+    cell = max(extent * CELL_MARGIN, 1e-9)
+    if count:
+        cell = max(cell, math.sqrt(width * height * TARGET_PER_CELL / count))
+        cell = max(cell, math.sqrt(width * height / (MAX_CELLS_PER_OBJECT * count)))
+    return cell
+
+
+def grid_dims(width: float, height: float, cell: float) -> tuple[int, int]:
+    """(columns, rows) of cells of side `cell` covering [0, width) × [0, height)."""
+    return max(1, math.ceil(width / cell)), max(1, math.ceil(height / cell))
+
+
+@njit(cache=True)
+def static_cells(pos, size, static, cell, nx, ny):
+    """Cells each static object is filed in: every cell its closed box meets.
+
+    pos, size (n, 2) px; static (n,) bool; cell px; nx × ny cells. Returns (start, items): the
+    static objects of cell c (c = cy·nx + cx) are items[start[c]:start[c+1]], in id order.
+    """
+    n = pos.shape[0]
+    span = np.empty((n, 4), np.int64)
+    counts = np.zeros(nx * ny, np.int64)
+    for i in range(n):
+        span[i, 0] = min(max(int(pos[i, 0] // cell), 0), nx - 1)
+        span[i, 1] = min(max(int((pos[i, 0] + size[i, 0]) // cell), 0), nx - 1)
+        span[i, 2] = min(max(int(pos[i, 1] // cell), 0), ny - 1)
+        span[i, 3] = min(max(int((pos[i, 1] + size[i, 1]) // cell), 0), ny - 1)
+        if static[i]:
+            for cy in range(span[i, 2], span[i, 3] + 1):
+                for cx in range(span[i, 0], span[i, 1] + 1):
+                    counts[cy * nx + cx] += 1
+    start = np.zeros(nx * ny + 1, np.int64)
+    for c in range(nx * ny):
+        start[c + 1] = start[c] + counts[c]
+    items = np.empty(start[nx * ny], np.int64)
+    fill = start[:-1].copy()
+    for i in range(n):
+        if static[i]:
+            for cy in range(span[i, 2], span[i, 3] + 1):
+                for cx in range(span[i, 0], span[i, 1] + 1):
+                    c = cy * nx + cx
+                    items[fill[c]] = i
+                    fill[c] += 1
+    return start, items
+
 
 # Grid cells (gnx·gny, 2) int64: the first moving object filed there (-1: none) and how many.
 C_HEAD, C_COUNT = range(2)

@@ -60,8 +60,15 @@ from __future__ import annotations
 import numpy as np
 
 from collide2d.engine import events, models
-from collide2d.engine.broadphase import grid_cell, grid_dims
-from collide2d.engine.cells import build_grid, cell_insert, cell_remove, room_around, room_needed
+from collide2d.engine.cells import (
+    build_grid,
+    cell_insert,
+    cell_remove,
+    grid_cell,
+    grid_dims,
+    room_around,
+    room_needed,
+)
 from collide2d.engine.errors import EventCapExceeded, NoRoom
 from collide2d.engine.eventqueue import (
     HKEY,

@@ -10,16 +10,16 @@ Each step runs move -> walls -> pairs. Walls reflect exactly as a wall would (re
 Pairs: the candidates are the pairs whose boxes overlap after the walls, or overlapped during the
 step (a corner passed through within it, found by sweeping the pair back along its relative
 velocity), taken in the order their contacts began (swept back the same way; ties and pairs whose
-overlap began before the step, first, in ascending (a, b) order), each tested again on the
-current state so that it sees what the pairs before it changed (a pair that only comes to
-overlap through such a push waits for the next step). A pair in contact that approaches along
-the contact normal gets the elastic exchange. The normal is the axis along which the pair
-started overlapping, found from its relative velocity (contact.box_step_contact; for exact shapes
-the direction of approach, contact.step_contact), and the pair is pushed apart along it, shared
-by inverse mass, never out of the world, by twice the depth it went in since that instant: each
-object ends where a bounce at the contact instant would have put it, as the walls reflect. Only
-when the motion cannot tell (the overlap began before the previous step, or nothing moves) the
-axis of the smaller overlap decides, and the push is that depth once.
+overlap began before the step, first, in ascending (a, b) order), each tested again on the current
+state so that it sees what the pairs before it changed (a pair that only comes to overlap through
+such a push waits for the next step). A pair in contact that approaches along the contact normal
+gets the elastic exchange. The normal is the axis along which the pair started overlapping, found
+from its relative velocity (stepcontact.box_step_contact; for exact shapes the direction of
+approach, stepcontact.step_contact), and the pair is pushed apart along it, shared by inverse mass,
+never out of the world, by twice the depth it went in since that instant: each object ends where a
+bounce at the contact instant would have put it, as the walls reflect. Only when the motion cannot
+tell (the overlap began before the previous step, or nothing moves) the axis of the smaller overlap
+decides, and the push is that depth once.
 
 Finding the overlapping pairs without testing them all (a Verlet list): the broad phase
 (broadphase.py, sort-and-sweep or a grid chosen by the scene) lists the pairs whose boxes, each

@@ -21,10 +21,11 @@ import math
 import numpy as np
 
 from collide2d.engine.broadphase import KEY_MASK, KEY_SHIFT
-from collide2d.engine.contact import box_clip, box_sweep
+from collide2d.engine.contact import box_sweep
 from collide2d.engine.jit import njit, prange
 from collide2d.engine.models.stepped_motion import B_H, B_SX, B_SY, B_VX, B_VY, B_W, B_X, B_Y
 from collide2d.engine.sort import sort_by_time
+from collide2d.engine.stepcontact import box_clip
 from collide2d.engine.threads import join_shares, shares_total
 
 

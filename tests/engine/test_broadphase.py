@@ -11,7 +11,6 @@ from hypothesis import strategies as st
 from collide2d.engine.broadphase import (
     CELL_MARGIN,
     GRID_FILINGS_PER_OBJECT,
-    MAX_CELLS_PER_OBJECT,
     METHOD_CELLS,
     METHOD_GRID,
     METHOD_SWEEP,
@@ -19,12 +18,10 @@ from collide2d.engine.broadphase import (
     candidates,
     choose,
     find_pairs,
-    grid_cell,
-    grid_dims,
-    static_cells,
     sweep_pairs,
     workspace,
 )
+from collide2d.engine.cells import MAX_CELLS_PER_OBJECT, grid_cell, grid_dims, static_cells
 
 
 def brute_pairs(lo, hi, static):

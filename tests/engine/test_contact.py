@@ -14,12 +14,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from collide2d.engine.contact import (
-    box_clip,
     box_next_contact,
-    box_overlap_axis,
     box_penetration,
     box_reach,
-    box_step_contact,
     box_sweep,
     disc_roots,
     next_contact,
@@ -29,6 +26,7 @@ from collide2d.engine.contact import (
 )
 from collide2d.engine.events import AXIS_NORMAL, AXIS_X, AXIS_XY, AXIS_Y
 from collide2d.engine.shapes import edge_normals, pixel_hull
+from collide2d.engine.stepcontact import box_clip, box_overlap_axis, box_step_contact
 from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON
 
 INF = math.inf

@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from collide2d.engine.broadphase import KEY_SHIFT
-from collide2d.engine.contact import box_clip, box_step_contact, box_sweep
+from collide2d.engine.contact import box_sweep
 from collide2d.engine.events import (
     AXIS_NAMES,
     EV_PAIR,
@@ -30,6 +30,7 @@ from collide2d.engine.models.stepped_list import (
 from collide2d.engine.models.stepped_narrow import narrow
 from collide2d.engine.models.stepped_step import step
 from collide2d.engine.response import exchange, fold, separate
+from collide2d.engine.stepcontact import box_clip, box_step_contact
 from collide2d.engine.world import KIND_CIRCLE, Bodies, Looks, WorldSpec
 
 
