@@ -10,6 +10,10 @@ module (not numba's). A call runs it in one of two lanes:
   hundred times slower, but nothing is loaded or compiled: a small scene finishes before numba
   would have started.
 
+Compiled kernels are cached on disk as numba caches them, but stamped fresh only while every
+source of their package is as it was (`_package_cache`): numba itself checks only the kernel's own
+file, though the code it keeps has the kernels it calls compiled in.
+
 The lane is a context variable: `compiled()` says which lane this thread runs, and
 `lane(compiled)` sets it for a `with` block (the runner picks one per run, `runner.lanes`). The
 default is compiled, unless the environment says `COLLIDE2D_JIT=0` (or numba's own
@@ -29,6 +33,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import hashlib
 import os
 from contextvars import ContextVar
 
@@ -115,7 +120,11 @@ class Kernel:
             scope = self.py_func.__globals__
             if scope.get("prange") is range:
                 scope["prange"] = numba.prange
-            self._dispatcher = numba.njit(**options)(self.py_func)
+            cache = options.pop("cache", False)
+            dispatcher = numba.njit(**options)(self.py_func)
+            if cache:
+                dispatcher._cache = _package_cache()(self.py_func)
+            self._dispatcher = dispatcher
         return self._dispatcher
 
     @property
@@ -138,6 +147,68 @@ class Kernel:
 
     def __repr__(self) -> str:
         return f"<kernel {self.py_func.__module__}.{self.py_func.__qualname__}>"
+
+
+def _package_root(path: str) -> str | None:
+    """The outermost package folder holding the file at `path`; None outside a package."""
+    folder = os.path.dirname(os.path.abspath(path))
+    if not (os.path.isfile(path) and os.path.isfile(os.path.join(folder, "__init__.py"))):
+        return None
+    while os.path.isfile(os.path.join(os.path.dirname(folder), "__init__.py")):
+        folder = os.path.dirname(folder)
+    return folder
+
+
+@functools.cache
+def _package_fingerprint(root: str) -> str:
+    """A digest of every Python source under `root`: changes when any of them does."""
+    digest = hashlib.sha256()
+    for folder, dirs, files in sorted(os.walk(root)):
+        dirs.sort()
+        for name in sorted(files):
+            if name.endswith(".py"):
+                path = os.path.join(folder, name)
+                digest.update(os.path.relpath(path, root).encode())
+                with open(path, "rb") as f:
+                    digest.update(hashlib.sha256(f.read()).digest())
+    return digest.hexdigest()
+
+
+@functools.cache
+def _package_cache():
+    """numba's on-disk cache of a function, made stale by an edit anywhere in its package.
+
+    numba keeps a compiled kernel until the kernel's own file changes, but the code it keeps has
+    the kernels it calls compiled into it: after an edit of a callee's file alone (or an upgrade
+    that leaves the caller's file as it was) the old code would load, and may crash. Here the
+    freshness stamp numba checks is its own (the file's) plus a digest of every source of the
+    outermost package holding the file, so any edit there compiles afresh."""
+    from numba.core.caching import FunctionCache
+
+    def package_wide(locator):
+        class Locator(locator):
+            @classmethod
+            def from_function(cls, py_func, py_file):
+                found = super().from_function(py_func, py_file)
+                if found is not None:
+                    found.package_root = _package_root(py_file)
+                return found
+
+            def get_source_stamp(self):
+                own = super().get_source_stamp()
+                root = self.package_root
+                return own if root is None else (own, _package_fingerprint(root))
+
+        Locator.__name__ = Locator.__qualname__ = locator.__name__
+        return Locator
+
+    base = FunctionCache._impl_class
+    impl = type(
+        "PackageCacheImpl",
+        (base,),
+        {"_locator_classes": [package_wide(cls) for cls in base._locator_classes]},
+    )
+    return type("PackageCache", (FunctionCache,), {"_impl_class": impl})
 
 
 def _kernel_named(module: str, qualname: str) -> Kernel:

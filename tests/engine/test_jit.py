@@ -83,3 +83,55 @@ def test_an_interpreted_run_never_imports_numba(tmp_path):
             [sys.executable, "-c", code, mode], capture_output=True, text=True, env=env
         )
         assert done.stdout.split() == ["0", loads_numba], (mode, done.stdout, done.stderr)
+
+
+CALLER = """from collide2d.engine.jit import njit
+from pkg.callee import g
+
+
+@njit(cache=True)
+def f(x):
+    return g(x) + 1
+"""
+CALLEE = """from collide2d.engine.jit import njit
+
+
+@njit(cache=True)
+def g(x):
+    return x * {factor}
+"""
+
+
+@pytest.mark.skipif(os.environ.get("NUMBA_DISABLE_JIT") == "1", reason="nothing compiles")
+def test_an_edit_of_a_called_kernels_file_alone_compiles_the_caller_afresh(tmp_path):
+    # numba keeps a cached kernel while its own file is unchanged, with the kernels it calls
+    # compiled into it; a kernel of collide2d is stale once any file of its package changed
+    package = tmp_path / "pkg"
+    package.mkdir()
+    (package / "__init__.py").write_text("")
+    (package / "caller.py").write_text(CALLER)
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), PYTHONPATH=str(tmp_path))
+    env.pop("COLLIDE2D_JIT", None)
+    code = (
+        "from numba.core import event\n"
+        "compiled = []\n"
+        "class Listen(event.Listener):\n"
+        "    def on_start(self, ev): compiled.append(ev.data['dispatcher'].py_func.__name__)\n"
+        "    def on_end(self, ev): pass\n"
+        "event.register('numba:compile', Listen())\n"
+        "from pkg.caller import f\n"
+        "print(f(3), *sorted(compiled) or ['none'])\n"
+    )
+
+    def run() -> list[str]:
+        done = subprocess.run(
+            [sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True
+        )
+        return done.stdout.split()
+
+    (package / "callee.py").write_text(CALLEE.format(factor=2))
+    assert run() == ["7", "f", "g"]  # compiled
+    assert run() == ["7", "none"]  # loaded from the cache
+    (package / "callee.py").write_text(CALLEE.format(factor=3))
+    assert run() == ["10", "f", "g"]  # compiled again, the caller too: its callee changed
+    assert run() == ["10", "none"]
