@@ -49,8 +49,28 @@ def step(first, last, S, dt, width, height, exact, cores, tick, t, log, rows, ti
     """Run the stages first ... last-1 (of STAGES) of one step; returns (event buffers, how many
     events, bp): the buffers that grew replace the caller's. What a stage hands the next waits
     in bp between calls: the drift in params[P_DRIFT], the overlapping pairs in state[ST_NEAR]."""
-    body, inv_mass, static, movable, ext, rank, anchor = S
     keys, near, order, lo, hi, folds, state, params, ws, when, finder, scratch, spare = bp
+    rows, times, n_ev, lists = _stages(
+        first, last, S, dt, width, height, exact, cores, tick, t, log, rows, times, n_ev, bp,
+        (keys, spare, near, when),
+    )
+    keys, spare, near, when = lists
+    return rows, times, n_ev, (
+        keys, near, order, lo, hi, folds, state, params, ws, when, finder, scratch, spare
+    )
+
+
+@njit(cache=True)
+def _stages(first, last, S, dt, width, height, exact, cores, tick, t, log, rows, times, n_ev, bp,
+            lists):
+    """`step`, with the buffers that can grow apart from bp: lists = (keys, spare, near, when)
+    (bp's own slots for them are not read); returns (event buffers, how many events, lists).
+    `run` keeps them apart from bp between steps, so that a step hands back these four arrays
+    and not all of bp's (each array handed back costs two atomic reference counts, which at
+    1,000 objects were a twentieth of a step)."""
+    body, inv_mass, static, movable, ext, rank, anchor = S
+    _, _, order, lo, hi, folds, state, params, ws, _, finder, scratch, _ = bp
+    keys, spare, near, when = lists
     chunks = state[ST_CHUNKS]
     if first <= _MOVE < last:
         # move, walls: every object; the walls' events in id order; how far anything drifted
@@ -62,12 +82,15 @@ def step(first, last, S, dt, width, height, exact, cores, tick, t, log, rows, ti
             if log:
                 rows, times, n_ev = log_walls(folds, n_folds, tick, t, rows, times, n_ev)
     if state[ST_POSSIBLE] == 0:  # no pair can happen
-        return rows, times, n_ev, bp
+        return rows, times, n_ev, lists
     if first <= _BROAD < last:
         # the candidate list made anew once an object drifted its margin
         if state[ST_KEYS] < 0 or params[P_DRIFT] >= params[P_MARGIN] - params[P_SLACK]:
-            keys, spare, state[ST_KEYS] = relist(S, dt, bp)
-            bp = (keys, near, order, lo, hi, folds, state, params, ws, when, finder, scratch, spare)
+            keys, spare, state[ST_KEYS] = relist(
+                S, dt,
+                (keys, near, order, lo, hi, folds, state, params, ws, when, finder, scratch, spare),
+            )  # fmt: skip
+            lists = (keys, spare, near, when)
     if first <= _NARROW < last:
         # the listed pairs in contact this step, in the order their contacts began, from the
         # bands near enough to touch by now
@@ -76,7 +99,7 @@ def step(first, last, S, dt, width, height, exact, cores, tick, t, log, rows, ti
         while state[ST_NEAR] > near.shape[0]:
             near = np.empty(2 * state[ST_NEAR], np.int64)
             when = np.empty(2 * state[ST_NEAR])
-            bp = (keys, near, order, lo, hi, folds, state, params, ws, when, finder, scratch, spare)
+            lists = (keys, spare, near, when)
             state[ST_NEAR] = narrow(body, ext, keys, n_keys, near, when, dt, chunks)
     if first <= _RESPONSE < last:
         rows, times, n_ev = respond(
@@ -97,7 +120,7 @@ def step(first, last, S, dt, width, height, exact, cores, tick, t, log, rows, ti
             n_ev,
             state,
         )
-    return rows, times, n_ev, bp
+    return rows, times, n_ev, lists
 
 
 @njit(cache=True)
@@ -118,10 +141,12 @@ def run(world, substeps, tick0, ticks, log, S, exact, cores, rows, times, bp):
     width, height, fps = world
     dt = 1.0 / (fps * substeps)
     n_ev = np.int64(0)  # not the literal 0, which would compile step once more for it
+    keys, near, order, lo, hi, folds, state, params, ws, when, finder, scratch, spare = bp
+    lists = (keys, spare, near, when)
     for tick in range(tick0 + 1, tick0 + ticks + 1):
         t = tick / fps
         for _ in range(substeps):
-            rows, times, n_ev, bp = step(
+            rows, times, n_ev, lists = _stages(
                 _FIRST,
                 _LAST,
                 S,
@@ -137,5 +162,9 @@ def run(world, substeps, tick0, ticks, log, S, exact, cores, rows, times, bp):
                 times,
                 n_ev,
                 bp,
+                lists,
             )
-    return rows, times, n_ev, bp
+    keys, spare, near, when = lists
+    return rows, times, n_ev, (
+        keys, near, order, lo, hi, folds, state, params, ws, when, finder, scratch, spare
+    )
