@@ -57,25 +57,31 @@ def exchange(vax, vay, vbx, vby, wa, wb, code, nx, ny):
 
 
 @njit(cache=True)
-def _shift_within(pos, i, axis, d, span):
-    """Move pos[i, axis] by d but keep it in [0, span]; returns the part of d actually made."""
-    x = pos[i, axis]
+def _shift_within(x, d, span):
+    """x moved by d but kept in [0, span]: (where it ends, the part of d actually made)."""
     target = min(max(x + d, 0.0), max(span, 0.0))
-    pos[i, axis] = target
-    return target - x
+    return target, target - x
 
 
 @njit(cache=True)
-def _separate_axis(pos, a, b, wa, wb, axis, push, span_a, span_b):
+def _separate_axis(xa, xb, wa, wb, push, span_a, span_b):
     """Push b by +push·wb/(wa+wb) and a by -push·wa/(wa+wb) along one axis, in the world;
-    what one of them cannot take at a wall is handed to the other."""
+    what one of them cannot take at a wall is handed to the other. Returns (xa, xb): the
+    coordinates on that axis after. Scalars in and out, so that the pair loop that calls it
+    hands no array to a call (each costs reference counts)."""
     da = -push * (wa / (wa + wb))
     db = push * (wb / (wa + wb))
-    made_a = _shift_within(pos, a, axis, da, span_a) if wa > 0.0 else 0.0
-    made_b = _shift_within(pos, b, axis, db + (da - made_a) * -1.0, span_b) if wb > 0.0 else 0.0
+    made_a = 0.0
+    if wa > 0.0:
+        xa, made_a = _shift_within(xa, da, span_a)
+    if wb > 0.0:
+        xb, made_b = _shift_within(xb, db + (da - made_a) * -1.0, span_b)
+    else:
+        made_b = 0.0
     left = push - (made_b - made_a)
     if wa > 0.0 and left != 0.0:
-        _shift_within(pos, a, axis, -left, span_a)
+        xa, _ = _shift_within(xa, -left, span_a)
+    return xa, xb
 
 
 @njit(cache=True)
@@ -90,14 +96,16 @@ def separate(pos, size, a, b, wa, wb, code, nx, ny, depth, depth_y, width, heigh
     span_ay = height - size[a, 1]
     span_bx = width - size[b, 0]
     span_by = height - size[b, 1]
-    if code == AXIS_XY:
-        _separate_axis(pos, a, b, wa, wb, 0, depth * nx, span_ax, span_bx)
-        _separate_axis(pos, a, b, wa, wb, 1, depth_y * ny, span_ay, span_by)
-    else:
-        if nx != 0.0:
-            _separate_axis(pos, a, b, wa, wb, 0, depth * nx, span_ax, span_bx)
-        if ny != 0.0:
-            _separate_axis(pos, a, b, wa, wb, 1, depth * ny, span_ay, span_by)
+    push_x = depth * nx
+    push_y = depth_y * ny if code == AXIS_XY else depth * ny
+    if code == AXIS_XY or nx != 0.0:
+        pos[a, 0], pos[b, 0] = _separate_axis(
+            pos[a, 0], pos[b, 0], wa, wb, push_x, span_ax, span_bx
+        )
+    if code == AXIS_XY or ny != 0.0:
+        pos[a, 1], pos[b, 1] = _separate_axis(
+            pos[a, 1], pos[b, 1], wa, wb, push_y, span_ay, span_by
+        )
 
 
 @njit(cache=True)

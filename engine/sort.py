@@ -131,13 +131,7 @@ def sort_by_time(when, keys, n):
     """Sort when[:n] and keys[:n] together in place by (time, key), allocating nothing: insertion
     sort for the usual handful, a heap sort past INSERTION_SORT_MAX."""
     if n > INSERTION_SORT_MAX:
-        top = np.int64(0)  # a typed 0: a literal 0 would compile _sift_timed once more
-        for root in range(n // 2 - 1, -1, -1):
-            _sift_timed(when, keys, root, n)
-        for end in range(n - 1, 0, -1):
-            when[0], when[end] = when[end], when[0]
-            keys[0], keys[end] = keys[end], keys[0]
-            _sift_timed(when, keys, top, end)
+        _heap_sort_timed(when, keys, n)
         return
     for i in range(1, n):
         t = when[i]
@@ -152,15 +146,28 @@ def sort_by_time(when, keys, n):
 
 
 @njit(cache=True)
-def _sift_timed(when, keys, root, n):
-    while True:
-        c = 2 * root + 1
-        if c >= n:
-            return
-        if c + 1 < n and _before(when, keys, c, c + 1):
-            c += 1
-        if not _before(when, keys, root, c):
-            return
-        when[root], when[c] = when[c], when[root]
-        keys[root], keys[c] = keys[c], keys[root]
-        root = c
+def _heap_sort_timed(when, keys, n):
+    """`sort_by_time`'s heap sort: the heap built, then its top taken n - 1 times, every sift
+    in this one loop, so that no call inside hands the arrays on (each costs reference counts:
+    a sort of a thousand pairs made thousands of calls)."""
+    half = n // 2
+    for r in range(half + n - 1):
+        if r < half:  # build: each inner node sifted, the last first
+            root = half - 1 - r
+            end = n
+        else:  # take the top: it goes to the end, the new top sifts down
+            end = n - 1 - (r - half)
+            when[0], when[end] = when[end], when[0]
+            keys[0], keys[end] = keys[end], keys[0]
+            root = 0
+        while True:
+            c = 2 * root + 1
+            if c >= end:
+                break
+            if c + 1 < end and _before(when, keys, c, c + 1):
+                c += 1
+            if not _before(when, keys, root, c):
+                break
+            when[root], when[c] = when[c], when[root]
+            keys[root], keys[c] = keys[c], keys[root]
+            root = c

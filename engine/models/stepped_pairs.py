@@ -86,9 +86,22 @@ def respond(
         else:
             a = rank[ea]
             b = rank[eb]
-        depth, depth_y, code, nx, ny = _contact(
-            a, b, ea, eb, body, dt, exact, shape, radius, start, verts, normals
-        )
+        if exact:
+            depth, depth_y, code, nx, ny = _contact(
+                a, b, ea, eb, body, dt, exact, shape, radius, start, verts, normals
+            )
+        else:  # boxes: no call that takes an array (each costs reference counts, per pair)
+            depth, depth_y, code, nx, ny = box_step_contact(
+                body[b, B_X] - body[a, B_X],
+                body[b, B_Y] - body[a, B_Y],
+                body[b, B_VX] - body[a, B_VX],
+                body[b, B_VY] - body[a, B_VY],
+                body[a, B_W],
+                body[a, B_H],
+                body[b, B_W],
+                body[b, B_H],
+                dt,
+            )
         if depth <= 0.0:
             continue
         vax, vay, vbx, vby, changed = exchange(

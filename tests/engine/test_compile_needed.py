@@ -109,7 +109,7 @@ reach = np.empty((n, 4), np.int64)
 assert paper._near(pos, size, np.zeros((n, 2), np.int64), keys, n, near, reach) == n
 sort.sort_by_time(rng.random(n), keys.copy(), n)
 sort.heap_argsort(rng.random(n))
-for f in (sort.sort_keys, sort._sift_keys, sort._sift_timed, sort._sift_order):
+for f in (sort.sort_keys, sort._sift_keys, sort._heap_sort_timed, sort._sift_order):
     literal = any(isinstance(a, types.Literal) for s in f.signatures for a in s)
     print(f.__name__, len(f.signatures), literal)
 """
@@ -126,7 +126,7 @@ def test_the_sorts_compile_once_not_again_for_a_literal_zero(tmp_path):
     assert got == [
         *("sort_keys", "1", "False"),
         *("_sift_keys", "1", "False"),
-        *("_sift_timed", "1", "False"),
+        *("_heap_sort_timed", "1", "False"),
         *("_sift_order", "1", "False"),
     ]
 
