@@ -382,6 +382,29 @@ def test_the_model_equals_testing_every_pair(seed, broadphase, substeps, skip):
     assert model.velocities().tobytes() == ref_vel.tobytes()
 
 
+@pytest.mark.parametrize("broadphase", ["sweep", "cells"])
+def test_buffers_that_fill_mid_run_grow_and_change_no_bit(broadphase):
+    # the candidate keys, their spare and this step's pairs in contact start far too small: a
+    # run grows each where it fills (the list when it is made, the pairs in the middle of a
+    # step) and ends on the same events, positions and velocities as a run that never grew
+    world = WorldSpec(150, 110, 10)
+    bodies = crowd(60, 3, world)
+    runs = []
+    for tiny in (False, True):
+        model = make("stepped", world, bodies, broadphase=broadphase)
+        if tiny:
+            bp = list(model._bp)
+            for slot, dtype in ((0, np.int64), (1, np.int64), (9, np.float64), (12, np.int64)):
+                bp[slot] = np.empty(1, dtype)  # keys, near, when, spare
+            model._bp = tuple(bp)
+        events = np.concatenate([model.advance(17), model.advance(23)])
+        runs.append((events.tobytes(), model.positions().tobytes(), model.velocities().tobytes()))
+        grown = (model._bp[0].size, model._bp[1].size, model._bp[9].size, model._bp[12].size)
+    assert runs[0] == runs[1]
+    assert len(np.frombuffer(runs[0][0], dtype=events.dtype)) > 20
+    assert min(grown) > 1  # each buffer grew
+
+
 def test_a_large_crowd_through_each_method_gives_the_same_bytes():
     # 2,000 boxes in a wide world: the list is remade many times and the objects inside are put
     # back in space order; the three methods and the run in small chunks agree to the bit.
