@@ -66,8 +66,8 @@ def _stages(first, last, S, dt, width, height, exact, cores, tick, t, log, rows,
     """`step`, with the buffers that can grow apart from bp: lists = (keys, spare, near, when)
     (bp's own slots for them are not read); returns (event buffers, how many events, lists).
     `run` keeps them apart from bp between steps, so that a step hands back these four arrays
-    and not all of bp's (each array handed back costs two atomic reference counts, which at
-    1,000 objects were a twentieth of a step)."""
+    and not all of bp's (each array handed back costs two atomic reference counts: handing back
+    all of bp took a step's fixed cost, measured on two objects, from 0.6 to 1.0 us)."""
     body, inv_mass, static, movable, ext, rank, anchor = S
     _, _, order, lo, hi, folds, state, params, ws, _, finder, scratch, _ = bp
     keys, spare, near, when = lists
