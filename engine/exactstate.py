@@ -27,7 +27,10 @@ class State(NamedTuple):
     s_items: np.ndarray  # the static objects filed in each cell
     HT: np.ndarray  # heap: event times
     HI: np.ndarray  # heap: event ids and counters
-    HN: np.ndarray  # heap: tie-breaking keys
+    HN: np.ndarray  # heap: contact normals
+    QT: np.ndarray  # horizon queue: times by slot (horizonqueue.py)
+    QK: np.ndarray  # horizon queue: keys by slot
+    QP: np.ndarray  # horizon queue: each object's slot
     st: np.ndarray  # int64 scalar state, indices S_* below
     stf: np.ndarray  # float64 scalar state, indices SF_* below
     world: tuple  # the world's sides and grid, floats

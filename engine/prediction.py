@@ -1,9 +1,10 @@
 """The exact model's predictions: an object's next wall contact, cell crossing and contacts.
 
-A prediction job (a row of `jobs`, see exactstate.py) names an object; `predict` pushes its
-horizon (the first of its next wall contact and its next cell crossing) and its contacts with the
-objects in the 3×3 cells around it that come no later than the horizon. A pair is swept from the
-later of its two clocks (contact.next_contact), so a predicted time depends only on the pair's
+A prediction job (a row of `jobs`, see exactstate.py) names an object; `predict` sets its horizon
+(the first of its next wall contact and its next cell crossing) in the horizon queue
+(horizonqueue.py) and pushes its contacts with the objects in the 3×3 cells around it that come no
+later than the horizon on the event queue (eventqueue.py). A pair is swept from the later of its
+two clocks (contact.next_contact), so a predicted time depends only on the pair's
 state.
 """
 
@@ -39,6 +40,7 @@ from collide2d.engine.exactstate import (
     Y,
     hot,
 )
+from collide2d.engine.horizonqueue import set_horizon
 from collide2d.engine.jit import njit
 from collide2d.engine.world import KIND_BOX
 
@@ -143,11 +145,11 @@ def _predict_pair(i, j, t_now, horizon, F, N, C, HT, HI, HN, st):
 
 
 @hot
-def predict(jobs, k, t_now, F, N, C, cells, s_start, s_items, HT, HI, HN, st, world):
-    """Run prediction job k for object i: push its horizon (the first of its next wall contact
-    and its next cell crossing) and its contacts with the objects in the 3×3 cells around it
-    that come no later than that. Inlined into the event loop's one call site: a call would
-    cost more than the prediction of a small scene."""
+def predict(jobs, k, t_now, F, N, C, cells, s_start, s_items, HT, HI, HN, QT, QK, QP, st, world):
+    """Run prediction job k for object i: set its horizon (the first of its next wall contact
+    and its next cell crossing; horizonqueue.py) and push its contacts with the objects in the
+    3×3 cells around it that come no later than that. Inlined into the event loop's one call
+    site: a call would cost more than the prediction of a small scene."""
     i, skip, mode = jobs[k, J_OBJ], jobs[k, J_SKIP], jobs[k, J_HIGHER]
     higher = mode == JOB_FIRST
     t_wall, side = _wall_time(i, F, world)
@@ -155,11 +157,11 @@ def predict(jobs, k, t_now, F, N, C, cells, s_start, s_items, HT, HI, HN, st, wo
     if mode == JOB_CONTACTS:
         pass
     elif t_cross <= t_wall and t_cross < INF:
-        key = make_key(RANK_CROSS, i, d, d)
-        push(HT, HI, HN, st, max(t_cross, t_now), key, N[i, CNT], 0, 0.0, 0.0)
+        set_horizon(QT, QK, QP, i, max(t_cross, t_now), make_key(RANK_CROSS, i, d, d))
     elif t_wall < INF:
-        key = make_key(RANK_WALL, i, side, side)
-        push(HT, HI, HN, st, max(t_wall, t_now), key, N[i, CNT], 0, 0.0, 0.0)
+        set_horizon(QT, QK, QP, i, max(t_wall, t_now), make_key(RANK_WALL, i, side, side))
+    else:
+        set_horizon(QT, QK, QP, i, INF, make_key(RANK_WALL, i, 0, 0))
     horizon = max(min(t_wall, t_cross), t_now)
     gnx, gny = world[4], world[5]
     gx = N[i, CELL] % gnx

@@ -106,6 +106,7 @@ from collide2d.engine.exactstate import (
     DIR_LEFT,
     DIR_RIGHT,
     DIR_UP,
+    INF,
     INV_MASS,
     J_EXTRA,
     J_OBJ,
@@ -139,6 +140,7 @@ from collide2d.engine.exactstate import (
     hot,
     kernel,
 )
+from collide2d.engine.horizonqueue import first_horizon, new_horizons
 from collide2d.engine.noroom import jammed, listing, no_room, no_room_message
 from collide2d.engine.prediction import predict, set_job
 from collide2d.engine.response import exchange
@@ -250,7 +252,7 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
     with a higher cap would resume). st[S_LOGGED] counts the rows written, st[S_WALLS] and
     st[S_PAIRS] every event, logged or not.
     """
-    F, N, C, cells, s_start, s_items, HT, HI, HN, st, stf, world = S
+    F, N, C, cells, s_start, s_items, HT, HI, HN, QT, QK, QP, st, stf, world = S
     n = F.shape[0]
     extra_room = n * n if everyone else 0
     # (The loop's steps are written out here, not as inlined helpers: helpers cost ~15 % of the
@@ -276,18 +278,28 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
                 return STATUS_DONE
             tick = st[S_TICK] + 1
             t_end = tick / world[2]
-            if st[S_HEAP_N] == 0 or HT[0] > t_end + instant(t_end):  # t = k/fps is tick k's
+            if st[S_HEAP_N] > 0 and not is_valid(HI, 0, N):  # a stale contact: drop it
+                pop(HT, HI, HN, st)
+                continue
+            t_pair = HT[0] if st[S_HEAP_N] > 0 else INF
+            t_horizon = QT[0] if QT.shape[0] > 0 else INF
+            t_first = min(t_pair, t_horizon)
+            if t_first > t_end + instant(t_end):  # t = k/fps is tick k's
                 stf[SF_T_NOW] = t_end
                 st[S_TICK] = tick
                 st[S_TICK_EVENTS] = 0
                 continue
-            # take the next event: the first valid entry of the top's instant, in key order, once
-            # the heap has room for what it may push
-            if not is_valid(HI, 0, N):
-                pop(HT, HI, HN, st)
-                continue
-            k = first_of_instant(HT, HI, st, N, stack)
-            rank, a, b, code = split_key(HI[k, HKEY])
+            # take the next event: of the valid events at the first one's instant, the one of the
+            # smallest key (a horizon's key is smaller than any contact's), once the heap has room
+            # for what it may push
+            horizon = t_horizon <= t_first + instant(t_first)
+            if horizon:
+                k = first_horizon(QT, QK, t_first + instant(t_first), stack)
+                key = QK[k]
+            else:
+                k = first_of_instant(HT, HI, st, N, stack)
+                key = HI[k, HKEY]
+            rank, a, b, code = split_key(key)
             room = room_needed(rank, a, b, HT, st, N, cells, s_start, world) + extra_room
             if HT.shape[0] - st[S_HEAP_N] < room:
                 if compact(HT, HI, HN, st, N) < room:
@@ -295,8 +307,12 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
                 continue  # the entries moved: pick again
             if log and st[S_LOGGED] == rows.shape[0]:
                 return STATUS_LOG_FULL
-            # apply it: refile (a cell crossing), reflect (a wall) or exchange (a pair); count, log
-            t, key, ca, cb, nx, ny = remove(HT, HI, HN, st, k)
+            # apply it: refile (a cell crossing), reflect (a wall) or exchange (a pair); count, log.
+            # (A horizon stays in its slot: predicting the object again replaces it.)
+            if horizon:
+                t = QT[k]
+            else:
+                t, key, ca, cb, nx, ny = remove(HT, HI, HN, st, k)
             stf[SF_T_NOW] = t
             if rank == RANK_CROSS:
                 n_jobs = _on_cross(a, b, N, cells, world, jobs)
@@ -304,7 +320,8 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
                 st[S_TICK_EVENTS] += 1
                 if st[S_TICK_EVENTS] > cap:  # put it back: a call with a higher cap resumes
                     st[S_TICK_EVENTS] -= 1
-                    push(HT, HI, HN, st, t, key, ca, cb, nx, ny)
+                    if not horizon:
+                        push(HT, HI, HN, st, t, key, ca, cb, nx, ny)
                     return STATUS_CAP
                 if rank == RANK_WALL:
                     n_jobs = _on_wall(a, b, t, F, N, world, jobs)
@@ -337,7 +354,9 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
                 set_job(jobs, J_EXTRA, extra, N[extra, PARTNER], JOB_CONTACTS)
                 job = J_EXTRA
                 extra += 1
-            predict(jobs, job, t, F, N, C, cells, s_start, s_items, HT, HI, HN, st, world)
+            predict(
+                jobs, job, t, F, N, C, cells, s_start, s_items, HT, HI, HN, QT, QK, QP, st, world
+            )
 
 
 class Model:
@@ -408,6 +427,7 @@ class Model:
         self._G = build_grid(self._F, self._N, self.cell_size, gnx, gny)
         cap = max(64, HEAP_PER_OBJECT * n)
         self._heap = [np.empty(cap), np.empty((cap, 3), np.int64), np.empty((cap, 2))]
+        self._horizons = new_horizons(static)
         self._st = np.zeros(8, np.int64)
         self._stf = np.zeros(1)
         self._jobs = np.zeros((JOB_ROWS, 3), np.int64)  # scratch: the prediction jobs of one event
@@ -416,7 +436,15 @@ class Model:
     def _state(self) -> State:
         """The arrays the kernels share."""
         return State(
-            self._F, self._N, self._C, *self._G, *self._heap, self._st, self._stf, self._world
+            self._F,
+            self._N,
+            self._C,
+            *self._G,
+            *self._heap,
+            *self._horizons,
+            self._st,
+            self._stf,
+            self._world,
         )
 
     def advance(self, ticks: int, log: bool = True) -> np.ndarray:
