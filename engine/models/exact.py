@@ -111,6 +111,7 @@ from collide2d.engine.exactstate import (
     J_EXTRA,
     J_OBJ,
     JOB_CONTACTS,
+    JOB_CROSS,
     JOB_EVENT,
     JOB_FIRST,
     JOB_ROWS,
@@ -182,7 +183,7 @@ def _on_cross(i, d, N, cells, world, jobs):
     cell_remove(N, cells, i)
     cell_insert(N, cells, i, gy * gnx + gx)
     N[i, PARTNER] = -1
-    set_job(jobs, 0, i, -1, JOB_EVENT)
+    set_job(jobs, 0, i, d, JOB_CROSS)
     return 1
 
 
