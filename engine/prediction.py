@@ -179,6 +179,7 @@ def predict(jobs, k, t_now, F, N, C, cells, s_start, s_items, HT, HI, HN, QT, QK
         else:
             y1 = gy - 1
     st[S_STAMP] += 1
+    statics = s_items.shape[0] > 0
     for cy in range(y0, y1 + 1):
         for cx in range(x0, x1 + 1):
             c = cy * gnx + cx
@@ -187,6 +188,8 @@ def predict(jobs, k, t_now, F, N, C, cells, s_start, s_items, HT, HI, HN, QT, QK
                 if j != i and j != skip and not (higher and j < i):
                     _predict_pair(i, j, t_now, limit, F, N, C, HT, HI, HN, st)
                 j = N[j, NEXT]
+            if not statics:  # (spares reading the static objects' lists of a scene without any)
+                continue
             for m in range(s_start[c], s_start[c + 1]):
                 j = s_items[m]
                 if N[j, STAMP] != st[S_STAMP] and j != skip:
