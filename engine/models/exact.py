@@ -11,21 +11,27 @@ wall and pair events in the order they happened, `t` = the exact contact time; p
 velocities at the end of the last tick.
 
 Objects fly on straight lines between events. Each keeps its own clock (TLOC: its position is
-valid at that time) and an invalidation counter. A 4-ary heap, in preallocated arrays that grow
-when full, holds predicted events keyed by (time, rank, a, b): cell crossings first (bookkeeping,
-never logged), then walls by (id, side), then pairs in (a, b) order. An entry records the counters
-of its objects when predicted and is skipped as stale if either has changed since.
+valid at that time) and an invalidation counter. Two queues hold what comes next, keyed by (time,
+rank, a, b) so that ties go cell crossings first (bookkeeping, never logged), then walls by (id,
+side), then pairs in (a, b) order: each moving object's *horizon*, the first of its next wall
+contact and its next cell crossing, in its own slot of an indexed heap that predicting the object
+again updates in place (horizonqueue.py); and the predicted contacts, in a 4-ary heap in
+preallocated arrays that grow when full (eventqueue.py), each entry recording the counters of its
+objects when predicted and skipped as stale if either has changed since. The next event is, of
+the events at the earliest one's instant, the one of the smallest key.
 
-Prediction stays local and short. Moving objects are filed in a uniform grid (broadphase.py) by
-their box centre. Each moving object has one entry for its *horizon*: the first of its next wall
-contact and its next cell crossing. Its contacts are predicted against the objects in the 3×3
-cells around it, and pushed only when they come no later than its horizon: at the horizon it is
-predicted again anyway (a wall changes its velocity, a crossing its neighbours), and a contact
-between i and j is always pushed by whichever of the two last changed velocity or cell before it,
-since that one's horizon lies beyond it. After an event only the objects it touched are moved,
-counted and predicted again; a pair is swept from the later of its two clocks, so a predicted
-time depends only on the pair's state, not on when (or on which grid) it was asked. Frames
-sample each object at the tick's end from its own clock.
+Prediction stays local. Moving objects are filed in a uniform grid (cells.py) by their box
+centre. When its velocity changes (a wall, a pair; and at the first prediction) an object's
+contacts are predicted against the objects in the 3×3 cells around it, and pushed when they come
+no later than its next wall contact (its counter changes there, so anything later would be
+stale); after a cell crossing, only against the row or column of cells it has just come next to.
+So a contact between i and j is pushed before it happens: by whichever of the two last changed
+velocity, if they were neighbours then, else by the crossing that made them neighbours (a centre
+crosses one cell side at a time, so the cells it comes next to are that row or column). After
+an event only the objects it touched are moved, counted and predicted again; a pair is swept
+from the later of its two clocks, so a predicted time depends only on the pair's state, not on
+when (or on which grid) it was asked. Frames sample each object at the tick's end from its own
+clock.
 
 Robust rules (contact.next_contact): touching or overlapping and approaching collide now;
 overlapping and separating make no event; nothing is scheduled in the past; a pair that has just
@@ -47,12 +53,13 @@ error is NoRoom naming them (the hot loop keeps no record for this).
 The kernel counts the wall and pair events as they happen, logged or not (`event_counts`).
 
 The parts live in their own modules: the state layout (floats F (n, 8), ints N (n, 8), scalar
-state; exactstate.py), the event queue (a 4-ary heap; eventqueue.py), the grid's per-cell lists
-(cells.py), the predictions (prediction.py), objects with no room to move (noroom.py) and the
-event log (events.py). This module applies events (`_on_cross`, `_on_wall`, `_on_pair`) and
-runs the main loop, `_run`: take the next event, apply it, predict again for what it touched. The
-kernel `_run` (with `predict` inlined) allocates nothing: growing the heap or the event log is
-done in Python between calls (the kernel stops before an event it has no room for, and resumes).
+state; exactstate.py), the horizon queue (horizonqueue.py), the event queue (a 4-ary heap;
+eventqueue.py), the grid's per-cell lists (cells.py), the predictions (prediction.py), objects with
+no room to move (noroom.py) and the event log (events.py). This module applies events (`_on_cross`,
+`_on_wall`, `_on_pair`) and runs the main loop, `_run`: take the next event, apply it, predict
+again for what it touched. The kernel `_run` (with `predict` inlined) allocates nothing: growing
+the heap or the event log is done in Python between calls (the kernel stops before an event it has
+no room for, and resumes).
 """
 
 from __future__ import annotations
