@@ -286,11 +286,17 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
                 return STATUS_DONE
             tick = st[S_TICK] + 1
             t_end = tick / world[2]
-            if st[S_HEAP_N] > 0 and not is_valid(HI, 0, N):  # a stale contact: drop it
+            t_horizon = QT[0] if QT.shape[0] > 0 else INF
+            t_pair = HT[0] if st[S_HEAP_N] > 0 else INF
+            # a stale contact is dropped once it could come first (past the first horizon's
+            # instant it cannot, whether stale or not)
+            if (
+                st[S_HEAP_N] > 0
+                and t_pair <= t_horizon + instant(t_horizon)
+                and not is_valid(HI, 0, N)
+            ):
                 pop(HT, HI, HN, st)
                 continue
-            t_pair = HT[0] if st[S_HEAP_N] > 0 else INF
-            t_horizon = QT[0] if QT.shape[0] > 0 else INF
             t_first = min(t_pair, t_horizon)
             if t_first > t_end + instant(t_end):  # t = k/fps is tick k's
                 stf[SF_T_NOW] = t_end
