@@ -1,13 +1,15 @@
 """The exact model's event queue: a 4-ary heap of predicted events in preallocated arrays.
 
-An entry is a time (HT, float64), a key and the two invalidation counters its objects had when it
-was predicted (HI, int64), and a contact normal (HN, float64). Keys pack (rank, a, b, code) into
-one int64, so ties in time go as cell crossings, then walls by (id, side), then pairs by (a, b).
-An entry is stale once either object's counter (column CNT of N) has changed; stale entries are
-skipped when popped and dropped by `compact` when the heap is full. The heap's size is st[S_HEAP_N].
-Events closer in time than `instant(t)` are one instant (rounding, not physics, parts them) and
-`first_of_instant` takes them in key order. The caller makes sure there is room before a push
-(`has_room`); `grown` doubles an array between kernel calls.
+The model keeps its predicted contacts here (each object's horizon, its next wall contact or cell
+crossing, has a slot of its own in horizonqueue.py, keyed the same way). An entry is a time (HT,
+float64), a key and the two invalidation counters its objects had when it was predicted (HI,
+int64), and a contact normal (HN, float64). Keys pack (rank, a, b, code) into one int64, so ties in
+time go as cell crossings, then walls by (id, side), then pairs by (a, b). An entry is stale once
+either object's counter (column CNT of N) has changed; stale entries are skipped when popped and
+dropped by `compact` when the heap is full. The heap's size is st[S_HEAP_N]. Events closer in time
+than `instant(t)` are one instant (rounding, not physics, parts them) and `first_of_instant` takes
+them in key order. The caller makes sure there is room before a push (`has_room`); `grown` doubles
+an array between kernel calls.
 """
 
 from __future__ import annotations

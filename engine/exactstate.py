@@ -27,7 +27,10 @@ class State(NamedTuple):
     s_items: np.ndarray  # the static objects filed in each cell
     HT: np.ndarray  # heap: event times
     HI: np.ndarray  # heap: event ids and counters
-    HN: np.ndarray  # heap: tie-breaking keys
+    HN: np.ndarray  # heap: contact normals
+    QT: np.ndarray  # horizon queue: times by slot (horizonqueue.py)
+    QK: np.ndarray  # horizon queue: keys by slot
+    QP: np.ndarray  # horizon queue: each object's slot
     st: np.ndarray  # int64 scalar state, indices S_* below
     stf: np.ndarray  # float64 scalar state, indices SF_* below
     world: tuple  # the world's sides and grid, floats
@@ -41,12 +44,13 @@ X, Y, VX, VY, TLOC, SW, SH, INV_MASS = range(8)
 # the partner of its last event if that was a pair (-1 otherwise).
 CNT, STATIC, SHAPE, CELL, NEXT, PREV, STAMP, PARTNER = range(8)
 
-# A prediction job (one row of `jobs`): the object, the partner to leave out (-1: none), and its
-# mode: JOB_EVENT (after an event of the object), JOB_FIRST (the first prediction: only static
-# objects and higher ids, each pair once), JOB_CONTACTS (only contacts, no horizon: the extra
-# predictions of `repredict="all"`).
+# A prediction job (one row of `jobs`): the object, the partner to leave out (-1: none; for
+# JOB_CROSS, the direction it crossed in), and its mode: JOB_EVENT (after an event of the object),
+# JOB_FIRST (the first prediction: only static objects and higher ids, each pair once),
+# JOB_CONTACTS (only contacts, no horizon: the extra predictions of `repredict="all"`), JOB_CROSS
+# (after a cell crossing: its horizon, and contacts only with the cells it has just come next to).
 J_OBJ, J_SKIP, J_HIGHER = range(3)
-JOB_EVENT, JOB_FIRST, JOB_CONTACTS = range(3)
+JOB_EVENT, JOB_FIRST, JOB_CONTACTS, JOB_CROSS = range(4)
 # Rows of `jobs`: the (at most two) objects an event touched, and one for the extra predictions.
 JOB_ROWS = 3
 J_EXTRA = 2

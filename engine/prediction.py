@@ -1,9 +1,10 @@
 """The exact model's predictions: an object's next wall contact, cell crossing and contacts.
 
-A prediction job (a row of `jobs`, see exactstate.py) names an object; `predict` pushes its
-horizon (the first of its next wall contact and its next cell crossing) and its contacts with the
-objects in the 3×3 cells around it that come no later than the horizon. A pair is swept from the
-later of its two clocks (contact.next_contact), so a predicted time depends only on the pair's
+A prediction job (a row of `jobs`, see exactstate.py) names an object; `predict` sets its horizon
+(the first of its next wall contact and its next cell crossing) in the horizon queue
+(horizonqueue.py) and pushes its contacts with the objects in the 3×3 cells around it that come no
+later than the horizon on the event queue (eventqueue.py). A pair is swept from the later of its
+two clocks (contact.next_contact), so a predicted time depends only on the pair's
 state.
 """
 
@@ -25,6 +26,7 @@ from collide2d.engine.exactstate import (
     J_OBJ,
     J_SKIP,
     JOB_CONTACTS,
+    JOB_CROSS,
     JOB_FIRST,
     NEXT,
     S_STAMP,
@@ -39,6 +41,7 @@ from collide2d.engine.exactstate import (
     Y,
     hot,
 )
+from collide2d.engine.horizonqueue import set_horizon
 from collide2d.engine.jit import njit
 from collide2d.engine.world import KIND_BOX
 
@@ -115,8 +118,8 @@ def _shape_contact(a, b, qx, qy, ux, uy, now, F, N, C):
 
 
 @hot
-def _predict_pair(i, j, t_now, horizon, F, N, C, HT, HI, HN, st):
-    """Push the next contact of i and j if it comes no later than `horizon` (s).
+def _predict_pair(i, j, t_now, limit, F, N, C, HT, HI, HN, st):
+    """Push the next contact of i and j if it comes no later than `limit` (s).
 
     The pair is swept from the later of the two objects' clocks, so that only one position is
     carried forward and the predicted time does not depend on when the question is asked.
@@ -128,7 +131,7 @@ def _predict_pair(i, j, t_now, horizon, F, N, C, HT, HI, HN, st):
     qy = (F[b, Y] + F[b, VY] * (t0 - F[b, TLOC])) - (F[a, Y] + F[a, VY] * (t0 - F[a, TLOC]))
     ux = F[b, VX] - F[a, VX]
     uy = F[b, VY] - F[a, VY]
-    if not box_reach(qx, qy, ux, uy, F[a, SW], F[a, SH], F[b, SW], F[b, SH], horizon - t0):
+    if not box_reach(qx, qy, ux, uy, F[a, SW], F[a, SH], F[b, SW], F[b, SH], limit - t0):
         return
     now = t_now - t0
     if N[a, SHAPE] == KIND_BOX and N[b, SHAPE] == KIND_BOX:
@@ -138,46 +141,60 @@ def _predict_pair(i, j, t_now, horizon, F, N, C, HT, HI, HN, st):
     else:
         t, code, nx, ny = _shape_contact(a, b, qx, qy, ux, uy, now, F, N, C)
     t = max(t0 + t, t_now)
-    if t <= horizon:
+    if t <= limit:
         push(HT, HI, HN, st, t, make_key(RANK_PAIR, a, b, code), N[a, CNT], N[b, CNT], nx, ny)
 
 
 @hot
-def predict(jobs, k, t_now, F, N, C, cells, s_start, s_items, HT, HI, HN, st, world):
-    """Run prediction job k for object i: push its horizon (the first of its next wall contact
-    and its next cell crossing) and its contacts with the objects in the 3×3 cells around it
-    that come no later than that. Inlined into the event loop's one call site: a call would
-    cost more than the prediction of a small scene."""
+def predict(jobs, k, t_now, F, N, C, cells, s_start, s_items, HT, HI, HN, QT, QK, QP, st, world):
+    """Run prediction job k for object i: set its horizon (the first of its next wall contact
+    and its next cell crossing; horizonqueue.py) and push its contacts with the objects in the
+    3×3 cells around it that come no later than that. Inlined into the event loop's one call
+    site: a call would cost more than the prediction of a small scene."""
     i, skip, mode = jobs[k, J_OBJ], jobs[k, J_SKIP], jobs[k, J_HIGHER]
     higher = mode == JOB_FIRST
     t_wall, side = _wall_time(i, F, world)
-    t_cross, d = _cross_time(i, F, N, world)
-    if mode == JOB_CONTACTS:
-        pass
-    elif t_cross <= t_wall and t_cross < INF:
-        key = make_key(RANK_CROSS, i, d, d)
-        push(HT, HI, HN, st, max(t_cross, t_now), key, N[i, CNT], 0, 0.0, 0.0)
-    elif t_wall < INF:
-        key = make_key(RANK_WALL, i, side, side)
-        push(HT, HI, HN, st, max(t_wall, t_now), key, N[i, CNT], 0, 0.0, 0.0)
-    horizon = max(min(t_wall, t_cross), t_now)
+    if mode != JOB_CONTACTS:
+        t_cross, d = _cross_time(i, F, N, world)
+        if t_cross <= t_wall and t_cross < INF:
+            set_horizon(QT, QK, QP, i, max(t_cross, t_now), make_key(RANK_CROSS, i, d, d))
+        elif t_wall < INF:
+            set_horizon(QT, QK, QP, i, max(t_wall, t_now), make_key(RANK_WALL, i, side, side))
+        else:
+            set_horizon(QT, QK, QP, i, INF, make_key(RANK_WALL, i, 0, 0))
+    limit = max(t_wall, t_now)
     gnx, gny = world[4], world[5]
     gx = N[i, CELL] % gnx
     gy = N[i, CELL] // gnx
+    x0, x1 = max(gx - 1, 0), min(gx + 1, gnx - 1)
+    y0, y1 = max(gy - 1, 0), min(gy + 1, gny - 1)
+    if mode == JOB_CROSS:  # only the row or column of cells it has just come next to
+        came, skip = skip, -1
+        if came == DIR_RIGHT:
+            x0 = gx + 1
+        elif came == DIR_LEFT:
+            x1 = gx - 1
+        elif came == DIR_DOWN:
+            y0 = gy + 1
+        else:
+            y1 = gy - 1
     st[S_STAMP] += 1
-    for cy in range(max(gy - 1, 0), min(gy + 1, gny - 1) + 1):
-        for cx in range(max(gx - 1, 0), min(gx + 1, gnx - 1) + 1):
+    statics = s_items.shape[0] > 0
+    for cy in range(y0, y1 + 1):
+        for cx in range(x0, x1 + 1):
             c = cy * gnx + cx
             j = cells[c, C_HEAD]
             while j >= 0:
                 if j != i and j != skip and not (higher and j < i):
-                    _predict_pair(i, j, t_now, horizon, F, N, C, HT, HI, HN, st)
+                    _predict_pair(i, j, t_now, limit, F, N, C, HT, HI, HN, st)
                 j = N[j, NEXT]
+            if not statics:  # (spares reading the static objects' lists of a scene without any)
+                continue
             for m in range(s_start[c], s_start[c + 1]):
                 j = s_items[m]
                 if N[j, STAMP] != st[S_STAMP] and j != skip:
                     N[j, STAMP] = st[S_STAMP]
-                    _predict_pair(i, j, t_now, horizon, F, N, C, HT, HI, HN, st)
+                    _predict_pair(i, j, t_now, limit, F, N, C, HT, HI, HN, st)
 
 
 @hot

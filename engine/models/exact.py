@@ -11,21 +11,27 @@ wall and pair events in the order they happened, `t` = the exact contact time; p
 velocities at the end of the last tick.
 
 Objects fly on straight lines between events. Each keeps its own clock (TLOC: its position is
-valid at that time) and an invalidation counter. A 4-ary heap, in preallocated arrays that grow
-when full, holds predicted events keyed by (time, rank, a, b): cell crossings first (bookkeeping,
-never logged), then walls by (id, side), then pairs in (a, b) order. An entry records the counters
-of its objects when predicted and is skipped as stale if either has changed since.
+valid at that time) and an invalidation counter. Two queues hold what comes next, keyed by (time,
+rank, a, b) so that ties go cell crossings first (bookkeeping, never logged), then walls by (id,
+side), then pairs in (a, b) order: each moving object's *horizon*, the first of its next wall
+contact and its next cell crossing, in its own slot of an indexed heap that predicting the object
+again updates in place (horizonqueue.py); and the predicted contacts, in a 4-ary heap in
+preallocated arrays that grow when full (eventqueue.py), each entry recording the counters of its
+objects when predicted and skipped as stale if either has changed since. The next event is, of
+the events at the earliest one's instant, the one of the smallest key.
 
-Prediction stays local and short. Moving objects are filed in a uniform grid (broadphase.py) by
-their box centre. Each moving object has one entry for its *horizon*: the first of its next wall
-contact and its next cell crossing. Its contacts are predicted against the objects in the 3×3
-cells around it, and pushed only when they come no later than its horizon: at the horizon it is
-predicted again anyway (a wall changes its velocity, a crossing its neighbours), and a contact
-between i and j is always pushed by whichever of the two last changed velocity or cell before it,
-since that one's horizon lies beyond it. After an event only the objects it touched are moved,
-counted and predicted again; a pair is swept from the later of its two clocks, so a predicted
-time depends only on the pair's state, not on when (or on which grid) it was asked. Frames
-sample each object at the tick's end from its own clock.
+Prediction stays local. Moving objects are filed in a uniform grid (cells.py) by their box
+centre. When its velocity changes (a wall, a pair; and at the first prediction) an object's
+contacts are predicted against the objects in the 3×3 cells around it, and pushed when they come
+no later than its next wall contact (its counter changes there, so anything later would be
+stale); after a cell crossing, only against the row or column of cells it has just come next to.
+So a contact between i and j is pushed before it happens: by whichever of the two last changed
+velocity, if they were neighbours then, else by the crossing that made them neighbours (a centre
+crosses one cell side at a time, so the cells it comes next to are that row or column). After
+an event only the objects it touched are moved, counted and predicted again; a pair is swept
+from the later of its two clocks, so a predicted time depends only on the pair's state, not on
+when (or on which grid) it was asked. Frames sample each object at the tick's end from its own
+clock.
 
 Robust rules (contact.next_contact): touching or overlapping and approaching collide now;
 overlapping and separating make no event; nothing is scheduled in the past; a pair that has just
@@ -47,12 +53,13 @@ error is NoRoom naming them (the hot loop keeps no record for this).
 The kernel counts the wall and pair events as they happen, logged or not (`event_counts`).
 
 The parts live in their own modules: the state layout (floats F (n, 8), ints N (n, 8), scalar
-state; exactstate.py), the event queue (a 4-ary heap; eventqueue.py), the grid's per-cell lists
-(cells.py), the predictions (prediction.py), objects with no room to move (noroom.py) and the
-event log (events.py). This module applies events (`_on_cross`, `_on_wall`, `_on_pair`) and
-runs the main loop, `_run`: take the next event, apply it, predict again for what it touched. The
-kernel `_run` (with `predict` inlined) allocates nothing: growing the heap or the event log is
-done in Python between calls (the kernel stops before an event it has no room for, and resumes).
+state; exactstate.py), the horizon queue (horizonqueue.py), the event queue (a 4-ary heap;
+eventqueue.py), the grid's per-cell lists (cells.py), the predictions (prediction.py), objects with
+no room to move (noroom.py) and the event log (events.py). This module applies events (`_on_cross`,
+`_on_wall`, `_on_pair`) and runs the main loop, `_run`: take the next event, apply it, predict
+again for what it touched. The kernel `_run` (with `predict` inlined) allocates nothing: growing
+the heap or the event log is done in Python between calls (the kernel stops before an event it has
+no room for, and resumes).
 """
 
 from __future__ import annotations
@@ -106,10 +113,12 @@ from collide2d.engine.exactstate import (
     DIR_LEFT,
     DIR_RIGHT,
     DIR_UP,
+    INF,
     INV_MASS,
     J_EXTRA,
     J_OBJ,
     JOB_CONTACTS,
+    JOB_CROSS,
     JOB_EVENT,
     JOB_FIRST,
     JOB_ROWS,
@@ -139,6 +148,7 @@ from collide2d.engine.exactstate import (
     hot,
     kernel,
 )
+from collide2d.engine.horizonqueue import first_horizon, new_horizons
 from collide2d.engine.noroom import jammed, listing, no_room, no_room_message
 from collide2d.engine.prediction import predict, set_job
 from collide2d.engine.response import exchange
@@ -180,7 +190,7 @@ def _on_cross(i, d, N, cells, world, jobs):
     cell_remove(N, cells, i)
     cell_insert(N, cells, i, gy * gnx + gx)
     N[i, PARTNER] = -1
-    set_job(jobs, 0, i, -1, JOB_EVENT)
+    set_job(jobs, 0, i, d, JOB_CROSS)
     return 1
 
 
@@ -250,7 +260,7 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
     with a higher cap would resume). st[S_LOGGED] counts the rows written, st[S_WALLS] and
     st[S_PAIRS] every event, logged or not.
     """
-    F, N, C, cells, s_start, s_items, HT, HI, HN, st, stf, world = S
+    F, N, C, cells, s_start, s_items, HT, HI, HN, QT, QK, QP, st, stf, world = S
     n = F.shape[0]
     extra_room = n * n if everyone else 0
     # (The loop's steps are written out here, not as inlined helpers: helpers cost ~15 % of the
@@ -276,18 +286,34 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
                 return STATUS_DONE
             tick = st[S_TICK] + 1
             t_end = tick / world[2]
-            if st[S_HEAP_N] == 0 or HT[0] > t_end + instant(t_end):  # t = k/fps is tick k's
+            t_horizon = QT[0] if QT.shape[0] > 0 else INF
+            t_pair = HT[0] if st[S_HEAP_N] > 0 else INF
+            # a stale contact is dropped once it could come first (past the first horizon's
+            # instant it cannot, whether stale or not)
+            if (
+                st[S_HEAP_N] > 0
+                and t_pair <= t_horizon + instant(t_horizon)
+                and not is_valid(HI, 0, N)
+            ):
+                pop(HT, HI, HN, st)
+                continue
+            t_first = min(t_pair, t_horizon)
+            if t_first > t_end + instant(t_end):  # t = k/fps is tick k's
                 stf[SF_T_NOW] = t_end
                 st[S_TICK] = tick
                 st[S_TICK_EVENTS] = 0
                 continue
-            # take the next event: the first valid entry of the top's instant, in key order, once
-            # the heap has room for what it may push
-            if not is_valid(HI, 0, N):
-                pop(HT, HI, HN, st)
-                continue
-            k = first_of_instant(HT, HI, st, N, stack)
-            rank, a, b, code = split_key(HI[k, HKEY])
+            # take the next event: of the valid events at the first one's instant, the one of the
+            # smallest key (a horizon's key is smaller than any contact's), once the heap has room
+            # for what it may push
+            horizon = t_horizon <= t_first + instant(t_first)
+            if horizon:
+                k = first_horizon(QT, QK, t_first + instant(t_first), stack)
+                key = QK[k]
+            else:
+                k = first_of_instant(HT, HI, st, N, stack)
+                key = HI[k, HKEY]
+            rank, a, b, code = split_key(key)
             room = room_needed(rank, a, b, HT, st, N, cells, s_start, world) + extra_room
             if HT.shape[0] - st[S_HEAP_N] < room:
                 if compact(HT, HI, HN, st, N) < room:
@@ -295,8 +321,12 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
                 continue  # the entries moved: pick again
             if log and st[S_LOGGED] == rows.shape[0]:
                 return STATUS_LOG_FULL
-            # apply it: refile (a cell crossing), reflect (a wall) or exchange (a pair); count, log
-            t, key, ca, cb, nx, ny = remove(HT, HI, HN, st, k)
+            # apply it: refile (a cell crossing), reflect (a wall) or exchange (a pair); count, log.
+            # (A horizon stays in its slot: predicting the object again replaces it.)
+            if horizon:
+                t = QT[k]
+            else:
+                t, key, ca, cb, nx, ny = remove(HT, HI, HN, st, k)
             stf[SF_T_NOW] = t
             if rank == RANK_CROSS:
                 n_jobs = _on_cross(a, b, N, cells, world, jobs)
@@ -304,7 +334,8 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
                 st[S_TICK_EVENTS] += 1
                 if st[S_TICK_EVENTS] > cap:  # put it back: a call with a higher cap resumes
                     st[S_TICK_EVENTS] -= 1
-                    push(HT, HI, HN, st, t, key, ca, cb, nx, ny)
+                    if not horizon:
+                        push(HT, HI, HN, st, t, key, ca, cb, nx, ny)
                     return STATUS_CAP
                 if rank == RANK_WALL:
                     n_jobs = _on_wall(a, b, t, F, N, world, jobs)
@@ -337,7 +368,9 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
                 set_job(jobs, J_EXTRA, extra, N[extra, PARTNER], JOB_CONTACTS)
                 job = J_EXTRA
                 extra += 1
-            predict(jobs, job, t, F, N, C, cells, s_start, s_items, HT, HI, HN, st, world)
+            predict(
+                jobs, job, t, F, N, C, cells, s_start, s_items, HT, HI, HN, QT, QK, QP, st, world
+            )
 
 
 class Model:
@@ -408,6 +441,7 @@ class Model:
         self._G = build_grid(self._F, self._N, self.cell_size, gnx, gny)
         cap = max(64, HEAP_PER_OBJECT * n)
         self._heap = [np.empty(cap), np.empty((cap, 3), np.int64), np.empty((cap, 2))]
+        self._horizons = new_horizons(static)
         self._st = np.zeros(8, np.int64)
         self._stf = np.zeros(1)
         self._jobs = np.zeros((JOB_ROWS, 3), np.int64)  # scratch: the prediction jobs of one event
@@ -416,7 +450,15 @@ class Model:
     def _state(self) -> State:
         """The arrays the kernels share."""
         return State(
-            self._F, self._N, self._C, *self._G, *self._heap, self._st, self._stf, self._world
+            self._F,
+            self._N,
+            self._C,
+            *self._G,
+            *self._heap,
+            *self._horizons,
+            self._st,
+            self._stf,
+            self._world,
         )
 
     def advance(self, ticks: int, log: bool = True) -> np.ndarray:
