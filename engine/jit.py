@@ -169,8 +169,12 @@ def _package_fingerprint(root: str) -> str:
             if name.endswith(".py"):
                 path = os.path.join(folder, name)
                 digest.update(os.path.relpath(path, root).encode())
-                with open(path, "rb") as f:
-                    digest.update(hashlib.sha256(f.read()).digest())
+                try:
+                    with open(path, "rb") as f:
+                        digest.update(hashlib.sha256(f.read()).digest())
+                except OSError:  # a file this process may not read: its size and time stand in
+                    stat = os.stat(path)
+                    digest.update(f"{stat.st_size}:{stat.st_mtime_ns}".encode())
     return digest.hexdigest()
 
 

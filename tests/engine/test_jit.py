@@ -135,3 +135,21 @@ def test_an_edit_of_a_called_kernels_file_alone_compiles_the_caller_afresh(tmp_p
     (package / "callee.py").write_text(CALLEE.format(factor=3))
     assert run() == ["10", "f", "g"]  # compiled again, the caller too: its callee changed
     assert run() == ["10", "none"]
+
+
+def test_a_source_that_cannot_be_read_still_gives_a_package_digest(tmp_path, monkeypatch):
+    # a file the process may not read (another user's, say) must not stop a compiled run: its
+    # size and time stand in for its text, so changing it still changes the digest
+    (tmp_path / "a.py").write_text("x = 1\n")
+    (tmp_path / "locked.py").write_text("y = 2\n")
+    opened = open
+
+    def refuse_locked(path, *args, **kwargs):
+        if str(path).endswith("locked.py"):
+            raise PermissionError(path)
+        return opened(path, *args, **kwargs)
+
+    monkeypatch.setattr("builtins.open", refuse_locked)
+    before = jit._package_fingerprint.__wrapped__(str(tmp_path))
+    (tmp_path / "locked.py").write_text("y = 22\n")
+    assert jit._package_fingerprint.__wrapped__(str(tmp_path)) != before
