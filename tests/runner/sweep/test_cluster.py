@@ -196,7 +196,7 @@ def test_ctrl_c_writes_the_rows_done_marked_incomplete(tmp_path):
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
             proc.wait()
-    assert proc.returncode == 130
+    assert proc.returncode == 130, f"stdout: {out_text!r}; stderr: {err_text!r}"
     assert _group_ends(proc.pid), "a worker process outlived the sweep"
     assert "Traceback" not in err_text and "KeyboardInterrupt" not in err_text
     status = json.loads((out / "sweep" / "sweep.json").read_text())
