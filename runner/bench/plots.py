@@ -91,6 +91,11 @@ def _pareto_figure(plt, ticker, err, sens, folder, atomic_path) -> None:
             if r["scene"] == scene:
                 ax.axhline(max(r["error_long_px"], ERROR_FLOOR_PX), color="red", linewidth=0.8,
                            linestyle=":", label="exact, velocities nudged 1e-9 px/s")  # fmt: skip
+        ys = [max(r["error_long_px"], ERROR_FLOOR_PX) for r in mine]
+        if max(ys) == min(ys) and not any(r["scene"] == scene for r in sens):
+            # every point at one error (say all at the floor): a decade either side, not
+            # matplotlib's warning about a range of zero height
+            ax.set_ylim(ys[0] / 10, ys[0] * 10)
         ax.set(xscale="log", yscale="log", title=scene)
         span = f"{long_s:g} s" if long_s is not None else "the run's end"
         ax.set_xlabel(f"run time to {span} of simulation (s)")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+import warnings
 
 import pytest
 
@@ -31,3 +32,16 @@ def test_plots_are_written_with_matplotlib(tmp_path):
     ]  # fmt: skip
     assert plots.plots(rows, tmp_path) == ["scaling.png", "runtime_vs_error.png"]
     assert (tmp_path / "runtime_vs_error.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_points_all_at_one_error_plot_without_a_warning(tmp_path):
+    # a sweep of the exact model: every error at the floor, a y range of zero height
+    pytest.importorskip("matplotlib")
+    rows = [
+        {"part": "error", "scene": "s", "model": "exact", "fps": fps, "substeps": 1,
+         "run_time_s": 0.1 * fps, "long_s": 10.0, "error_long_px": 0.0, "pareto": "yes"}
+        for fps in (10, 60)
+    ]  # fmt: skip
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert plots.plots(rows, tmp_path) == ["runtime_vs_error.png"]
