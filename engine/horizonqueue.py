@@ -13,25 +13,27 @@ without one, a look at every object. `first_horizon` takes, of the horizons with
 the first, the one with the smallest key, as the event queue does for its contacts. The order is
 that of (time, key) exactly, whatever w is: w only sets how much walking finding the next takes.
 
-The queue is one tuple Q = (QT, QK, QL, QH, QS, QW): each object's horizon time QT (n,) float64
-(inf: none, or a static object) and key QK (n,) int64 (eventqueue.py keys: rank, id, side or
-direction, so ties go crossings first, then walls, by id); its links QL (n, 3) int64 (next and
-previous object in its bucket's list, -1 for none, and its bucket, -1 when in none); the first
-object of each ring slot QH (slots,) int64 (-1: empty; slots a power of two); the scalar state QS
-(the bucket the walk is at, every filed horizon's bucket being at least it; the object of the
-first horizon, -1 when not known; how many horizons are filed) and the width QW (1,) float64, s.
+The queue is one tuple Q = (QT, QC, QL, QH, QS, QW), small, as the event loop's memory
+traffic is most of its time: each object's horizon time QT (n,) float64 (inf: none, or a static
+object; the bucket of a finite one is QT·QW[0], rounded down) and what it is, QC (n,) int8 (rank
+× 4 + side or direction: its event queue key, eventqueue.py, is `horizon_key`, so ties go
+crossings first, then walls, by id); its links QL (n, 2) int32 (next and previous object in its
+bucket's list, -1 for none); the first object of each ring slot QH (slots,) int32 (-1: empty;
+slots a power of two); the scalar state QS (the bucket the walk is at, every filed horizon's
+bucket being at least it; the object of the first horizon, -1 when not known; how many horizons
+are filed) and QW (1,) float64, one over the bucket width (1/s).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from collide2d.engine.eventqueue import A_SHIFT, RANK_SHIFT, RANK_WALL
+from collide2d.engine.eventqueue import ID_BITS, RANK_WALL, make_key
 from collide2d.engine.exactstate import INF, hot
 from collide2d.engine.jit import njit
 
-# Columns of QL: the next and previous object in the same bucket's list, and the bucket.
-Q_NEXT, Q_PREV, Q_BUCKET = range(3)
+# Columns of QL: the next and previous object in the same bucket's list.
+Q_NEXT, Q_PREV = range(2)
 # QS: the bucket the walk is at, the object of the first horizon (-1: not known), horizons filed.
 QS_AT, QS_TOP, QS_FILED = range(3)
 # A horizon this many bucket widths away or more is filed in the bucket FAR (no int64 overflow).
@@ -65,59 +67,79 @@ def new_horizons(static: np.ndarray, width: float) -> tuple:
     while slots < SLOTS_PER_OBJECT * int((~static).sum()):
         slots *= 2
     QT = np.full(n, INF)
-    QK = (RANK_WALL << RANK_SHIFT) | (np.arange(n, dtype=np.int64) << A_SHIFT)
-    QL = np.full((n, 3), -1, np.int64)
-    QH = np.full(slots, -1, np.int64)
+    QC = np.full(n, RANK_WALL * 4, np.int8)
+    QL = np.full((n, 2), -1, np.int32)
+    QH = np.full(slots, -1, np.int32)
     QS = np.zeros(3, np.int64)
     QS[QS_TOP] = -1
-    QW = np.array([float(width)])
-    return QT, QK, QL, QH, QS, QW
+    QW = np.array([1.0 / float(width)])
+    return QT, QC, QL, QH, QS, QW
 
 
 @hot
-def _before(QT, QK, i, j):
-    """Object i's horizon comes before object j's, by (time, key)."""
-    return QT[i] < QT[j] or (QT[i] == QT[j] and QK[i] < QK[j])
+def horizon_key(Q, i):
+    """Object i's horizon as an event queue key (rank, i, side or direction)."""
+    c = int(Q[1][i])
+    return make_key(c >> 2, int(i), c & 3, c & 3)
+
+
+@hot
+def _bucket(t, QW):
+    a = t * QW[0]
+    return int(a) if a < FAR else FAR
+
+
+@hot
+def _order(QC, i):
+    """Where object i's horizon key goes among other objects': by (rank, id)."""
+    return ((int(QC[i]) >> 2) << ID_BITS) | int(i)
+
+
+@hot
+def _before(QT, QC, i, j):
+    """Object i's horizon comes before object j's (another object's), by (time, key)."""
+    if QT[i] != QT[j]:
+        return QT[i] < QT[j]
+    return _order(QC, i) < _order(QC, j)
 
 
 @njit(cache=True)
-def set_horizon(Q, i, t, key):
-    """Object i's horizon becomes (t, key) (t >= the present; inf: none): it leaves its bucket
-    for that of t, and the first horizon stays known unless it was i's and i's is now later."""
-    QT, QK, QL, QH, QS, QW = Q
+def set_horizon(Q, i, t, rank, d):
+    """Object i's horizon becomes (t, rank, side or direction d) (t >= the present; inf: none):
+    it leaves its bucket for that of t, and the first horizon stays known unless it was i's and
+    i's is now later."""
+    QT, QC, QL, QH, QS, QW = Q
     mask = QH.shape[0] - 1
-    if QL[i, Q_BUCKET] >= 0:  # unlink
-        nxt, prv = QL[i, Q_NEXT], QL[i, Q_PREV]
+    if QT[i] < INF:  # unlink
+        nxt, prv = int(QL[i, Q_NEXT]), int(QL[i, Q_PREV])
         if prv >= 0:
             QL[prv, Q_NEXT] = nxt
         else:
-            QH[QL[i, Q_BUCKET] & mask] = nxt
+            QH[_bucket(QT[i], QW) & mask] = nxt
         if nxt >= 0:
             QL[nxt, Q_PREV] = prv
         QS[QS_FILED] -= 1
     top = QS[QS_TOP]
-    later = top == i and (t > QT[i] or (t == QT[i] and key > QK[i]))
+    code = rank * 4 + d
+    later = top == i and (t > QT[i] or (t == QT[i] and code > QC[i]))
     QT[i] = t
-    QK[i] = key
+    QC[i] = code
     if t < INF:
-        a = t / QW[0]
-        b = int(a) if a < FAR else FAR
+        b = _bucket(t, QW)
         s = b & mask
-        QL[i, Q_BUCKET] = b
         QL[i, Q_PREV] = -1
-        QL[i, Q_NEXT] = QH[s]
-        if QH[s] >= 0:
-            QL[QH[s], Q_PREV] = i
+        head = int(QH[s])
+        QL[i, Q_NEXT] = head
+        if head >= 0:
+            QL[head, Q_PREV] = i
         QH[s] = i
         QS[QS_FILED] += 1
         if b < QS[QS_AT]:
             QS[QS_AT] = b
-    else:
-        QL[i, Q_BUCKET] = -1
     if top == i:
         if later:
             QS[QS_TOP] = -1
-    elif top >= 0 and _before(QT, QK, i, top):
+    elif top >= 0 and _before(QT, QC, i, top):
         QS[QS_TOP] = i
 
 
@@ -126,7 +148,7 @@ def find_top(Q):
     """The object of the first horizon (by time, then key), -1 if none has one; kept known in
     QS. Walks the buckets from the current one to the first holding a horizon of its own (not
     one of a later pass of the ring); after a whole ring without, looks at every object."""
-    QT, QK, QL, QH, QS, QW = Q
+    QT, QC, QL, QH, QS, QW = Q
     if QS[QS_FILED] == 0:
         QS[QS_TOP] = -1
         return -1
@@ -134,19 +156,19 @@ def find_top(Q):
     at = QS[QS_AT]
     best = -1
     for _ in range(QH.shape[0]):
-        j = QH[at & mask]
+        j = int(QH[at & mask])
         while j >= 0:
-            if QL[j, Q_BUCKET] == at and (best < 0 or _before(QT, QK, j, best)):
+            if _bucket(QT[j], QW) == at and (best < 0 or _before(QT, QC, j, best)):
                 best = j
-            j = QL[j, Q_NEXT]
+            j = int(QL[j, Q_NEXT])
         if best >= 0:
             break
         at += 1
     if best < 0:  # a whole ring of slots without one: look at every object
         for j in range(QT.shape[0]):
-            if QL[j, Q_BUCKET] >= 0 and (best < 0 or _before(QT, QK, j, best)):
+            if QT[j] < INF and (best < 0 or _before(QT, QC, j, best)):
                 best = j
-        at = QL[best, Q_BUCKET]
+        at = _bucket(QT[best], QW)
     QS[QS_AT] = at
     QS[QS_TOP] = best
     return best
@@ -156,16 +178,14 @@ def find_top(Q):
 def first_horizon(Q, bound):
     """The object of the horizon to take next: of those no later than `bound` (the first
     horizon's, at least; it is known), the one with the smallest key."""
-    QT, QK, QL, QH, QS, QW = Q
+    QT, QC, QL, QH, QS, QW = Q
     mask = QH.shape[0] - 1
-    best = QS[QS_TOP]
-    a = bound / QW[0]
-    last = int(a) if a < FAR else FAR
-    last = min(last, QS[QS_AT] + mask)  # a whole ring sees every slot
+    best = int(QS[QS_TOP])
+    last = min(_bucket(bound, QW), QS[QS_AT] + mask)  # a whole ring sees every slot
     for b in range(QS[QS_AT], last + 1):
-        j = QH[b & mask]
+        j = int(QH[b & mask])
         while j >= 0:
-            if QT[j] <= bound and QK[j] < QK[best]:
+            if QT[j] <= bound and _order(QC, j) < _order(QC, best):
                 best = j
-            j = QL[j, Q_NEXT]
+            j = int(QL[j, Q_NEXT])
     return best

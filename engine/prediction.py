@@ -157,11 +157,11 @@ def predict(jobs, k, t_now, F, N, C, cells, s_start, s_items, HT, HI, HN, Q, st,
     if mode != JOB_CONTACTS:
         t_cross, d = _cross_time(i, F, N, world)
         if t_cross <= t_wall and t_cross < INF:
-            set_horizon(Q, i, max(t_cross, t_now), make_key(RANK_CROSS, i, d, d))
+            set_horizon(Q, i, max(t_cross, t_now), RANK_CROSS, d)
         elif t_wall < INF:
-            set_horizon(Q, i, max(t_wall, t_now), make_key(RANK_WALL, i, side, side))
+            set_horizon(Q, i, max(t_wall, t_now), RANK_WALL, side)
         else:
-            set_horizon(Q, i, INF, make_key(RANK_WALL, i, 0, 0))
+            set_horizon(Q, i, INF, RANK_WALL, 0)
     limit = max(t_wall, t_now)
     gnx, gny = world[4], world[5]
     gx = N[i, CELL] % gnx

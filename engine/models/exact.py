@@ -154,6 +154,7 @@ from collide2d.engine.horizonqueue import (
     bucket_width,
     find_top,
     first_horizon,
+    horizon_key,
     new_horizons,
 )
 from collide2d.engine.noroom import jammed, listing, no_room, no_room_message
@@ -268,7 +269,7 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
     st[S_PAIRS] every event, logged or not.
     """
     F, N, C, cells, s_start, s_items, HT, HI, HN, Q, st, stf, world = S
-    QT, QK, QS = Q[0], Q[1], Q[4]
+    QT, QS = Q[0], Q[4]
     n = F.shape[0]
     extra_room = n * n if everyone else 0
     # (The loop's steps are written out here, not as inlined helpers: helpers cost ~15 % of the
@@ -320,7 +321,7 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
             horizon = t_horizon <= t_first + instant(t_first)
             if horizon:
                 k = first_horizon(Q, t_first + instant(t_first))
-                key = QK[k]
+                key = horizon_key(Q, k)
             else:
                 k = first_of_instant(HT, HI, st, N, stack)
                 key = HI[k, HKEY]

@@ -15,12 +15,12 @@ from collide2d.engine import jit
 from collide2d.engine.eventqueue import RANK_CROSS, RANK_WALL, make_key, split_key
 from collide2d.engine.horizonqueue import (
     FAR,
-    Q_BUCKET,
     Q_NEXT,
     QS_TOP,
     bucket_width,
     find_top,
     first_horizon,
+    horizon_key,
     new_horizons,
     set_horizon,
 )
@@ -39,26 +39,29 @@ updates = st.lists(
 )
 
 
+def _bucket(t, QW):
+    a = t * QW[0]
+    return int(a) if a < FAR else FAR
+
+
 def _check(Q, static, expected):
     """The queue holds exactly `expected` ({object: (t, key)}), each finite one filed once in the
     list of its bucket's slot."""
-    QT, QK, QL, QH, QS, QW = Q
+    QT, QC, QL, QH, QS, QW = Q
     mask = QH.size - 1
     seen = []
     for s in range(QH.size):
         j = QH[s]
         while j >= 0:
-            assert QL[j, Q_BUCKET] & mask == s
+            assert _bucket(QT[j], QW) & mask == s
+            assert _bucket(QT[j], QW) >= QS[0]  # never behind the walk
             seen.append(int(j))
             j = QL[j, Q_NEXT]
     filed = sorted(i for i, (t, _) in expected.items() if t < np.inf)
     assert sorted(seen) == filed
     for i, (t, key) in expected.items():
-        assert (QT[i], QK[i]) == (t, key)
-        assert split_key(QK[i])[1] == i
-        if t < np.inf:
-            a = t / QW[0]
-            assert QL[i, Q_BUCKET] == (int(a) if a < FAR else FAR)
+        assert (QT[i], horizon_key(Q, i)) == (t, key)
+        assert split_key(horizon_key(Q, i))[1] == i
     assert not static[seen].any()
 
 
@@ -68,14 +71,15 @@ def _check(Q, static, expected):
 def test_updates_keep_the_first_horizon_known(compiled, moves, seed, width):
     static = np.random.default_rng(seed).random(12) < 0.25
     Q = new_horizons(static, width)
-    QT, QK = Q[0], Q[1]
-    expected = {int(i): (np.inf, QK[i]) for i in np.flatnonzero(~static)}
+    QT = Q[0]
+    expected = {int(i): (np.inf, horizon_key(Q, i)) for i in np.flatnonzero(~static)}
     with jit.lane(compiled):
         for i, t, cross, side, look in moves:
             if static[i]:
                 continue
-            key = make_key(RANK_CROSS if cross else RANK_WALL, i, side, side)
-            set_horizon(Q, i, t, key)
+            rank = RANK_CROSS if cross else RANK_WALL
+            key = make_key(rank, i, side, side)
+            set_horizon(Q, i, t, rank, side)
             expected[i] = (t, key)
             _check(Q, static, expected)
             if not look:
@@ -85,11 +89,11 @@ def test_updates_keep_the_first_horizon_known(compiled, moves, seed, width):
             if not finite:
                 assert top == -1
                 continue
-            assert (QT[top], QK[top], top) == min(finite)
+            assert (QT[top], horizon_key(Q, top), top) == min(finite)
             assert Q[4][QS_TOP] == top
             bound = QT[top] + 2.0**-40  # the instant of the top: its two nearest times at 1.0
             k = first_horizon(Q, bound)
-            assert QK[k] == min(key for t, key, _ in finite if t <= bound)
+            assert horizon_key(Q, k) == min(key for t, key, _ in finite if t <= bound)
 
 
 def test_the_bucket_width_is_about_a_cell_crossing_per_object():
