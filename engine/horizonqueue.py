@@ -178,7 +178,7 @@ def find_top(Q):
     return best
 
 
-@njit(cache=True)
+@hot
 def first_horizon(Q, bound):
     """The object of the horizon to take next: of those no later than `bound` (the first
     horizon's, at least; it is known), the one with the smallest key."""

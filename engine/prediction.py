@@ -157,11 +157,12 @@ def predict(jobs, k, t_now, F, N, C, cells, s_start, s_items, HT, HI, HN, Q, st,
     if mode != JOB_CONTACTS:
         t_cross, d = _cross_time(i, F, N, world)
         if t_cross <= t_wall and t_cross < INF:
-            set_horizon(Q, i, max(t_cross, t_now), RANK_CROSS, d)
+            t_h, rank, what = max(t_cross, t_now), RANK_CROSS, d
         elif t_wall < INF:
-            set_horizon(Q, i, max(t_wall, t_now), RANK_WALL, side)
+            t_h, rank, what = max(t_wall, t_now), RANK_WALL, side
         else:
-            set_horizon(Q, i, INF, RANK_WALL, 0)
+            t_h, rank, what = INF, RANK_WALL, 0
+        set_horizon(Q, i, t_h, rank, what)  # (one call site: one compiled specialisation)
     limit = max(t_wall, t_now)
     gnx, gny = world[4], world[5]
     gx = N[i, CELL] % gnx
