@@ -153,10 +153,10 @@ from collide2d.engine.exactstate import (
 from collide2d.engine.horizonqueue import (
     QS_TOP,
     bucket_width,
-    find_top,
     first_horizon,
     horizon_key,
     new_horizons,
+    next_top,
 )
 from collide2d.engine.noroom import jammed, listing, no_room, no_room_message
 from collide2d.engine.prediction import predict, set_job
@@ -302,7 +302,7 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
             t_end = tick / world[2]
             top = QS[QS_TOP]
             if top < 0:
-                top = find_top(Q)
+                top = next_top(Q)
             t_horizon = QT[top] if top >= 0 else INF
             t_pair = HT[0] if st[S_HEAP_N] > 0 else INF
             # a stale contact is dropped once it could come first (past the first horizon's
