@@ -18,10 +18,10 @@ from collide2d.engine.horizonqueue import (
     Q_NEXT,
     QS_TOP,
     bucket_width,
-    find_top,
     first_horizon,
     horizon_key,
     new_horizons,
+    next_top,
     set_horizon,
 )
 
@@ -67,14 +67,20 @@ def _check(Q, static, expected):
 
 @pytest.mark.parametrize("compiled", [False, True])
 @settings(max_examples=40, deadline=None)
-@given(moves=updates, seed=st.integers(0, 2**32 - 1), width=st.sampled_from(WIDTHS))
-def test_updates_keep_the_first_horizon_known(compiled, moves, seed, width):
-    static = np.random.default_rng(seed).random(12) < 0.25
+@given(
+    moves=updates,
+    seed=st.integers(0, 2**32 - 1),
+    width=st.sampled_from(WIDTHS),
+    n=st.sampled_from((5, 12)),  # few objects are looked at in place, more walked to
+)
+def test_updates_keep_the_first_horizon_known(compiled, moves, seed, width, n):
+    static = np.random.default_rng(seed).random(n) < 0.25
     Q = new_horizons(static, width)
     QT = Q[0]
     expected = {int(i): (np.inf, horizon_key(Q, i)) for i in np.flatnonzero(~static)}
     with jit.lane(compiled):
         for i, t, cross, side, look in moves:
+            i %= n
             if static[i]:
                 continue
             rank = RANK_CROSS if cross else RANK_WALL
@@ -84,7 +90,7 @@ def test_updates_keep_the_first_horizon_known(compiled, moves, seed, width):
             _check(Q, static, expected)
             if not look:
                 continue
-            top = find_top(Q)
+            top = next_top(Q)
             finite = [(t, key, j) for j, (t, key) in expected.items() if t < np.inf]
             if not finite:
                 assert top == -1
