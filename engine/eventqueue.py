@@ -1,7 +1,7 @@
 """The exact model's event queue: a 4-ary heap of predicted events in preallocated arrays.
 
 The model keeps its predicted contacts here (each object's horizon, its next wall contact or cell
-crossing, has a slot of its own in horizonqueue.py, keyed the same way). An entry is a time (HT,
+crossing, is filed in horizonqueue.py, keyed the same way). An entry is a time (HT,
 float64), a key and the two invalidation counters its objects had when it was predicted (HI,
 int64), and a contact normal (HN, float64). Keys pack (rank, a, b, code) into one int64, so ties in
 time go as cell crossings, then walls by (id, side), then pairs by (a, b). An entry is stale once

@@ -28,9 +28,7 @@ class State(NamedTuple):
     HT: np.ndarray  # heap: event times
     HI: np.ndarray  # heap: event ids and counters
     HN: np.ndarray  # heap: contact normals
-    QT: np.ndarray  # horizon queue: times by slot (horizonqueue.py)
-    QK: np.ndarray  # horizon queue: keys by slot
-    QP: np.ndarray  # horizon queue: each object's slot
+    Q: tuple  # horizon queue: each object's horizon, filed in buckets (horizonqueue.py)
     st: np.ndarray  # int64 scalar state, indices S_* below
     stf: np.ndarray  # float64 scalar state, indices SF_* below
     world: tuple  # the world's sides and grid, floats

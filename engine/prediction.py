@@ -146,7 +146,7 @@ def _predict_pair(i, j, t_now, limit, F, N, C, HT, HI, HN, st):
 
 
 @hot
-def predict(jobs, k, t_now, F, N, C, cells, s_start, s_items, HT, HI, HN, QT, QK, QP, st, world):
+def predict(jobs, k, t_now, F, N, C, cells, s_start, s_items, HT, HI, HN, Q, st, world):
     """Run prediction job k for object i: set its horizon (the first of its next wall contact
     and its next cell crossing; horizonqueue.py) and push its contacts with the objects in the
     3×3 cells around it that come no later than that. Inlined into the event loop's one call
@@ -157,11 +157,12 @@ def predict(jobs, k, t_now, F, N, C, cells, s_start, s_items, HT, HI, HN, QT, QK
     if mode != JOB_CONTACTS:
         t_cross, d = _cross_time(i, F, N, world)
         if t_cross <= t_wall and t_cross < INF:
-            set_horizon(QT, QK, QP, i, max(t_cross, t_now), make_key(RANK_CROSS, i, d, d))
+            t_h, rank, what = max(t_cross, t_now), RANK_CROSS, d
         elif t_wall < INF:
-            set_horizon(QT, QK, QP, i, max(t_wall, t_now), make_key(RANK_WALL, i, side, side))
+            t_h, rank, what = max(t_wall, t_now), RANK_WALL, side
         else:
-            set_horizon(QT, QK, QP, i, INF, make_key(RANK_WALL, i, 0, 0))
+            t_h, rank, what = INF, RANK_WALL, 0
+        set_horizon(Q, i, t_h, rank, what)  # (one call site: one compiled specialisation)
     limit = max(t_wall, t_now)
     gnx, gny = world[4], world[5]
     gx = N[i, CELL] % gnx

@@ -4,7 +4,8 @@ Input: the world, the `Bodies` (copied) and the options `geometry` ("exact", the
 for None: circles and polygons by their real shapes; "box": every object as its box),
 `max_events_per_tick`, `cell_size` (px; the grid's cell, chosen from the scene when not given:
 one cell for the whole world when the grid would be at most 3 cells a side, where every cell is
-in every other's 3×3 anyway and crossings would be bookkeeping for nothing) and `repredict`
+in every other's 3×3 anyway and crossings would be bookkeeping for nothing, or when at most
+ONE_CELL_MOVERS objects move) and `repredict`
 ("touched", the default; "all" predicts every moving object again after each event, the work
 the local re-prediction saves, for tests and `collide2d bench`). Output, per `advance`: the
 wall and pair events in the order they happened, `t` = the exact contact time; positions and
@@ -14,10 +15,11 @@ Objects fly on straight lines between events. Each keeps its own clock (TLOC: it
 valid at that time) and an invalidation counter. Two queues hold what comes next, keyed by (time,
 rank, a, b) so that ties go cell crossings first (bookkeeping, never logged), then walls by (id,
 side), then pairs in (a, b) order: each moving object's *horizon*, the first of its next wall
-contact and its next cell crossing, in its own slot of an indexed heap that predicting the object
-again updates in place (horizonqueue.py); and the predicted contacts, in a 4-ary heap in
-preallocated arrays that grow when full (eventqueue.py), each entry recording the counters of its
-objects when predicted and skipped as stale if either has changed since. The next event is, of
+contact and its next cell crossing, filed by its time in a bucket of a calendar queue that
+predicting the object again moves it out of and into in constant time (horizonqueue.py); and the
+predicted contacts, in a 4-ary heap in preallocated arrays that grow when full (eventqueue.py),
+each entry recording the counters of its objects when predicted and skipped as stale if either
+has changed since. The next event is, of
 the events at the earliest one's instant, the one of the smallest key.
 
 Prediction stays local. Moving objects are filed in a uniform grid (cells.py) by their box
@@ -148,7 +150,14 @@ from collide2d.engine.exactstate import (
     hot,
     kernel,
 )
-from collide2d.engine.horizonqueue import first_horizon, new_horizons
+from collide2d.engine.horizonqueue import (
+    QS_TOP,
+    bucket_width,
+    first_horizon,
+    horizon_key,
+    new_horizons,
+    next_top,
+)
 from collide2d.engine.noroom import jammed, listing, no_room, no_room_message
 from collide2d.engine.prediction import predict, set_job
 from collide2d.engine.response import exchange
@@ -162,6 +171,10 @@ MAX_EVENTS_PER_TICK = models.MAX_EVENTS_PER_TICK
 # re-prediction saves; its heap room grows with n^2, so only for small scenes: tests and
 # `collide2d bench`).
 REPREDICT = ("touched", "all")
+# At most this many moving objects share one cell, the whole world: testing each against the
+# others costs less than the cell crossings a grid makes (the two-body chain of `collide2d bench
+# --part exact`: 12 million events/s in one cell, 4 million in 4x3 cells).
+ONE_CELL_MOVERS = 16
 # Heap entries to start with per object (the heap drops stale entries, or doubles, when full).
 HEAP_PER_OBJECT = 4
 
@@ -260,7 +273,8 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
     with a higher cap would resume). st[S_LOGGED] counts the rows written, st[S_WALLS] and
     st[S_PAIRS] every event, logged or not.
     """
-    F, N, C, cells, s_start, s_items, HT, HI, HN, QT, QK, QP, st, stf, world = S
+    F, N, C, cells, s_start, s_items, HT, HI, HN, Q, st, stf, world = S
+    QT, QS = Q[0], Q[4]
     n = F.shape[0]
     extra_room = n * n if everyone else 0
     # (The loop's steps are written out here, not as inlined helpers: helpers cost ~15 % of the
@@ -286,7 +300,10 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
                 return STATUS_DONE
             tick = st[S_TICK] + 1
             t_end = tick / world[2]
-            t_horizon = QT[0] if QT.shape[0] > 0 else INF
+            top = QS[QS_TOP]
+            if top < 0:
+                top = next_top(Q)
+            t_horizon = QT[top] if top >= 0 else INF
             t_pair = HT[0] if st[S_HEAP_N] > 0 else INF
             # a stale contact is dropped once it could come first (past the first horizon's
             # instant it cannot, whether stale or not)
@@ -308,8 +325,8 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
             # for what it may push
             horizon = t_horizon <= t_first + instant(t_first)
             if horizon:
-                k = first_horizon(QT, QK, t_first + instant(t_first), stack)
-                key = QK[k]
+                k = first_horizon(Q, t_first + instant(t_first))
+                key = horizon_key(Q, k)
             else:
                 k = first_of_instant(HT, HI, st, N, stack)
                 key = HI[k, HKEY]
@@ -369,7 +386,7 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
                 job = J_EXTRA
                 extra += 1
             predict(
-                jobs, job, t, F, N, C, cells, s_start, s_items, HT, HI, HN, QT, QK, QP, st, world
+                jobs, job, t, F, N, C, cells, s_start, s_items, HT, HI, HN, Q, st, world
             )
 
 
@@ -424,9 +441,11 @@ class Model:
         self._C = (cores.radius, cores.start, cores.verts, cores.normals)
         if cell_size is None:
             cell_size = grid_cell(world.width, world.height, bodies.size, static)
-            if max(grid_dims(world.width, world.height, cell_size)) <= 3:
-                # every cell is in every other's 3x3: one cell sees the same neighbours and
-                # spares the cell crossings (the grid never changes the answer)
+            few = int((~static).sum()) <= ONE_CELL_MOVERS
+            if few or max(grid_dims(world.width, world.height, cell_size)) <= 3:
+                # every cell is in every other's 3x3 (or there are few to test): one cell sees
+                # the same neighbours (or few) and spares the cell crossings (the grid never
+                # changes the answer)
                 cell_size = float(max(world.width, world.height))
         self.cell_size = float(cell_size)
         gnx, gny = grid_dims(world.width, world.height, self.cell_size)
@@ -441,7 +460,9 @@ class Model:
         self._G = build_grid(self._F, self._N, self.cell_size, gnx, gny)
         cap = max(64, HEAP_PER_OBJECT * n)
         self._heap = [np.empty(cap), np.empty((cap, 3), np.int64), np.empty((cap, 2))]
-        self._horizons = new_horizons(static)
+        self._horizons = new_horizons(
+            static, bucket_width(self._F, static, self.cell_size, world.width, world.height)
+        )
         self._st = np.zeros(8, np.int64)
         self._stf = np.zeros(1)
         self._jobs = np.zeros((JOB_ROWS, 3), np.int64)  # scratch: the prediction jobs of one event
@@ -455,7 +476,7 @@ class Model:
             self._C,
             *self._G,
             *self._heap,
-            *self._horizons,
+            self._horizons,
             self._st,
             self._stf,
             self._world,

@@ -585,8 +585,8 @@ def test_the_grid_does_not_change_the_answer():
 
 
 def test_the_one_cell_grid_of_a_small_world_gives_the_same_bytes():
-    # three movers in 320x240 px would make a grid of at most 3 cells a side: the model makes it
-    # one cell (no crossings); a fine grid given by hand must give the same events and state
+    # three movers in 320x240 px are few (ONE_CELL_MOVERS): the model makes the grid one cell
+    # (no crossings); a fine grid given by hand must give the same events and state
     world = WorldSpec(320, 240, 10)
     bodies = Bodies.boxes(
         [[50, 115], [200, 115], [20, 20]],
