@@ -65,6 +65,28 @@ GRID_FILINGS_PER_OBJECT = 16.0
 # cell crossing (~1e-12 px) can never hide a touching neighbour two cells away.
 CELL_MARGIN = 1.01
 
+
+
+def index(i):
+    """i as the index of a hot loop: unsigned when compiled, as it is when interpreted.
+
+    numba wraps a signed index that is negative (a[-1] is the last item), which costs three
+    instructions per read that LLVM can rarely prove away (an index read from another array); an
+    unsigned index has no such wrap. The loops that cast their indices (the cell pair tests and
+    counting sort, the stepped model's move, pair tests, grown boxes and bands) run about a
+    quarter fewer instructions. Every index cast is >= 0, so the results are the same; the
+    interpreted lane keeps Python's int (a numpy unsigned scalar there costs more than it saves)."""
+    return i
+
+
+@overload(index)
+def _index(i):
+    def unsigned(i):
+        return np.uint64(i)
+
+    return unsigned
+
+
 # --- candidate pairs ---------------------------------------------------------------------------
 
 
@@ -286,14 +308,15 @@ def _cell_grid(lo, hi, cell, order, ws):
         cxy[i, 1] = cy
         c = cy * nx + cx
         key[i] = c
-        start[c + 1] += 1
+        start[index(c + 1)] += 1
     for c in range(nx * ny):
         start[c + 1] += start[c]
     start[nx * ny + 1] = n
-    for i in range(n - 1, -1, -1):
-        c = key[i]
-        slot = start[c + 1] - 1
-        start[c + 1] = slot
+    for r in range(n):  # unsigned indices (`index`), the objects from last to first
+        i = index(n - 1 - r)
+        c = index(key[i] + 1)
+        slot = index(start[c] - 1)
+        start[c] = slot
         order[slot] = i
         box[slot, 0] = lo[i, 0]
         box[slot, 1] = lo[i, 1]
@@ -305,28 +328,30 @@ def _cell_grid(lo, hi, cell, order, ws):
 @njit(cache=True)
 def _cell_pairs(s0, s1, order, cxy, start, box, movable, nx, ny, out, base, room):
     """The pairs of `cell_candidates` for the boxes in slots s0 ... s1-1 (cxy: each box's
-    column and row), written to out[base:base + room] while they fit; returns how many."""
+    column and row), written to out[base:base + room] while they fit; returns how many.
+    Its indices go through `index` (unsigned when compiled)."""
     k = 0
     m = room
-    for s in range(s0, s1):
+    for s in range(index(s0), index(s1)):
         a = order[s]
-        cx = cxy[a, 0]
-        cy = cxy[a, 1]
+        ia = index(a)
+        cx = cxy[ia, 0]
+        cy = cxy[ia, 1]
         c = cy * nx + cx
-        ma = movable[a]
+        ma = movable[ia]
         lax, lay, hax, hay = box[s, 0], box[s, 1], box[s, 2], box[s, 3]
         # two runs of slots: the later boxes of its own cell and those of the cell to its right
         # (+1, 0); the cells (-1, +1), (0, +1), (+1, +1) of the next row, side by side in a row
         for run in range(2):
             if run == 0:
-                first = s + 1
-                last = start[c + 2 + (1 if cx + 1 < nx else 0)]
+                first = s + index(1)
+                last = index(start[index(c + 2 + (1 if cx + 1 < nx else 0))])
             else:
                 if cy + 1 >= ny:
                     break
                 g = c + nx
-                first = start[g + (0 if cx > 0 else 1)]
-                last = start[g + (3 if cx + 1 < nx else 2)]
+                first = index(start[index(g + (0 if cx > 0 else 1))])
+                last = index(start[index(g + (3 if cx + 1 < nx else 2))])
             for t in range(first, last):
                 b = order[t]
                 # branch-free: write the key, keep it only when the boxes overlap
@@ -335,10 +360,10 @@ def _cell_pairs(s0, s1, order, cxy, start, box, movable, nx, ny, out, base, room
                     & (lax < box[t, 2])
                     & (box[t, 1] < hay)
                     & (lay < box[t, 3])
-                    & (ma | movable[b])
+                    & (ma | movable[index(b)])
                 )
                 if k < m:
-                    out[base + k] = _key(a, b)
+                    out[index(base + k)] = _key(a, b)
                 k += meet
     return k
 

@@ -32,6 +32,7 @@ from collide2d.engine.broadphase import (
     KEY_SHIFT,
     METHOD_GRID,
     find_split,
+    index,
 )
 from collide2d.engine.jit import njit, prange
 from collide2d.engine.models.stepped_motion import B_H, B_VX, B_VY, B_W, B_X, B_Y
@@ -65,7 +66,7 @@ P_MARGIN, P_CELL, P_SLACK, P_DRIFT = range(4)
 def _grow_range(body, lo, hi, margin, dt, first, last):
     """The boxes of objects first ... last-1 over the step of dt s just taken (swept back on a
     straight line), grown by margin px, into lo, hi."""
-    for i in range(first, last):
+    for i in range(index(first), index(last)):  # unsigned indices: broadphase.index
         x = body[i, B_X]
         y = body[i, B_Y]
         bx = x - body[i, B_VX] * dt
@@ -174,8 +175,8 @@ def _band(lo, hi, key, margin):
     """The band of a listed pair (keys of indices into lo, hi: the boxes grown by margin): how
     far apart the boxes were on the axis they were farthest apart on, in steps of 2 x margin /
     BANDS (band 0 for boxes that overlap), after BAND_SLACK_PX taken off."""
-    a = key >> KEY_SHIFT
-    b = key & KEY_MASK
+    a = index(key >> KEY_SHIFT)
+    b = index(key & KEY_MASK)
     gap = max(lo[b, 0] - hi[a, 0], lo[a, 0] - hi[b, 0], lo[b, 1] - hi[a, 1], lo[a, 1] - hi[b, 1])
     apart = (gap + 2.0 * margin - BAND_SLACK_PX) * (BANDS / (2.0 * margin))
     return min(max(int(apart), 0), BANDS - 1) if apart > 0.0 else 0
@@ -195,7 +196,7 @@ def _by_band(lo, hi, keys, spare, k, margin, state):
         state[ST_BANDS + j + 1] += state[ST_BANDS + j]
     for c in range(k):
         j = keys[c] >> BAND_SHIFT
-        spare[state[ST_BANDS + j]] = keys[c] & PAIR_MASK
+        spare[index(state[ST_BANDS + j])] = keys[c] & PAIR_MASK
         state[ST_BANDS + j] += 1
     for j in range(BANDS, 0, -1):  # each band's end back to its start
         state[ST_BANDS + j] = state[ST_BANDS + j - 1]

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from collide2d.engine.broadphase import index
 from collide2d.engine.events import EV_WALL, SIDE_BOTTOM, SIDE_LEFT, SIDE_RIGHT, SIDE_TOP, log_event
 from collide2d.engine.jit import njit, prange
 from collide2d.engine.response import fold
@@ -44,7 +45,7 @@ def _move_range(body, static, ext, anchor, first, last, dt, folds, n_folds):
     world; their fold rows go to folds from row n_folds. Returns (rows now, the farthest any of
     them is from its anchor on an axis, px)."""
     drift = 0.0
-    for i in range(first, last):
+    for i in range(index(first), index(last)):  # unsigned indices: broadphase.index
         if static[i]:
             continue
         x = body[i, B_X] + body[i, B_VX] * dt

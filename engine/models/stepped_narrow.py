@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from collide2d.engine.broadphase import KEY_MASK, KEY_SHIFT
+from collide2d.engine.broadphase import KEY_MASK, KEY_SHIFT, index
 from collide2d.engine.contact import box_sweep
 from collide2d.engine.jit import njit, prange
 from collide2d.engine.models.stepped_motion import B_H, B_SX, B_SY, B_VX, B_VY, B_W, B_X, B_Y
@@ -57,9 +57,9 @@ def _contact_range(body, ext, keys, first, last, near, when, base, room, dt):
     to near[base:base + room] with the time each contact began in `when` while they fit;
     returns how many."""
     k = 0
-    for c in range(first, last):
-        a = keys[c] >> KEY_SHIFT
-        b = keys[c] & KEY_MASK
+    for c in range(index(first), index(last)):  # unsigned indices: broadphase.index
+        a = index(keys[c] >> KEY_SHIFT)
+        b = index(keys[c] & KEY_MASK)
         qx = body[b, B_X] - body[a, B_X]
         qy = body[b, B_Y] - body[a, B_Y]
         wa, ha, wb, hb = body[a, B_W], body[a, B_H], body[b, B_W], body[b, B_H]
@@ -81,8 +81,8 @@ def _contact_range(body, ext, keys, first, last, near, when, base, room, dt):
         if k < room:
             ea = ext[a]
             eb = ext[b]
-            near[base + k] = (min(ea, eb) << KEY_SHIFT) | max(ea, eb)
-            when[base + k] = t_enter if -dt <= t_enter < dt else -math.inf
+            near[index(base + k)] = (min(ea, eb) << KEY_SHIFT) | max(ea, eb)
+            when[index(base + k)] = t_enter if -dt <= t_enter < dt else -math.inf
         k += 1
     return k
 
