@@ -79,7 +79,10 @@ def index(i):
     return i
 
 
-@overload(index)
+# Inlined where it is used (numba's IR), so that the cast has no compiled function of its own: as
+# a function of its own, kernels loaded from a cache that other processes had written crashed on a
+# call to address 0 in sweep workers and tests' subprocesses; inlined, none did (full suites).
+@overload(index, inline="always")
 def _index(i):
     def unsigned(i):
         return np.uint64(i)

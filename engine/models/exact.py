@@ -505,9 +505,10 @@ class Model:
 
     def _call(self, target, log, cap, rows, times) -> int:
         """One call of the kernel `_run` on the model's state; its status. (Interpreted, a time
-        past float64's range, as a subnormal speed gives, is inf as compiled: no numpy warning.)"""
+        past float64's range, as a subnormal speed gives, is inf as compiled, and inf - inf is nan
+        as compiled: no numpy warning.)"""
         everyone = self.repredict == "all"
-        with np.errstate(over="ignore"):
+        with np.errstate(over="ignore", invalid="ignore"):
             return _run(
                 self._state(), self._jobs, self._stack, target, log, cap, everyone, rows, times
             )

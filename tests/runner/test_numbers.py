@@ -657,3 +657,25 @@ def test_the_cli_writes_a_finite_summary_at_the_bounds(tmp_path, capsys):
     summary = json.loads(text, parse_constant=refuse)
     assert summary["kinetic_energy"]["start"] == pytest.approx(MAX_MASS * MAX_SPEED**2)
     check_summary(summary)
+
+
+def test_a_subnormal_speed_in_one_cell_with_a_circle_runs_without_a_numpy_warning():
+    # found by the test above: in a world of one grid cell the exact model predicts every pair, and
+    # a subnormal speed gives a contact interval of inf - inf; interpreted, nan as compiled
+    text = """version: 1
+world: {width: 160, height: 120, fps: 10}
+model: {kind: exact}
+ticks: 4
+objects:
+  - {shape: box, size: [8, 6], position: [10, 10], velocity: [1.1125369292536007e-308, 0], mass: 2}
+  - {shape: circle, diameter: 6, position: [60, 60]}
+  - {shape: polygon, points: [[0, 0], [5, 0], [0, 5]], position: [100, 10]}
+generate:
+  - {count: 3, shape: box, size: 4, speed: 10, seed: 1}
+  - {count: 2, shape: box, size: 3, speed: {min: 0, max: 20}}
+  - {count: 2, shape: circle, diameter: 3, mass: 1, velocity: {min: [-5, -5], max: [5, 5]}}
+"""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        result = simulate(loads(text, "n.yaml"), log_events=False)
+    check_summary(result.summary)
