@@ -81,7 +81,8 @@ def index(i):
 
 # Inlined where it is used (numba's IR), so that the cast has no compiled function of its own: as
 # a function of its own, kernels loaded from a cache that other processes had written crashed on a
-# call to address 0 in sweep workers and tests' subprocesses; inlined, none did (full suites).
+# call to address 0 in sweep workers and tests' subprocesses; inlined, none did (a whole suite on
+# two workers from an empty cache).
 @overload(index, inline="always")
 def _index(i):
     def unsigned(i):
