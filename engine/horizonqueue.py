@@ -151,7 +151,7 @@ def set_horizon(Q, i, t, rank, d):
 def next_top(Q):
     """find_top, with a scene of FEW objects looked at in place (no call: the two-body chain
     finds its first horizon again after nearly every event)."""
-    QT, QC, QS = Q[0], Q[1], Q[4]
+    QT, QC, _, _, QS, QW = Q
     if QT.shape[0] > FEW:
         return find_top(Q)
     best = -1
@@ -159,7 +159,7 @@ def next_top(Q):
         if QT[j] < INF and (best < 0 or _before(QT, QC, j, best)):
             best = j
     if best >= 0:
-        QS[QS_AT] = _bucket(QT[best], Q[5])
+        QS[QS_AT] = _bucket(QT[best], QW)
     QS[QS_TOP] = best
     return best
 

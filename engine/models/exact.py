@@ -274,7 +274,7 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
     st[S_PAIRS] every event, logged or not.
     """
     F, N, C, cells, s_start, s_items, HT, HI, HN, Q, st, stf, world = S
-    QT, QS = Q[0], Q[4]
+    QT, _, _, _, QS, _ = Q
     n = F.shape[0]
     extra_room = n * n if everyone else 0
     # (The loop's steps are written out here, not as inlined helpers: helpers cost ~15 % of the
