@@ -171,8 +171,11 @@ def cmd_run(args: argparse.Namespace) -> int:
         counts = summary["events"]
         compiled = summary.get("compile_time_s", 0.0)
         also = f" (+{compiled:.1f}s compiling kernels)" if compiled >= 0.05 else ""
+        ran = plural(scenario.ticks, "tick")
+        if "interrupted_at_tick" in summary:  # the ticks run, not the ticks asked for
+            ran = f"{summary['interrupted_at_tick']:,} of {ran}"
         print(
-            f"{scenario.name}: {plural(scenario.ticks, 'tick')} under {scenario.model}, "
+            f"{scenario.name}: {ran} under {scenario.model}, "
             f"{counts['wall']:,} wall and {plural(counts['pair'], 'pair event')} "
             f"in {summary['run_time_s']:.3f}s{also} -> {target}"
         )

@@ -188,12 +188,13 @@ def test_ctrl_c_keeps_the_run_so_far(tmp_path):
         assert time.monotonic() < deadline and proc.poll() is None
         time.sleep(0.05)
     proc.send_signal(signal.SIGINT)
-    _, err = proc.communicate(timeout=120)
+    said, err = proc.communicate(timeout=120)
     assert proc.returncode == 130
     assert "interrupted at tick" in err and "holds the run so far" in err
     summary = json.loads((out / "small" / "summary.json").read_text())
     stopped = summary["interrupted_at_tick"]
     assert 0 < stopped < 1_000_000_000
+    assert f"small: {stopped:,} of 1,000,000,000 ticks under" in said  # the ticks run
     events = [
         json.loads(line) for line in (out / "small" / "events.jsonl").read_text().splitlines()
     ]
