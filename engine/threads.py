@@ -23,15 +23,20 @@ import os
 
 from collide2d.engine.jit import njit, numba_module, when_loaded
 
-# Threads waiting at the end of a split stage sleep instead of spinning (OpenMP's default spins):
-# on a machine shared with other work a spinning thread holds a core another thread needs, and a
-# split stage then took ten times as long as one thread (measured on 2 cores at load 9). Set before
-# numba starts its threads; a value the user set is kept.
+# Threads waiting at the end of a split stage spin a short while (GNU OpenMP's GOMP_SPINCOUNT
+# turns of a pause loop, tens of microseconds), then sleep. Woken from sleep, a thread took about
+# 60 us per split stage on a 2-core virtual machine (a 100,000-object move of 90 us went to 100 us
+# on two threads, and to 48 us spinning); spinning without end (OpenMP's ACTIVE) took a split
+# stage ten times as long as one thread when the machine was busy (load 9). Even the short spin
+# loses to one thread on a busy machine, so the models time both ways as they run and keep the
+# faster (engine.splitchoice). Set before numba starts its threads; values the user set are kept.
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+os.environ.setdefault("GOMP_SPINCOUNT", "10000")
 
 # Objects from which a stage splits its work among threads (tuned on the standard scene of
-# `collide2d bench`: 2 cores pay from about 20,000 boxes).
-PARALLEL_MIN_OBJECTS = 20_000
+# `collide2d bench`: on 2 cores a split step of 10,000 boxes took 12.5 ns per box against 13.6 on
+# one thread, both models; at 5,000 the two were even).
+PARALLEL_MIN_OBJECTS = 8_000
 
 _threads: int | None = None  # None: every core numba may use
 

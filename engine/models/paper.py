@@ -74,6 +74,7 @@ from collide2d.engine.events import (
 from collide2d.engine.jit import njit, prange
 from collide2d.engine.motion import paper_rate
 from collide2d.engine.sort import sort_keys
+from collide2d.engine.splitchoice import SplitChoice
 from collide2d.engine.threads import chunks_for, join_shares
 from collide2d.engine.world import Bodies, WorldSpec
 
@@ -380,7 +381,7 @@ def _run(pos, size, room, step, period, count, movable, stop, log, st, bp, ev, w
                 k = _relist(
                     pos, size, step, period, count, disp, fence, movable,
                     _window(tick, forced, window, longest), cap, finder, cell, order, lo, hi,
-                    keys, ws, found[:, 0],
+                    keys, ws, found[:chunks, 0],
                 )
                 if k > keys.shape[0]:
                     st[_S_NEEDED] = k
@@ -463,11 +464,14 @@ class Model:
             np.empty((n, 4), small),  # reach boxes of this tick, for the narrow stage
         )
         self._ws = workspace(n, np.int64)
+        self._split = SplitChoice(chunks)
 
     def advance(self, ticks: int, log: bool = True) -> np.ndarray:
-        """Run `ticks` ticks; the events they made (EVENT_DTYPE, in order; empty if not log)."""
+        """Run `ticks` ticks; the events they made (EVENT_DTYPE, in order; empty if not log).
+        A scene that splits runs them split among threads or not, as the clock says
+        (splitchoice): the same bytes either way."""
         self._st[_S_EVENTS] = 0
-        self._run_to((self.tick + int(ticks)) * _N_STAGES, bool(log))
+        self._split.run(int(ticks), lambda k, chunks: self._ticks(k, bool(log), chunks))
         n = int(self._st[_S_EVENTS])
         return event_records(self._ev, self._ev[:n, ROW_TICK] / self.fps, n)
 
@@ -493,7 +497,9 @@ class Model:
         the candidate list), "narrow" (keeping the listed pairs whose reach boxes overlap),
         "response" (the flip rule). The state ends exactly as `advance(ticks, log=False)` would
         leave it. Each stage is timed from Python, so each count includes a call's overhead
-        (microseconds), which dominates in small scenes."""
+        (microseconds), which dominates in small scenes. A scene that splits runs split (the
+        clock does not choose here)."""
+        self._bp[7][4] = self._split.chunks
         spent = {name: 0.0 for name, _ in STAGES}
         clock = time.perf_counter
         for _ in range(int(ticks)):
@@ -503,6 +509,12 @@ class Model:
                 self._run_to(done + until, False)
                 spent[name] += clock() - began
         return spent
+
+    def _ticks(self, ticks: int, log: bool, chunks: int) -> None:
+        """Run `ticks` ticks, the split stages cut into `chunks` (1: not split); their events
+        are added to the log."""
+        self._bp[7][4] = chunks
+        self._run_to((self.tick + ticks) * _N_STAGES, log)
 
     def _run_to(self, stop: int, log: bool) -> None:
         """Run `_run` to `stop` (ticks done x _N_STAGES + stage), growing the buffers it asks
@@ -529,7 +541,7 @@ class Model:
                 self._ev = grown(self._ev, 2 * self.pos.shape[0])
             else:
                 rows = 2 * int(self._st[_S_NEEDED])
-                chunks = int(self._bp[7][4])
+                chunks = self._split.chunks
                 self._bp = (
                     self._bp[:2]
                     + (np.empty(rows, np.int64), np.empty(rows + chunks, np.int64))

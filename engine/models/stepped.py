@@ -64,6 +64,7 @@ from collide2d.engine.models.stepped_list import (
 from collide2d.engine.models.stepped_motion import BODY_COLUMNS
 from collide2d.engine.models.stepped_step import STAGES, run, step
 from collide2d.engine.shapes import GEOMETRIES, build_cores
+from collide2d.engine.splitchoice import SplitChoice
 from collide2d.engine.threads import chunks_for
 from collide2d.engine.world import Bodies, WorldSpec
 
@@ -146,9 +147,18 @@ class Model:
         cores = build_cores(bodies, geometry)
         self._cores = (cores.shape, cores.radius, cores.start, cores.verts, cores.normals)
         self._bp = _broad_phase(world, pos, vel, size, movable, substeps, skip, broadphase)
+        self._split = SplitChoice(self._bp[6][ST_CHUNKS])
 
     def advance(self, ticks: int, log: bool = True) -> np.ndarray:
-        """Run `ticks` ticks; the events in the order they happened (empty when log is False)."""
+        """Run `ticks` ticks; the events in the order they happened (empty when log is False).
+        A scene that splits runs them split among threads or not, as the clock says
+        (splitchoice): the same bytes either way."""
+        parts = self._split.run(int(ticks), lambda k, chunks: self._advance(k, log, chunks))
+        return parts[0] if len(parts) == 1 else np.concatenate(parts)
+
+    def _advance(self, ticks: int, log: bool, chunks: int) -> np.ndarray:
+        """`advance`, its split stages cut into `chunks` (1: not split)."""
+        self._bp[6][ST_CHUNKS] = chunks
         world = (float(self.world.width), float(self.world.height), float(self.world.fps))
         rows, times = new_log(log)
         rows, times, n, self._bp = run(
@@ -178,7 +188,9 @@ class Model:
         candidate list), "narrow" (testing the listed pairs), "response" (exchange and
         separation). The state ends exactly as `advance(ticks, log=False)` would leave it. Each
         stage is timed from Python, so each count includes a call's overhead (microseconds),
-        which dominates in small scenes."""
+        which dominates in small scenes. A scene that splits runs split (the clock does not
+        choose here)."""
+        self._bp[6][ST_CHUNKS] = self._split.chunks
         fps = float(self.world.fps)
         width, height = float(self.world.width), float(self.world.height)
         dt = 1.0 / (fps * self.substeps)
