@@ -183,24 +183,64 @@ def _band(lo, hi, key, margin):
 
 
 @njit(cache=True)
-def _by_band(lo, hi, keys, spare, k, margin, state):
-    """Put keys[:k] into spare by band, nearest band first, each band in the order it had (a
-    counting sort); state[ST_BANDS + j] is where band j begins."""
-    for j in range(BANDS + 1):
-        state[ST_BANDS + j] = 0
-    for c in range(k):  # each key's band kept in its top bits (indices stay below 2**28)
+def _band_range(lo, hi, keys, first, last, margin, counts):
+    """Keys first ... last-1: each one's band kept in its top bits (indices stay below 2**28)
+    and counted in counts (BANDS,)."""
+    for c in range(index(first), index(last)):
         j = _band(lo, hi, keys[c], margin)
-        state[ST_BANDS + j + 1] += 1
+        counts[j] += 1
         keys[c] |= j << BAND_SHIFT
-    for j in range(BANDS):
-        state[ST_BANDS + j + 1] += state[ST_BANDS + j]
-    for c in range(k):
+
+
+@njit(cache=True)
+def _place_by_band(keys, spare, first, last, at):
+    """Keys first ... last-1 into spare, band j's from at[j] on (at advances), the band bits
+    taken off."""
+    for c in range(index(first), index(last)):
         j = keys[c] >> BAND_SHIFT
-        spare[index(state[ST_BANDS + j])] = keys[c] & PAIR_MASK
-        state[ST_BANDS + j] += 1
-    for j in range(BANDS, 0, -1):  # each band's end back to its start
-        state[ST_BANDS + j] = state[ST_BANDS + j - 1]
-    state[ST_BANDS] = 0
+        spare[index(at[j])] = keys[c] & PAIR_MASK
+        at[j] += 1
+
+
+@njit(cache=True)
+def _band_starts(counts, state):
+    """From each run's count per band (runs, BANDS): where each band begins
+    (state[ST_BANDS + j], and state[ST_BANDS + BANDS] the end), and counts made each run's first
+    slot in each band (bands in order, each band's runs in run order)."""
+    start = 0
+    for j in range(BANDS):
+        state[ST_BANDS + j] = start
+        for c in range(counts.shape[0]):
+            here = counts[c, j]
+            counts[c, j] = start
+            start += here
+    state[ST_BANDS + BANDS] = start
+
+
+@njit(cache=True)
+def _by_band(lo, hi, keys, spare, k, margin, state, chunks):
+    """Put keys[:k] into spare by band, nearest band first, each band in the order it had (a
+    counting sort); state[ST_BANDS + j] is where band j begins. With chunks > 1 the keys are cut
+    into that many contiguous runs, on threads (`_by_band_split`): the same order."""
+    if chunks > 1:
+        _by_band_split(lo, hi, keys, spare, k, margin, state, chunks)
+        return
+    counts = np.zeros((1, BANDS), np.int64)
+    _band_range(lo, hi, keys, 0, k, margin, counts[0])
+    _band_starts(counts, state)
+    _place_by_band(keys, spare, 0, k, counts[0])
+
+
+@njit(cache=True, parallel=True)
+def _by_band_split(lo, hi, keys, spare, k, margin, state, chunks):
+    """`_by_band` on `chunks` threads: each run counts its keys' bands, then places them from
+    its own first slot in each band."""
+    counts = np.zeros((chunks, BANDS), np.int64)
+    for c in prange(chunks):
+        _band_range(lo, hi, keys, c * k // chunks, (c + 1) * k // chunks, margin, counts[c])
+    _band_starts(counts, state)
+    for c in prange(chunks):
+        _place_by_band(keys, spare, c * k // chunks, (c + 1) * k // chunks, counts[c])
 
 
 @njit(cache=True)
@@ -254,7 +294,7 @@ def relist(S, dt, bp):
         k = find_split(finder, lo, hi, movable, cell, order, keys, ws, found)
     if spare.shape[0] < keys.shape[0]:
         spare = np.empty(keys.shape[0], np.int64)
-    _by_band(lo, hi, keys, spare, k, margin, state)
+    _by_band(lo, hi, keys, spare, k, margin, state, chunks)
     keys, spare = spare, keys
     if state[ST_METHOD] != METHOD_GRID and _strayed(order):
         _reorder(S, order, scratch, keys, k, chunks)
