@@ -21,6 +21,7 @@ becomes OUT/NAME, without the GIF, which would be an animation of part of the ru
 
 from __future__ import annotations
 
+import contextlib
 import os
 import shutil
 import signal
@@ -45,9 +46,13 @@ from collide2d.runner.overlay import Overlay
 from collide2d.runner.progress import Progress
 from collide2d.runner.scenario import Scenario, ScenarioError
 
-# Ticks per model call when nothing else ends a chunk: large enough that the kernel dominates,
-# small enough that events stream out and progress moves.
+# Ticks per model call when nothing else ends a chunk: about CHUNK_S seconds of ticks at the
+# pace of the calls so far (FIRST_CHUNK_TICKS before any), at most CHUNK_TICKS: long enough that
+# the kernel dominates, short enough that events stream out, progress moves and Ctrl-C stops the
+# run within a fraction of a second even where one tick takes long (a dense scene).
 CHUNK_TICKS = 65_536
+CHUNK_S = 0.25
+FIRST_CHUNK_TICKS = 16
 
 
 class RunStopped(Exception):
@@ -126,6 +131,7 @@ def _drive(
     began = time.perf_counter()
     compiled_before = compiling.seconds()
     interrupted = _Interrupt() if interruptible else None
+    pace = _Pace()
 
     if on_tick is not None:
         on_tick(model)
@@ -135,14 +141,14 @@ def _drive(
         next_frame = frames.next_from(1)
     with interrupted or _NoInterrupt():
         while model.tick < scenario.ticks and not (interrupted and interrupted.seen):
-            stop = min(scenario.ticks, model.tick + CHUNK_TICKS)
+            stop = min(scenario.ticks, model.tick + pace.ticks())
             if next_frame is not None:
                 stop = min(stop, next_frame)
             if on_tick is not None:
                 stop = model.tick + 1
             stop = model.tick + lane.step(stop - model.tick)
             try:
-                with lane.timed(stop - model.tick):
+                with lane.timed(stop - model.tick), pace.timed(stop - model.tick):
                     events = model.advance(stop - model.tick, logging)
             except Runaway as exc:
                 when = (
@@ -203,6 +209,26 @@ def _drawn(renderer, model, k: int, overlay) -> np.ndarray:
     """Frame k's index picture, with the overlays when there are any."""
     idx = renderer.draw(model.positions())
     return idx if overlay is None else overlay.draw(k, idx, model)
+
+
+class _Pace:
+    """How many ticks the next model call runs: CHUNK_S seconds at the pace of the last call;
+    `timed` wraps each call, leaving out the time spent compiling kernels."""
+
+    def __init__(self):
+        self.per_tick = None  # seconds per tick of the last call
+
+    def ticks(self) -> int:
+        if self.per_tick is None:
+            return FIRST_CHUNK_TICKS
+        return int(min(CHUNK_TICKS, max(1, CHUNK_S / max(self.per_tick, 1e-9))))
+
+    @contextlib.contextmanager
+    def timed(self, ticks: int):
+        began, compiled = time.perf_counter(), compiling.seconds()
+        yield
+        spent = time.perf_counter() - began - (compiling.seconds() - compiled)
+        self.per_tick = max(spent, 0.0) / max(ticks, 1)
 
 
 class _Interrupt:

@@ -203,6 +203,48 @@ def test_ctrl_c_keeps_the_run_so_far(tmp_path):
     assert not (out / "small" / "animation.gif").exists()
 
 
+DENSE = """version: 1
+name: dense
+world: {width: 700, height: 500, fps: 60}
+model: stepped
+ticks: 1000000
+generate:
+  - {count: 4000, shape: box, size: 5, speed: {min: 50, max: 200}, seed: 3}
+output: {frames: none, gif: false, events: true}
+"""
+
+
+def test_ctrl_c_stops_a_dense_run_within_a_second_or_so(tmp_path):
+    # a tick of 4,000 boxes takes about half a millisecond: a model call of tens of thousands of
+    # ticks would hold Ctrl-C for half a minute; calls of about a quarter of a second do not
+    path = tmp_path / "dense.yaml"
+    path.write_text(DENSE)
+    out = tmp_path / "out"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "collide2d", "run", str(path), "--out", str(out), "--quiet",
+         "--jit", "on"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    try:
+        deadline = time.monotonic() + 120
+        while not any(p.stat().st_size for p in tmp_path.glob("out/.dense.*.run.tmp/*")):
+            assert time.monotonic() < deadline and proc.poll() is None
+            time.sleep(0.05)
+        time.sleep(1.0)  # well into the run, past its first short calls
+        sent = time.monotonic()
+        proc.send_signal(signal.SIGINT)
+        proc.communicate(timeout=60)
+        took = time.monotonic() - sent
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == 130
+    summary = json.loads((out / "dense" / "summary.json").read_text())
+    assert 0 < summary["interrupted_at_tick"] < 1_000_000
+    assert took < 8.0, f"the run went on {took:.1f} s after Ctrl-C"
+
+
 def read_all(fd: int) -> bytes:
     """Everything waiting on fd: one read may return only part of what a terminal holds."""
     chunks = []
