@@ -45,12 +45,12 @@ ST_KEYS, ST_METHOD, ST_POSSIBLE, ST_WALLS, ST_PAIRS, ST_NEAR, ST_CHUNKS, ST_BAND
 # The listed pairs come in this many bands by how far apart their boxes were when the list was
 # made, nearest first: a band whose pairs were farther apart than any two objects have drifted
 # since cannot touch yet, and the narrow phase skips it.
-BANDS = 8
+BANDS = 16
 STATE_SIZE = ST_BANDS + BANDS + 1
 # A pair's distance is taken this much (px) short when its band is chosen: room for rounding.
 BAND_SLACK_PX = 1e-6
 # While the list is sorted by band, a key holds its band above BAND_SHIFT.
-BAND_SHIFT = 60
+BAND_SHIFT = 59
 PAIR_MASK = (1 << BAND_SHIFT) - 1
 # The objects inside are put back in the broad phase's order once they have strayed from it by
 # more than this many rows of the grid on average (a row holds about sqrt(n) objects in a
