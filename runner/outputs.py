@@ -82,6 +82,26 @@ def _named(exc: OSError, path: Path) -> OSError:
     return exc
 
 
+def make_folder(path: str | os.PathLike) -> Path:
+    """Make the output folder `path` and its parents where missing; returns it. An OSError that
+    names the culprit when one cannot be a folder: a symbolic link to something missing, or a
+    file."""
+    path = Path(path)
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except FileExistsError as exc:
+        culprit = Path(exc.filename or path)
+        if culprit.is_symlink():
+            why = (
+                f"a symbolic link to {os.readlink(culprit)}, which does not exist "
+                "(make that folder, or name another)"
+            )
+        else:
+            why = "exists and is not a folder"
+        raise OSError(exc.errno, why, str(culprit)) from None
+    return path
+
+
 def _remove(path: Path) -> None:
     with contextlib.suppress(FileNotFoundError):
         os.unlink(path)

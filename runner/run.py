@@ -334,7 +334,7 @@ def run_to_dir(
     )
     root = Path(out_root)
     target = output_dir(root, scenario)
-    root.mkdir(parents=True, exist_ok=True)
+    outputs.make_folder(root)
     try:
         with rundir.RunLock(root, scenario.name):
             rundir.clean_leftovers(root, scenario.name)

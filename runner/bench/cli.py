@@ -105,7 +105,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
         rows += load.load(quick, echo)
     seconds = time.perf_counter() - began
-    target.mkdir(parents=True, exist_ok=True)
+    outputs.make_folder(target)
     args_line = "collide2d bench " + " ".join(sys.argv[2:]) if len(sys.argv) > 1 else "bench"
     outputs.atomic_write_text(target / "bench.csv", report.csv_text(rows))
     outputs.atomic_write_text(target / "bench.md", report.markdown(rows, args_line, seconds))

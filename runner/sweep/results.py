@@ -148,7 +148,7 @@ def write(
     folder: Path, columns: list[str], table: list[dict], total: int, complete: bool
 ) -> list[str]:
     """Write the sweep's files into `folder` (made if missing); the names written."""
-    folder.mkdir(parents=True, exist_ok=True)
+    outputs.make_folder(folder)
     outputs.atomic_write_text(folder / "results.csv", csv_text(columns, table))
     outputs.atomic_write_text(folder / "results.md", markdown(columns, table, total, complete))
     status = {"runs": total, "done": len(table), "complete": complete}

@@ -246,6 +246,20 @@ def test_a_linked_output_folder_is_refused_and_its_target_untouched(tmp_path, ca
     assert tree(tmp_path) == before
 
 
+@pytest.mark.parametrize("under", ["", "/deeper"])
+def test_an_output_folder_that_is_a_link_to_nothing_is_named_with_where_it_points(
+    tmp_path, capsys, under
+):
+    link = tmp_path / "outlink"
+    link.symlink_to(tmp_path / "nowhere", target_is_directory=True)
+    path = scenario(tmp_path)
+    before = tree(tmp_path)
+    assert main(["run", str(path), "--out", str(link) + under, "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert f"{link}: a symbolic link to {tmp_path / 'nowhere'}, which does not exist" in err
+    assert tree(tmp_path) == before
+
+
 def test_a_linked_output_file_is_refused_not_followed(tmp_path, capsys):
     outside = tmp_path / "outside.csv"
     outside.write_text("not yours\n")
