@@ -10,6 +10,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -26,6 +27,7 @@ SCENARIOS = ROOT / "scenarios"
 FIFTY = str(SCENARIOS / "paper_fifty_boxes.yaml")
 BIN = Path(sys.executable).parent
 START_S = 60  # the longest a scheduler or worker may take to come up on a busy machine
+SWEEP_S = 300  # the longest the sweep with a worker killed may take
 
 
 def _cli(*args, cwd=ROOT, timeout=240):
@@ -160,9 +162,20 @@ def test_a_worker_killed_mid_sweep_loses_no_row(tmp_path):
             workers[victim].send_signal(signal.SIGKILL)
             killed.append((victim, bool(busy)))
 
-        with distributed.Client(address, timeout=START_S) as client:
-            client.wait_for_workers(2, timeout=START_S)
-            figures, positions, complete = driver.run_sweep(client, runs, on_row=kill_a_busy_worker)
+        # were both workers to die the sweep would wait for ever: past SWEEP_S the whole cluster
+        # is killed, and the sweep fails instead of hanging
+        fired = []
+        watchdog = threading.Timer(SWEEP_S, lambda: fired.append([p.kill() for p in procs]))
+        watchdog.start()
+        try:
+            with distributed.Client(address, timeout=START_S) as client:
+                client.wait_for_workers(2, timeout=START_S)
+                figures, positions, complete = driver.run_sweep(
+                    client, runs, on_row=kill_a_busy_worker
+                )
+        finally:
+            watchdog.cancel()
+        assert not fired, f"the sweep took more than {SWEEP_S} s; the cluster was killed"
         ((victim, busy),) = killed  # a worker with a run in hand, killed while rows were missing
         assert busy and workers[victim].wait(timeout=30) == -signal.SIGKILL
         assert complete and sorted(figures) == list(range(len(runs)))
