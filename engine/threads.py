@@ -24,12 +24,13 @@ import os
 from collide2d.engine.jit import njit, numba_module, when_loaded
 
 # Threads waiting at the end of a split stage spin a short while (GNU OpenMP's GOMP_SPINCOUNT
-# turns of a pause loop, tens of microseconds), then sleep. Woken from sleep, a thread took about
-# 60 us per split stage on a 2-core virtual machine (a 100,000-object move of 90 us went to 100 us
-# on two threads, and to 48 us spinning); spinning without end (OpenMP's ACTIVE) took a split
-# stage ten times as long as one thread when the machine was busy (load 9). Even the short spin
-# loses to one thread on a busy machine, so the models time both ways as they run and keep the
-# faster (engine.splitchoice). Set before numba starts its threads; values the user set are kept.
+# turns of a pause loop, up to a few hundred microseconds), then sleep. Woken from sleep, a thread
+# took about 60 us per split stage on a 2-core virtual machine (a 100,000-object move of 90 us
+# went to 100 us on two threads, and to 48 us spinning); spinning without end (OpenMP's ACTIVE)
+# took a split stage ten times as long as one thread when the machine was busy (load 9). Even the
+# short spin loses to one thread on a busy machine, so the models time both ways as they run and
+# keep the faster (engine.splitchoice). Set before numba starts its threads; values the user set
+# are kept.
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 os.environ.setdefault("GOMP_SPINCOUNT", "10000")
 
