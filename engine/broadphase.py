@@ -66,7 +66,6 @@ GRID_FILINGS_PER_OBJECT = 16.0
 CELL_MARGIN = 1.01
 
 
-
 def index(i):
     """i as the index of a hot loop: unsigned when compiled, as it is when interpreted.
 
