@@ -84,22 +84,24 @@ def box_sweep(qx, qy, ux, uy, wa, ha, wb, hb):
 
 
 @njit(cache=True, inline="always")
+def axis_reach(q, u, lo, hi, dt):
+    """`box_reach` on one axis: False when on this axis the boxes are apart (q, B's position
+    less A's, outside [lo, hi]) and not closing at the relative speed u, or too far apart to
+    close the gap in dt s. Only comparisons joined by `&` and `|`, no choice between two numbers
+    (`x if c else y`, which may compile to a branch): the test runs on every candidate pair, most
+    of them far apart, where a branch that goes either way at random costs more than the
+    arithmetic."""
+    above_ok = (not q > hi) | ((-u > 0.0) & (not (q - hi > -u * dt)))
+    below_ok = (not q < lo) | ((u > 0.0) & (not (lo - q > u * dt)))
+    return above_ok & below_ok
+
+
+@njit(cache=True, inline="always")
 def box_reach(qx, qy, ux, uy, wa, ha, wb, hb, dt):
     """False when boxes A and B (any shapes inside them) surely cannot touch within dt seconds:
     on some axis they are apart and not closing, or too far apart to close the gap in time. A
     cheap filter before a sweep; True does not promise a contact."""
-    for q, u, lo, hi in ((qx, ux, -wb, wa), (qy, uy, -hb, ha)):
-        if q > hi:
-            gap = q - hi
-            closing = -u
-        elif q < lo:
-            gap = lo - q
-            closing = u
-        else:
-            continue
-        if not closing > 0.0 or gap > closing * dt:
-            return False
-    return True
+    return axis_reach(qx, ux, -wb, wa, dt) & axis_reach(qy, uy, -hb, ha, dt)
 
 
 @njit(cache=True)

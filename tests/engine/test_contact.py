@@ -13,6 +13,7 @@ from engine_refs import pixel_corners, ref_hull
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from collide2d.engine import jit
 from collide2d.engine.contact import (
     box_next_contact,
     box_penetration,
@@ -154,6 +155,41 @@ def test_box_reach_never_rules_out_a_contact_in_time(qx, qy, ux, uy, dt):
     t, *_ = box_next_contact(qx, qy, ux, uy, 10.0, 8.0, 6.0, 12.0)
     if t <= dt:
         assert box_reach(qx, qy, ux, uy, 10.0, 8.0, 6.0, 12.0, dt)
+
+
+def _reach_with_branches(qx, qy, ux, uy, wa, ha, wb, hb, dt):
+    """box_reach as first written, axis by axis with branches: the reference the branchless
+    form must equal."""
+    for q, u, lo, hi in ((qx, ux, -wb, wa), (qy, uy, -hb, ha)):
+        if q > hi:
+            gap, closing = q - hi, -u
+        elif q < lo:
+            gap, closing = lo - q, u
+        else:
+            continue
+        if not closing > 0.0 or gap > closing * dt:
+            return False
+    return True
+
+
+_edge = st.sampled_from([0.0, -0.0, 10.0, -6.0, 8.0, -12.0, 1e300, -1e300, 5e-324])
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.one_of(st.floats(-60, 60), _edge),
+    st.one_of(st.floats(-60, 60), _edge),
+    st.one_of(st.floats(-1e3, 1e3), _edge),
+    st.one_of(st.floats(-1e3, 1e3), _edge),
+    st.sampled_from([1 / 60, 1 / 600, 0.5, 0.0]),
+    st.booleans(),
+)
+def test_box_reach_is_the_test_with_branches_in_both_lanes(qx, qy, ux, uy, dt, compiled):
+    # the edges (q on a side of [lo, hi], u = +-0, huge and subnormal numbers) are where a
+    # rewrite without branches could part from the plain test
+    with jit.lane(compiled):
+        got = box_reach(qx, qy, ux, uy, 10.0, 8.0, 6.0, 12.0, dt)
+    assert got == _reach_with_branches(qx, qy, ux, uy, 10.0, 8.0, 6.0, 12.0, dt)
 
 
 # --- circles --------------------------------------------------------------------------------------
