@@ -7,7 +7,8 @@ core) with one thread each, and closes it on the way out. `run_all(client, fn, i
 submits `fn(item)` for every item and hands each result (or the exception it raised) to
 `on_result(i, value, error)` as runs finish, in any order. A task whose worker dies is run again
 elsewhere by the scheduler (up to its `allowed-failures`), so every item gets one result; on
-Ctrl-C the tasks still pending are cancelled and `run_all` returns False.
+Ctrl-C (SIGINT, answered inside `connect` even by a process started with it ignored) the tasks
+still pending are cancelled and `run_all` returns False.
 
 Dask is the optional `dask` extra: `require_dask` raises `DaskMissing` with the install command.
 """
@@ -42,6 +43,22 @@ def require_dask(what: str = "this command") -> None:
 
 
 @contextlib.contextmanager
+def _ctrl_c_raises():
+    """SIGINT raises KeyboardInterrupt in this process while open, as `collide2d run` stops on it:
+    also when the process started with SIGINT ignored, as a shell starts a job in the background
+    (`collide2d sweep ... &`; Python then leaves it ignored, and a `kill -INT` would go
+    unanswered)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, before)
+
+
+@contextlib.contextmanager
 def _ctrl_c_for_this_process_only():
     """Start worker processes with SIGINT ignored (they inherit it): Ctrl-C on a terminal reaches
     every process of the group, and only this one should act on it (cancel, write, close the
@@ -63,23 +80,24 @@ def connect(workers: int | None = None, scheduler: str | None = None):
     require_dask()
     from distributed import Client, LocalCluster
 
-    if scheduler:
-        with Client(scheduler, timeout=CONNECT_TIMEOUT_S) as client:
-            yield client
-        return
-    with _ctrl_c_for_this_process_only():
-        cluster = LocalCluster(
-            n_workers=workers or os.cpu_count() or 1,
-            threads_per_worker=1,
-            processes=True,
-            dashboard_address=":0",  # the HTTP server on a free port: 8787 may be taken
-            silence_logs=logging.CRITICAL,  # shutdown races log tracebacks; rows say what failed
-        )
-    try:
-        with Client(cluster) as client:
-            yield client
-    finally:
-        cluster.close()
+    with _ctrl_c_raises():
+        if scheduler:
+            with Client(scheduler, timeout=CONNECT_TIMEOUT_S) as client:
+                yield client
+            return
+        with _ctrl_c_for_this_process_only():
+            cluster = LocalCluster(
+                n_workers=workers or os.cpu_count() or 1,
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=":0",  # the HTTP server on a free port: 8787 may be taken
+                silence_logs=logging.CRITICAL,  # shutdown races log tracebacks; rows tell failures
+            )
+        try:
+            with Client(cluster) as client:
+                yield client
+        finally:
+            cluster.close()
 
 
 def progress_for(total: int, label: str, quiet: bool) -> Progress | None:

@@ -191,11 +191,22 @@ def test_a_worker_killed_mid_sweep_loses_no_row(tmp_path):
             _stop(proc)
 
 
-def test_ctrl_c_writes_the_rows_done_marked_incomplete(tmp_path):
+# The sweep started as a shell starts it: in the foreground (SIGINT as the shell had it), or in
+# the background of a script (`collide2d sweep ... &`: SIGINT ignored, which the sweep's process
+# would keep but for its own handler). `sh -c 'trap "" INT; exec ...'` starts it with SIGINT
+# ignored.
+STARTED = {
+    "foreground": [],
+    "background": ["sh", "-c", 'trap "" INT; exec "$@"', "sh"],
+}
+
+
+@pytest.mark.parametrize("started", sorted(STARTED))
+def test_ctrl_c_writes_the_rows_done_marked_incomplete(tmp_path, started):
     out = tmp_path / "out"
     proc = subprocess.Popen(
-        [str(BIN / "collide2d"), "sweep", FIFTY, "--set", "ticks=20000", "--seeds", "1-40",
-         "--workers", "2", "--out", str(out)],
+        [*STARTED[started], str(BIN / "collide2d"), "sweep", FIFTY, "--set", "ticks=20000",
+         "--seeds", "1-40", "--workers", "2", "--out", str(out)],
         cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL,
         text=True, start_new_session=True,
     )  # fmt: skip
