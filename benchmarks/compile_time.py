@@ -3,11 +3,18 @@
 Runs the project's scenarios (or the files given) compiled (`--jit on`) from an empty kernel
 cache, in one fresh process, and reports the wall time and, per kernel, its specialisations and
 the seconds numba spent compiling it, not counting the kernels it calls (those are their own
-rows; a caller's time includes linking and optimising their code into its own). The compile
+rows; a caller's time includes linking and optimising their code into its own), then the same
+seconds per scenario (a kernel's seconds go to the scenario that compiled it first). The compile
 time of the kernels is most of a cold test suite's and of a big scene's first run: this is the
-script to run before and after a change that may add to it. Usage:
+script to run before and after a change that may add to it.
+
+With `--suite`, the same for the test suite instead: plain `pytest` in one process from an empty
+kernel cache (the README's test command; extra pytest arguments after `--`), the seconds summed
+per test file, so that the tests whose kernels cost the most stand out. Compiles inside the
+tests' own subprocesses are not counted; they show in the wall time only. Usage:
 
     python benchmarks/compile_time.py [SCENARIO ...] [--top 25]
+    python benchmarks/compile_time.py --suite [--top 25] [-- PYTEST_ARGS ...]
 """
 
 from __future__ import annotations
@@ -18,70 +25,151 @@ import os
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 
-# Run in a fresh process with an empty cache: records (kernel, own seconds) per compilation.
-CHILD = """
-import json, sys, time
-from numba.core import event
-
-stack, rows = [], []
+# `listen(rows, where)` records (kernel, own seconds, where[0]) in rows for every compilation
+# from then on: where[0] names what runs (a scenario, a test file).
+LISTENER = """
+import time
 
 
-class Listen(event.Listener):
-    def on_start(self, ev):
-        func = ev.data["dispatcher"].py_func
-        stack.append([f"{func.__module__}.{func.__qualname__}", time.perf_counter(), 0.0])
+def listen(rows, where):
+    from numba.core import event
 
-    def on_end(self, ev):
-        name, began, inner = stack.pop()
-        took = time.perf_counter() - began
-        if stack:
-            stack[-1][2] += took
-        rows.append((name, took - inner))
+    stack = []
 
+    class Listen(event.Listener):
+        def on_start(self, ev):
+            func = ev.data["dispatcher"].py_func
+            stack.append([f"{func.__module__}.{func.__qualname__}", time.perf_counter(), 0.0])
 
-event.register("numba:compile", Listen())
+        def on_end(self, ev):
+            name, began, inner = stack.pop()
+            took = time.perf_counter() - began
+            if stack:
+                stack[-1][2] += took
+            rows.append((name, took - inner, where[0]))
+
+    event.register("numba:compile", Listen())
+"""
+
+# Run in a fresh process with an empty cache: the scenarios, compiled.
+CHILD = LISTENER + """
+import json, sys
 from collide2d.runner.cli import main
 
+rows, where = [], ["-"]
+listen(rows, where)
 out, paths = sys.argv[1], sys.argv[2:]
 began = time.perf_counter()
 for path in paths:
+    where[0] = path
     status = main(["run", path, "--out", out, "--jit", "on", "--quiet", "--no-gif", "--no-png"])
     if status:
         raise SystemExit(f"{path}: exit {status}")
 print(json.dumps({"wall_s": time.perf_counter() - began, "rows": rows}))
 """
 
+# A pytest plugin (module `collide2d_compile_log`): the listener, started once numba is loaded
+# (a test may check that numba is not), each test's file as `where`, the rows written at the end.
+PLUGIN = LISTENER + """
+import json, os
+import pytest
+from collide2d.engine import jit
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("scenarios", nargs="*", help="default: every file of scenarios/")
-    parser.add_argument("--top", type=int, default=25, help="kernels listed (default 25)")
-    args = parser.parse_args()
-    paths = args.scenarios or sorted(str(p) for p in (ROOT / "scenarios").glob("*.yaml"))
-    with tempfile.TemporaryDirectory(prefix="collide2d-compile-") as tmp:
-        env = dict(os.environ, NUMBA_CACHE_DIR=str(Path(tmp) / "cache"))
-        env.pop("COLLIDE2D_JIT", None)
-        done = subprocess.run(
-            [sys.executable, "-c", CHILD, str(Path(tmp) / "out"), *paths],
-            env=env, capture_output=True, text=True,
-        )  # fmt: skip
+rows, where = [], ["(collection)"]
+jit.when_loaded(lambda: listen(rows, where))
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_protocol(item, nextitem):
+    where[0] = item.nodeid.split("::")[0]
+    yield
+
+
+def pytest_unconfigure(config):
+    with open(os.environ["COLLIDE2D_COMPILE_LOG"], "w") as f:
+        json.dump({"rows": rows}, f)
+"""
+
+
+def _scenarios(paths: list[str], tmp: Path, env: dict) -> tuple[str, list]:
+    """Run the scenarios compiled in a child process: (the summary line, the rows)."""
+    paths = paths or sorted(str(p) for p in (ROOT / "scenarios").glob("*.yaml"))
+    done = subprocess.run(
+        [sys.executable, "-c", CHILD, str(tmp / "out"), *paths],
+        env=env, capture_output=True, text=True,
+    )  # fmt: skip
     if done.returncode:
         raise SystemExit(done.stderr)
     result = json.loads(done.stdout.splitlines()[-1])
-    kernels: dict[str, list[float]] = {}
-    for name, seconds in result["rows"]:
-        kernels.setdefault(name, []).append(seconds)
-    total = sum(seconds for _, seconds in result["rows"])
-    print(f"{len(paths)} scenarios, compiled from an empty cache: {result['wall_s']:.1f} s wall, "
-          f"{total:.1f} s compiling {len(result['rows'])} specialisations")  # fmt: skip
-    print(f"{'own s':>7}  {'specs':>5}  kernel")
-    ranked = sorted(kernels.items(), key=lambda item: -sum(item[1]))
-    for name, times in ranked[: args.top]:
+    return f"{len(paths)} scenarios, compiled from an empty cache: {result['wall_s']:.1f} s wall", (
+        result["rows"]
+    )
+
+
+def _suite(pytest_args: list[str], tmp: Path, env: dict) -> tuple[str, list]:
+    """Run the test suite in one pytest process with the listener: (the summary line, the rows)."""
+    (tmp / "collide2d_compile_log.py").write_text(PLUGIN)
+    log = tmp / "compiles.json"
+    env = dict(env, COLLIDE2D_COMPILE_LOG=str(log))
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(tmp), env.get("PYTHONPATH")]))
+    command = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider"]
+    command += ["-p", "collide2d_compile_log", *pytest_args]
+    began = time.perf_counter()
+    done = subprocess.run(command, cwd=ROOT, env=env, capture_output=True, text=True)
+    wall = time.perf_counter() - began
+    if not log.exists():
+        raise SystemExit(done.stdout + done.stderr)
+    lines = done.stdout.strip().splitlines() or ["(no output)"]
+    for line in lines:  # pytest's short summary: what failed, if anything
+        if line.startswith(("FAILED", "ERROR")):
+            print(line)
+    last = lines[-1]
+    return f"the suite in one process from an empty cache: {wall:.1f} s wall ({last})", (
+        json.loads(log.read_text())["rows"]
+    )
+
+
+def _table(title: str, seconds: dict[str, list[float]], top: int) -> None:
+    print(f"{'own s':>7}  {'specs':>5}  {title}")
+    ranked = sorted(seconds.items(), key=lambda item: -sum(item[1]))
+    for name, times in ranked[:top]:
         print(f"{sum(times):7.2f}  {len(times):5d}  {name}")
+
+
+def main() -> None:
+    argv = sys.argv[1:]
+    pytest_args = argv[argv.index("--") + 1 :] if "--" in argv else []
+    argv = argv[: argv.index("--")] if "--" in argv else argv
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("scenarios", nargs="*", help="default: every file of scenarios/")
+    parser.add_argument("--suite", action="store_true", help="the test suite, not scenarios")
+    parser.add_argument("--top", type=int, default=25, help="rows listed (default 25)")
+    args = parser.parse_args(argv)
+    if args.suite and args.scenarios:
+        parser.error("--suite takes no scenarios (pytest arguments go after --)")
+    with tempfile.TemporaryDirectory(prefix="collide2d-compile-") as tmp:
+        env = dict(os.environ, NUMBA_CACHE_DIR=str(Path(tmp) / "cache"))
+        env.pop("COLLIDE2D_JIT", None)
+        if args.suite:
+            summary, rows = _suite(pytest_args, Path(tmp), env)
+        else:
+            summary, rows = _scenarios(args.scenarios, Path(tmp), env)
+    kernels: dict[str, list[float]] = {}
+    places: dict[str, list[float]] = {}
+    for name, seconds, where in rows:
+        kernels.setdefault(name, []).append(seconds)
+        places.setdefault(where, []).append(seconds)
+    total = sum(seconds for _, seconds, _ in rows)
+    print(f"{summary}, {total:.1f} s compiling {len(rows)} specialisations")
+    _table("kernel", kernels, args.top)
+    print()
+    _table(f"{'test file' if args.suite else 'scenario'} (the kernels it compiled first)", places,
+           args.top)  # fmt: skip
 
 
 if __name__ == "__main__":
