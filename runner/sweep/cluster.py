@@ -43,30 +43,13 @@ def require_dask(what: str = "this command") -> None:
 
 
 @contextlib.contextmanager
-def _ctrl_c_raises():
-    """SIGINT raises KeyboardInterrupt in this process while open, as `collide2d run` stops on it:
-    also when the process started with SIGINT ignored, as a shell starts a job in the background
-    (`collide2d sweep ... &`; Python then leaves it ignored, and a `kill -INT` would go
-    unanswered)."""
+def _sigint(handler):
+    """SIGINT handled by `handler` while open (in the main thread, where Python runs signal
+    handlers; elsewhere nothing changes)."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-    before = signal.signal(signal.SIGINT, signal.default_int_handler)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGINT, before)
-
-
-@contextlib.contextmanager
-def _ctrl_c_for_this_process_only():
-    """Start worker processes with SIGINT ignored (they inherit it): Ctrl-C on a terminal reaches
-    every process of the group, and only this one should act on it (cancel, write, close the
-    cluster) instead of each worker printing a traceback as it dies."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    before = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    before = signal.signal(signal.SIGINT, handler)
     try:
         yield
     finally:
@@ -80,12 +63,18 @@ def connect(workers: int | None = None, scheduler: str | None = None):
     require_dask()
     from distributed import Client, LocalCluster
 
-    with _ctrl_c_raises():
+    # Ctrl-C raises KeyboardInterrupt here, as `collide2d run` stops on it: also when the process
+    # started with SIGINT ignored, as a shell starts a job in the background (`collide2d sweep
+    # ... &`; Python would leave it ignored, and a `kill -INT` would go unanswered)
+    with _sigint(signal.default_int_handler):
         if scheduler:
             with Client(scheduler, timeout=CONNECT_TIMEOUT_S) as client:
                 yield client
             return
-        with _ctrl_c_for_this_process_only():
+        # worker processes start with SIGINT ignored (they inherit it): Ctrl-C on a terminal
+        # reaches every process of the group, and only this one should act on it (cancel,
+        # write, close the cluster) instead of each worker printing a traceback as it dies
+        with _sigint(signal.SIG_IGN):
             cluster = LocalCluster(
                 n_workers=workers or os.cpu_count() or 1,
                 threads_per_worker=1,
