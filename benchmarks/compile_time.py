@@ -111,8 +111,9 @@ def _scenarios(paths: list[str], tmp: Path, env: dict) -> tuple[str, list]:
     )
 
 
-def _suite(pytest_args: list[str], tmp: Path, env: dict) -> tuple[str, list]:
-    """Run the test suite in one pytest process with the listener: (the summary line, the rows)."""
+def _suite(pytest_args: list[str], tmp: Path, env: dict) -> tuple[str, list, int]:
+    """Run the test suite in one pytest process with the listener: (the summary line, the rows,
+    pytest's exit status)."""
     (tmp / "collide2d_compile_log.py").write_text(PLUGIN)
     log = tmp / "compiles.json"
     env = dict(env, COLLIDE2D_COMPILE_LOG=str(log))
@@ -125,13 +126,20 @@ def _suite(pytest_args: list[str], tmp: Path, env: dict) -> tuple[str, list]:
     if not log.exists():
         raise SystemExit(done.stdout + done.stderr)
     lines = done.stdout.strip().splitlines() or ["(no output)"]
-    for line in lines:  # pytest's short summary: what failed, if anything
+    for line in lines + done.stderr.splitlines():  # what failed or was refused, if anything
         if line.startswith(("FAILED", "ERROR")):
             print(line)
     last = lines[-1]
-    return f"the suite in one process from an empty cache: {wall:.1f} s wall ({last})", (
-        json.loads(log.read_text())["rows"]
-    )
+    summary = f"the suite in one process from an empty cache: {wall:.1f} s wall ({last})"
+    return summary, json.loads(log.read_text())["rows"], done.returncode
+
+
+def _count(text: str) -> int:
+    """--top's value: a whole number >= 1."""
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be at least 1, got {value}")
+    return value
 
 
 def _table(title: str, seconds: dict[str, list[float]], top: int) -> None:
@@ -148,15 +156,18 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("scenarios", nargs="*", help="default: every file of scenarios/")
     parser.add_argument("--suite", action="store_true", help="the test suite, not scenarios")
-    parser.add_argument("--top", type=int, default=25, help="rows listed (default 25)")
+    parser.add_argument("--top", type=_count, default=25, help="rows listed (default 25)")
     args = parser.parse_args(argv)
     if args.suite and args.scenarios:
         parser.error("--suite takes no scenarios (pytest arguments go after --)")
+    if pytest_args and not args.suite:
+        parser.error("arguments after -- are pytest's: they go with --suite")
+    status = 0
     with tempfile.TemporaryDirectory(prefix="collide2d-compile-") as tmp:
         env = dict(os.environ, NUMBA_CACHE_DIR=str(Path(tmp) / "cache"))
         env.pop("COLLIDE2D_JIT", None)
         if args.suite:
-            summary, rows = _suite(pytest_args, Path(tmp), env)
+            summary, rows, status = _suite(pytest_args, Path(tmp), env)
         else:
             summary, rows = _scenarios(args.scenarios, Path(tmp), env)
     kernels: dict[str, list[float]] = {}
@@ -170,6 +181,7 @@ def main() -> None:
     print()
     _table(f"{'test file' if args.suite else 'scenario'} (the kernels it compiled first)", places,
            args.top)  # fmt: skip
+    raise SystemExit(status)  # pytest's, when it failed or found nothing to run
 
 
 if __name__ == "__main__":
