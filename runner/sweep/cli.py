@@ -21,14 +21,32 @@ EXIT_CANCELLED = 130
 REPORT_DIR = "sweep"
 
 
-def add_cluster_arguments(parser: argparse.ArgumentParser) -> None:
-    """--workers N | --scheduler ADDRESS (also on `check`)."""
+# An embedded cluster's workers are processes of this machine, each loading its own kernels: at
+# most this many per core (more is a typo, or a cluster to start with `dask worker` instead).
+LOCAL_WORKERS_PER_CORE = 8
+
+
+def local_workers(text: str) -> int:
+    """argparse type of --workers: a whole number from 1 to LOCAL_WORKERS_PER_CORE x the cores."""
     from collide2d.runner.options import positive_int
 
+    value = positive_int(text)
+    cores = os.cpu_count() or 1
+    if value > LOCAL_WORKERS_PER_CORE * cores:
+        raise argparse.ArgumentTypeError(
+            f"{value:,} worker processes on a machine of {cores} cores (at most "
+            f"{LOCAL_WORKERS_PER_CORE * cores}); for more, start a cluster with `dask scheduler` "
+            "and `dask worker` and name it with --scheduler"
+        )
+    return value
+
+
+def add_cluster_arguments(parser: argparse.ArgumentParser) -> None:
+    """--workers N | --scheduler ADDRESS (also on `check`)."""
     where = parser.add_mutually_exclusive_group()
     where.add_argument(
         "--workers",
-        type=positive_int,
+        type=local_workers,
         metavar="N",
         help="run on an embedded Dask cluster of N processes (default: one per core)",
     )

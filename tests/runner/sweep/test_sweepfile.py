@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 
@@ -11,6 +12,7 @@ import pytest
 from collide2d.runner.cli import main
 from collide2d.runner.scenario import ScenarioError
 from collide2d.runner.sweep import sweepfile
+from collide2d.runner.sweep.cli import LOCAL_WORKERS_PER_CORE
 
 SCENARIOS = Path(__file__).resolve().parents[3] / "scenarios"
 FIFTY = SCENARIOS / "paper_fifty_boxes.yaml"
@@ -83,6 +85,22 @@ def test_bad_input_exits_2_and_writes_nothing(tmp_path, capsys):
     assert main(["sweep", str(FIFTY), "--out", str(out)]) == 2
     assert "sweep is a symbolic link" in capsys.readouterr().err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["matrix.yaml", "out"]
+
+
+@pytest.mark.parametrize("command", ["sweep", "check"])
+def test_more_local_workers_than_the_machine_can_hold_are_refused_at_once(tmp_path, capsys,
+                                                                         command):
+    # a huge --workers would have the embedded cluster start that many processes
+    out = tmp_path / "out"
+    cap = LOCAL_WORKERS_PER_CORE * (os.cpu_count() or 1)
+    for workers in (str(cap + 1), "99999999999999999999"):
+        with pytest.raises(SystemExit) as done:
+            main([command, str(FIFTY), "--workers", workers, "--out", str(out)])
+        assert done.value.code == 2
+        err = capsys.readouterr().err
+        assert f"argument --workers: {int(workers):,} worker processes" in err
+        assert f"(at most {cap}); for more, start a cluster" in err
+    assert not out.exists()
 
 
 def test_without_dask_sweep_says_how_to_install_it(tmp_path, capsys, monkeypatch):
