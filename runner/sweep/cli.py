@@ -32,11 +32,12 @@ def local_workers(text: str) -> int:
 
     value = positive_int(text)
     cores = os.cpu_count() or 1
-    if value > LOCAL_WORKERS_PER_CORE * cores:
+    most = LOCAL_WORKERS_PER_CORE * cores
+    if value > most:
         raise argparse.ArgumentTypeError(
-            f"{value:,} worker processes on a machine of {cores} cores (at most "
-            f"{LOCAL_WORKERS_PER_CORE * cores}); for more, start a cluster with `dask scheduler` "
-            "and `dask worker` and name it with --scheduler"
+            f"{value:,} worker processes on a machine of {cores} cores (at most {most}); for "
+            "more, start a cluster with `dask scheduler` and `dask worker` and name it with "
+            "--scheduler"
         )
     return value
 
