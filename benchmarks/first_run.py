@@ -6,8 +6,9 @@
 
 each with `--jit auto` (the default) and `--jit on` (every kernel compiled, as before the lanes),
 interleaved, medians with the spread; every command runs from an empty temporary folder (`check`
-with `--root` this repository). `--python PY` runs another installation's collide2d (a fresh
-virtualenv holding a wheel, say). Usage:
+with `--root` this repository), Python's bytecode cached there as an installation has it
+(collide2d.runner.bench.targets.user_env). `--python PY` runs another installation's collide2d
+(a fresh virtualenv holding a wheel, say). Usage:
 
     python benchmarks/first_run.py [--repeats 3] [--warm-repeats 9] [--python PY]
 """
@@ -24,12 +25,14 @@ import tempfile
 import time
 from pathlib import Path
 
+from collide2d.runner.bench.targets import user_env
+
 ROOT = Path(__file__).resolve().parents[1]
 COMMAND = [sys.executable, "-m", "collide2d"]
 
 
 def timed(args: list[str], cache: Path, cwd: Path) -> float:
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache))
+    env = dict(user_env(str(cwd / "pycache")), NUMBA_CACHE_DIR=str(cache))
     env.pop("COLLIDE2D_JIT", None)
     env.pop("PYTHONPATH", None)
     began = time.perf_counter()

@@ -35,7 +35,7 @@ import math
 import numpy as np
 
 from collide2d.engine.jit import njit, overload, prange
-from collide2d.engine.sort import heap_argsort, sort_order
+from collide2d.engine.sort import heap_argsort, median, sort_order
 from collide2d.engine.threads import join_shares, shares_total
 
 # A candidate pair (a, b) is one sortable int64 key, a << KEY_SHIFT | b (ids below 2**31).
@@ -423,12 +423,12 @@ def choose(
     if n < 2:
         return METHODS.get(method, METHOD_SWEEP), 1.0
     sides = size.max(axis=1)
-    median, largest = float(np.median(sides)), float(sides.max())
+    median_side, largest = median(sides), float(sides.max())
     if method is None:
         neighbours = (n - 1) * 2.0 * float(size[:, 0].mean()) / max(float(width), 1.0)
         if not neighbours > SWEEP_MAX_X_NEIGHBOURS:
             method = "sweep"
-        elif largest <= CELLS_MAX_SIDE_RATIO * median:
+        elif largest <= CELLS_MAX_SIDE_RATIO * median_side:
             method = "cells"
         else:
             method = "grid"
@@ -436,7 +436,7 @@ def choose(
         return METHOD_SWEEP, 1.0
     if method == "cells":
         return METHOD_CELLS, largest * CELL_MARGIN
-    cell = max(GRID_CELL_PER_SIDE * median, 1e-6)
+    cell = max(GRID_CELL_PER_SIDE * median_side, 1e-6)
     while np.sum((np.floor(size / cell) + 2).prod(axis=1)) > GRID_FILINGS_PER_OBJECT * n:
         cell *= 2.0
     return METHOD_GRID, cell

@@ -33,6 +33,7 @@ import numpy as np
 from collide2d.engine.eventqueue import ID_BITS, RANK_WALL, make_key
 from collide2d.engine.exactstate import INF, hot
 from collide2d.engine.jit import njit
+from collide2d.engine.sort import median
 
 # Columns of QL: the next and previous object in the same bucket's list.
 Q_NEXT, Q_PREV = range(2)
@@ -59,7 +60,7 @@ def bucket_width(F: np.ndarray, static: np.ndarray, cell: float, width: float, h
         return 1.0
     span = min(cell, width, height)
     with np.errstate(over="ignore"):  # (a subnormal speed: no width from it)
-        w = float(np.median(span / speed)) / speed.size
+        w = median(span / speed) / speed.size
     return w if np.isfinite(w) and w > 0.0 else 1.0
 
 

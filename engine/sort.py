@@ -4,10 +4,14 @@
 sort (objects move a little between calls) or sorting it afresh by heap sort when it is far off;
 `sort_keys` sorts a short list of pair keys in place, `sort_by_time` a list of pair keys by the
 times beside them; `heap_argsort` gives the order of a key
-array (heap sort: O(n log n), compiles quickly, allocates only the result). All numba kernels.
+array (heap sort: O(n log n), compiles quickly, allocates only the result). All numba kernels,
+but `median`: numpy.median bit for bit, without the import of numpy.ma that numpy.median's first
+call costs (tens of ms of a small run's start).
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
@@ -171,3 +175,15 @@ def _heap_sort_timed(when, keys, n):
             when[root], when[c] = when[c], when[root]
             keys[root], keys[c] = keys[c], keys[root]
             root = c
+
+
+def median(v: np.ndarray) -> float:
+    """numpy.median of a non-empty 1-D array, bit for bit (the middle value, or the mean of the
+    two middle ones; NaN when any is NaN), without numpy.median's first-call import of numpy.ma."""
+    s = np.sort(np.asarray(v, dtype=np.float64).ravel())
+    if np.isnan(s[-1]):
+        return math.nan
+    k = s.shape[0] // 2
+    if s.shape[0] % 2:
+        return float(s[k])
+    return float((s[k - 1] + s[k]) / 2.0)

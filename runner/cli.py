@@ -217,16 +217,27 @@ def command_of(argv: list[str]) -> str | None:
     return None
 
 
+class _Version(argparse.Action):
+    """`--version`, the distribution's version read only when asked for (collide2d.__getattr__)."""
+
+    def __init__(self, option_strings, dest=argparse.SUPPRESS, help=None):
+        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, help=help)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        from collide2d import __version__
+
+        print(f"collide2d {__version__}")
+        parser.exit()
+
+
 def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     """The parser; with `command`, one of REGISTRARS' commands, only its module is loaded ("":
     none)."""
-    from collide2d import __version__
-
     parser = argparse.ArgumentParser(
         prog="collide2d",
         description="Declarative 2D collision scenarios: run them, see them, keep them honest.",
     )
-    parser.add_argument("--version", action="version", version=f"collide2d {__version__}")
+    parser.add_argument("--version", action=_Version, help="show the version and exit")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for module, function, commands in REGISTRARS:
         if command is None or command in commands:

@@ -42,6 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from collide2d.engine.jit import njit
+from collide2d.engine.sort import median as median_of
 from collide2d.runner import lanes
 
 # Candidate positions drawn per batch from a block's generator (fixed: it is part of the stream).
@@ -289,21 +290,9 @@ def cell_size(extent_x: float, extent_y: float, max_sides: np.ndarray) -> float:
     grid has more than GRID_CELLS_PER_BOX cells per box.
     """
     n = max(1, int(max_sides.shape[0]))
-    median = _median(max_sides) if max_sides.shape[0] else GRID_MIN_CELL
+    median = median_of(max_sides) if max_sides.shape[0] else GRID_MIN_CELL
     sparse = math.sqrt(max(extent_x, 1.0) * max(extent_y, 1.0) / (GRID_CELLS_PER_BOX * n))
     return max(GRID_MIN_CELL, median, sparse)
-
-
-def _median(v: np.ndarray) -> float:
-    """numpy.median of a non-empty 1-D array, bit for bit (the middle value, or the mean of the
-    two middle ones; NaN when any is NaN), without numpy.median's first-call import of numpy.ma."""
-    s = np.sort(np.asarray(v, dtype=np.float64))
-    if np.isnan(s[-1]):
-        return math.nan
-    k = s.shape[0] // 2
-    if s.shape[0] % 2:
-        return float(s[k])
-    return float((s[k - 1] + s[k]) / 2.0)
 
 
 APART_MAX_PER_CELL = 4  # _apart gives up (the kernel decides) past this many boxes in a cell

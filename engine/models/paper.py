@@ -459,7 +459,8 @@ class Model:
             np.empty((n, 2), np.int64),
             params,
             np.zeros((chunks, 3), np.int64),  # what each thread of a split stage found
-            np.unique(period[long_steps]).astype(np.int64),  # periods of the long steps
+            # periods of the long steps (sorted, each once; np.unique would import numpy.ma)
+            np.array(sorted(set(period[long_steps].tolist())), np.int64),
             marker(method),
             np.empty((n, 4), small),  # reach boxes of this tick, for the narrow stage
         )

@@ -64,6 +64,7 @@ from collide2d.engine.models.stepped_list import (
 from collide2d.engine.models.stepped_motion import BODY_COLUMNS
 from collide2d.engine.models.stepped_step import STAGES, run, step
 from collide2d.engine.shapes import GEOMETRIES, build_cores
+from collide2d.engine.sort import median
 from collide2d.engine.splitchoice import SplitChoice
 from collide2d.engine.threads import chunks_for
 from collide2d.engine.world import Bodies, WorldSpec
@@ -250,7 +251,7 @@ def _broad_phase(world, pos, vel, size, movable, substeps, skip, broadphase):
     n = pos.shape[0]
     possible = n >= 2 and (bool(movable.any()) or not skip)
     fastest = float(np.abs(vel).max()) / (world.fps * substeps) if n else 0.0
-    median_side = float(np.median(size.max(axis=1))) if n else 1.0
+    median_side = median(size.max(axis=1)) if n else 1.0
     margin = min(MARGIN_STEPS * fastest, MARGIN_MAX_SIDES * median_side)
     margin = max(margin, MARGIN_MIN_PX) if np.isfinite(margin) else MARGIN_MIN_PX
     method, cell = choose(world.width, world.height, size + 2.0 * margin, broadphase)

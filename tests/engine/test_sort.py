@@ -1,5 +1,6 @@
 """engine/sort.py: each sort gives numpy's order (or sorted()'s, for pairs of time and key), for
-nearly sorted and reshuffled input alike."""
+nearly sorted and reshuffled input alike; `median` is numpy.median bit for bit, and leaves numpy.ma
+unimported."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from collide2d.engine.sort import heap_argsort, sort_by_time, sort_keys, sort_order
+from collide2d.engine.sort import heap_argsort, median, sort_by_time, sort_keys, sort_order
 
 keys = st.lists(st.integers(-50, 50), max_size=200).map(lambda v: np.array(v, np.int64))
 
@@ -60,3 +61,30 @@ def test_sort_by_time_orders_by_time_then_key(entries):
     sort_by_time(w, k, n)
     assert list(zip(w[:n].tolist(), k[:n].tolist(), strict=True)) == sorted(entries[:n])
     assert np.array_equal(w[n:], when[n:]) and np.array_equal(k[n:], keys[n:])
+
+
+floats = st.floats(allow_nan=True, allow_infinity=True, width=64)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(floats, min_size=1, max_size=40))
+def test_median_is_numpy_median_bit_for_bit(values):
+    v = np.array(values, np.float64)
+    with np.errstate(invalid="ignore"):  # inf + -inf in the middle: NaN in both
+        expected = np.median(v)
+    got = median(v)
+    assert isinstance(got, float)
+    assert np.array_equal(np.float64(got), expected, equal_nan=True)
+    assert np.float64(got).tobytes() == expected.tobytes() or np.isnan(expected)
+
+
+def test_median_does_not_import_numpy_ma():
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, numpy as np; from collide2d.engine.sort import median; "
+        "median(np.array([3.0, 1.0, 2.0])); print('numpy.ma' in sys.modules)"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert done.stdout.strip() == "False"

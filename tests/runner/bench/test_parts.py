@@ -1,5 +1,6 @@
 """runner.bench.paper, exact and raster: the parts asked for with `--part`, each a quick run with
-one row per figure, and the path the raster part draws."""
+one row per figure, and the path the raster part draws; the targets part's runs have bytecode
+cached as an installation has it."""
 
 from __future__ import annotations
 
@@ -53,3 +54,18 @@ def test_quick_raster_part_through_the_command_line(tmp_path):
     assert "## Drawing and writing frames" in md and "one PNG frame" in md
     csv = (tmp_path / "bench" / "bench.csv").read_text().splitlines()
     assert len(csv) == 1 + 6 and all(line.startswith("raster,") for line in csv[1:])
+
+
+def test_small_runs_are_timed_with_bytecode_cached_apart_from_the_sources(tmp_path, monkeypatch):
+    import subprocess
+    import sys
+
+    from collide2d.runner.bench.targets import user_env
+
+    monkeypatch.setenv("PYTHONDONTWRITEBYTECODE", "1")  # as some CI images set it
+    env = user_env(str(tmp_path / "pycache"))
+    code = "import sys, collide2d.runner.bench.scenes; print(sys.dont_write_bytecode)"
+    done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "False"
+    assert list((tmp_path / "pycache").rglob("scenes.*.pyc"))  # written under the prefix
