@@ -5,7 +5,7 @@ sort (objects move a little between calls) or sorting it afresh by heap sort whe
 `sort_keys` sorts a short list of pair keys in place, `sort_by_time` a list of pair keys by the
 times beside them; `heap_argsort` gives the order of a key
 array (heap sort: O(n log n), compiles quickly, allocates only the result). All numba kernels,
-but `median`: numpy.median bit for bit, without the import of numpy.ma that numpy.median's first
+but `median`: numpy.median's value, without the import of numpy.ma that numpy.median's first
 call costs (tens of ms of a small run's start).
 """
 
@@ -178,8 +178,10 @@ def _heap_sort_timed(when, keys, n):
 
 
 def median(v: np.ndarray) -> float:
-    """numpy.median of a non-empty 1-D array, bit for bit (the middle value, or the mean of the
-    two middle ones; NaN when any is NaN), without numpy.median's first-call import of numpy.ma."""
+    """numpy.median of a non-empty 1-D array (the middle value, or the mean of the two middle
+    ones; NaN when any is NaN), without numpy.median's first-call import of numpy.ma. Bit for bit
+    but for the sign of a zero median: numpy's partition may put 0.0 or -0.0, which compare
+    equal, in the middle (every caller takes the median as a size, where the two are the same)."""
     s = np.sort(np.asarray(v, dtype=np.float64).ravel())
     if np.isnan(s[-1]):
         return math.nan
