@@ -134,14 +134,6 @@ def _suite(pytest_args: list[str], tmp: Path, env: dict) -> tuple[str, list, int
     return summary, json.loads(log.read_text())["rows"], done.returncode
 
 
-def _count(text: str) -> int:
-    """--top's value: a whole number >= 1."""
-    value = int(text)
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be at least 1, got {value}")
-    return value
-
-
 def _table(title: str, seconds: dict[str, list[float]], top: int) -> None:
     print(f"{'own s':>7}  {'specs':>5}  {title}")
     ranked = sorted(seconds.items(), key=lambda item: -sum(item[1]))
@@ -150,13 +142,15 @@ def _table(title: str, seconds: dict[str, list[float]], top: int) -> None:
 
 
 def main() -> None:
+    from collide2d.runner.options import positive_int
+
     argv = sys.argv[1:]
     pytest_args = argv[argv.index("--") + 1 :] if "--" in argv else []
     argv = argv[: argv.index("--")] if "--" in argv else argv
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("scenarios", nargs="*", help="default: every file of scenarios/")
     parser.add_argument("--suite", action="store_true", help="the test suite, not scenarios")
-    parser.add_argument("--top", type=_count, default=25, help="rows listed (default 25)")
+    parser.add_argument("--top", type=positive_int, default=25, help="rows listed (default 25)")
     args = parser.parse_args(argv)
     if args.suite and args.scenarios:
         parser.error("--suite takes no scenarios (pytest arguments go after --)")
