@@ -30,7 +30,9 @@ tests the listed pairs on the current boxes (and their sweeps over the step: eac
 within its margin too), sorts the few in contact, and takes them in that order: exactly the
 pairs, in exactly the order, of testing every pair. The same argument pair by pair lets a step
 skip the listed pairs that were farther apart than twice the drift so far: the list is kept in
-bands by that distance (stepped_list.within_reach). Pairs of two static
+bands by that distance (stepped_list.reach_bands), within buckets by the block of rows its pairs
+sit in, so that while the list holds a step tests each block's pairs right behind the block's
+move, from the cache (stepped_narrow.move_narrow). Pairs of two static
 objects are never listed, and with no movable object (or fewer than two objects) the pair stage is
 skipped; the `skip=False` option turns both skips off, and `broadphase` ("sweep", "grid",
 "cells") forces a method instead of the scene's choice (for tests and `collide2d bench`).
@@ -56,10 +58,12 @@ from collide2d.engine.broadphase import KEY_SHIFT, METHOD_SWEEP, choose, marker,
 from collide2d.engine.events import event_records, new_log
 from collide2d.engine.models.stepped_list import (
     BAND_SHIFT,
+    PARAMS_SIZE,
     ST_CHUNKS,
     ST_PAIRS,
     ST_WALLS,
-    STATE_SIZE,
+    blocks_for,
+    state_size,
 )
 from collide2d.engine.models.stepped_motion import BODY_COLUMNS
 from collide2d.engine.models.stepped_step import STAGES, run, step
@@ -190,7 +194,9 @@ class Model:
         separation). The state ends exactly as `advance(ticks, log=False)` would leave it. Each
         stage is timed from Python, so each count includes a call's overhead (microseconds),
         which dominates in small scenes. A scene that splits runs split (the clock does not
-        choose here)."""
+        choose here). The move and the narrow phase, which `advance` runs together block by block
+        while the list holds (stepped_narrow.move_narrow), run here one after the other, so that
+        each has a time of its own."""
         self._bp[6][ST_CHUNKS] = self._split.chunks
         fps = float(self.world.fps)
         width, height = float(self.world.width), float(self.world.height)
@@ -256,7 +262,7 @@ def _broad_phase(world, pos, vel, size, movable, substeps, skip, broadphase):
     margin = max(margin, MARGIN_MIN_PX) if np.isfinite(margin) else MARGIN_MIN_PX
     method, cell = choose(world.width, world.height, size + 2.0 * margin, broadphase)
     slack = DRIFT_SLACK_PX + DRIFT_SLACK_REL * max(world.width, world.height)
-    state = np.zeros(STATE_SIZE, np.int64)  # ST_*
+    state = np.zeros(state_size(blocks_for(n)), np.int64)  # ST_*
     state[: ST_CHUNKS + 1] = [-1, method, int(possible), 0, 0, 0, chunks_for(n)]
     order = np.arange(n, dtype=np.int64)
     if method == METHOD_SWEEP:
@@ -269,7 +275,7 @@ def _broad_phase(world, pos, vel, size, movable, substeps, skip, broadphase):
         np.empty_like(pos),  # hi
         np.empty((2 * n, 4), np.int64),  # folds
         state,
-        np.array([margin, cell, slack, 0.0]),  # P_*
+        np.array([margin, cell, slack] + [0.0] * (PARAMS_SIZE - 3)),  # P_*
         workspace(n),
         np.empty(max(16, n)),  # when
         marker(method),  # finder: the kernels compile only this method's pair finder

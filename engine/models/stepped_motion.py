@@ -40,7 +40,7 @@ def _fold_row(folds, n_folds, e, axis, low, high, first_low):
 
 
 @njit(cache=True)
-def _move_range(body, static, ext, anchor, first, last, dt, folds, n_folds):
+def move_range(body, static, ext, anchor, first, last, dt, folds, n_folds):
     """Move objects first ... last-1 (inside) for dt seconds and reflect each back into the
     world; their fold rows go to folds from row n_folds. Returns (rows now, the farthest any of
     them is from its anchor on an axis, px)."""
@@ -74,7 +74,7 @@ def move_walls(body, static, ext, anchor, dt, folds, chunks):
     anchor on an axis, px)."""
     if chunks > 1:
         return _move_chunks(body, static, ext, anchor, dt, folds, chunks)
-    return _move_range(body, static, ext, anchor, 0, body.shape[0], dt, folds, 0)
+    return move_range(body, static, ext, anchor, 0, body.shape[0], dt, folds, 0)
 
 
 @njit(cache=True, parallel=True)
@@ -83,24 +83,30 @@ def _move_chunks(body, static, ext, anchor, dt, folds, chunks):
     on two axes at most); then the runs' rows are moved together in run order."""
     n = body.shape[0]
     rows = np.zeros(chunks, np.int64)
+    firsts = np.zeros(chunks, np.int64)
     drifts = np.zeros(chunks)
     for c in prange(chunks):
         first = c * n // chunks
-        k, d = _move_range(
+        k, drifts[c] = move_range(
             body, static, ext, anchor, first, (c + 1) * n // chunks, dt, folds, 2 * first
         )
         rows[c] = k - 2 * first
-        drifts[c] = d
+        firsts[c] = first
+    return join_folds(folds, rows, firsts), drifts.max()
+
+
+@njit(cache=True)
+def join_folds(folds, rows, firsts):
+    """Move the fold rows of runs of objects together in run order (run c wrote rows[c] rows from
+    row 2 x firsts[c], its first object); returns how many rows."""
     n_folds = 0
-    drift = 0.0
-    for c in range(chunks):
-        first = 2 * (c * n // chunks)
+    for c in range(rows.shape[0]):
+        first = 2 * firsts[c]
         for r in range(rows[c]):
             for col in range(4):
                 folds[n_folds + r, col] = folds[first + r, col]
         n_folds += rows[c]
-        drift = max(drift, drifts[c])
-    return n_folds, drift
+    return n_folds
 
 
 @njit(cache=True)

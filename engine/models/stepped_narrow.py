@@ -9,9 +9,16 @@ order, so the result is the same whatever order the objects are kept in inside.
 
 A pair is in contact when its boxes overlap now with positive area, or overlapped during the step
 (swept back on straight lines, both objects clear of the walls this step: a corner passed through
-within it). Most listed pairs are far apart: a cheap reach test (contact.box_reach, without
-branches) drops them before any sweep. Large scenes cut the keys into contiguous
-runs, one per thread, each writing its own share of `near`, joined in run order before the sort.
+within it). Each bucket of the list (stepped_list) is tested only as far as its bands can touch
+by now. Most listed pairs are far apart: a cheap reach test (contact.box_reach, without
+branches) drops them before any sweep.
+
+`narrow` tests the list after the move; `move_narrow`, which a step runs while the list holds,
+runs the move itself block by block and tests each block's own pairs right behind it, while the
+block's rows are still in the cache (a large scene's rows are not once the whole move has passed:
+at 100,000 objects that pass is 6.4 MB), then the pairs between blocks. Large scenes cut the
+blocks into contiguous runs, one per thread, each writing its own share of `near`, joined in run
+order before the sort.
 """
 
 from __future__ import annotations
@@ -23,7 +30,26 @@ import numpy as np
 from collide2d.engine.broadphase import KEY_MASK, KEY_SHIFT, index
 from collide2d.engine.contact import axis_reach, box_sweep
 from collide2d.engine.jit import njit, prange
-from collide2d.engine.models.stepped_motion import B_H, B_SX, B_SY, B_VX, B_VY, B_W, B_X, B_Y
+from collide2d.engine.models.stepped_list import (
+    BANDS,
+    ST_BANDS,
+    block_count,
+    block_rows,
+    reach_bands,
+    start_reach,
+)
+from collide2d.engine.models.stepped_motion import (
+    B_H,
+    B_SX,
+    B_SY,
+    B_VX,
+    B_VY,
+    B_W,
+    B_X,
+    B_Y,
+    join_folds,
+    move_range,
+)
 from collide2d.engine.sort import sort_by_time
 from collide2d.engine.stepcontact import box_clip
 from collide2d.engine.threads import join_shares, shares_total
@@ -75,32 +101,47 @@ def _contact_range(body, ext, keys, first, last, near, when, base, room, dt):
 
 
 @njit(cache=True)
-def _overlapping(body, ext, keys, n_keys, near, when, dt):
-    """The listed pairs in contact during the step (`_contact_range` over the whole list), sorted
-    by the time in `when`, then by key, when they fit; returns how many (the caller grows `near`
-    and `when` and asks again)."""
+def _tested_range(body, ext, keys, state, bucket, bands, near, when, base, room, dt):
+    """`_contact_range` over the first `bands` bands of a bucket of the list (state[ST_BANDS +
+    bucket] on, see stepped_list)."""
+    at = ST_BANDS + bucket
+    return _contact_range(body, ext, keys, state[at], state[at + bands], near, when, base, room, dt)
+
+
+@njit(cache=True)
+def _blocks_range(body, ext, keys, state, first, last, bands, near, when, base, room, dt):
+    """`_tested_range` over both buckets (own pairs, then those reaching into earlier blocks) of
+    blocks first ... last-1."""
+    k = 0
+    for block in range(first, last):
+        for kind in range(2):
+            k += _tested_range(
+                body, ext, keys, state, (2 * block + kind) * BANDS, bands, near, when, base + k,
+                room - k, dt,
+            )
+    return k
+
+
+@njit(cache=True)
+def narrow(body, ext, keys, state, bands, near, when, dt, chunks):
+    """The narrow phase: the pairs in the first `bands` bands of every bucket of the list that
+    are in contact during the step, sorted by the time in `when`, then by key, when they fit;
+    returns how many (the caller grows `near` and `when` and asks again). Split among `chunks`
+    threads when more than one (`_narrow_split`)."""
+    if chunks > 1:
+        return _narrow_split(body, ext, keys, state, bands, near, when, dt, chunks)
     room = near.shape[0]
-    k = _contact_range(body, ext, keys, 0, n_keys, near, when, 0, room, dt)
+    k = _blocks_range(body, ext, keys, state, 0, block_count(state), bands, near, when, 0, room, dt)
     if k <= room:
         sort_by_time(when, near, k)
     return k
 
 
-@njit(cache=True, parallel=True)
-def _overlapping_split(body, ext, keys, n_keys, near, when, dt, chunks):
-    """`_overlapping` with the listed pairs cut into `chunks` contiguous runs, one per thread: run
-    c writes its pairs into its own share of `near` and `when`, then the shares are moved
-    together in run order and sorted by (time, key), a total order, so the result is the same as
-    `_overlapping`'s. When a share is too small the count returned is more than `near` holds, and
-    the caller grows it and asks again."""
-    room = near.shape[0]
-    share = room // chunks
-    found = np.zeros(chunks, np.int64)
-    for c in prange(chunks):
-        found[c] = _contact_range(
-            body, ext, keys, c * n_keys // chunks, (c + 1) * n_keys // chunks,
-            near, when, c * share, share, dt
-        )
+@njit(cache=True)
+def _join_sorted(found, share, room, near, when):
+    """The chunks' pairs in contact (chunk c's found[c] in its share of `share` slots) moved
+    together and sorted by (time, key), a total order, so the result is the one of one thread;
+    returns how many, or more than `room` when a share was too small."""
     total = shares_total(found, share, room)
     if total > room:
         return total
@@ -110,9 +151,115 @@ def _overlapping_split(body, ext, keys, n_keys, near, when, dt, chunks):
     return k
 
 
+@njit(cache=True, parallel=True)
+def _narrow_split(body, ext, keys, state, bands, near, when, dt, chunks):
+    """`narrow` with the blocks cut into `chunks` contiguous runs, one per thread: run c writes
+    its pairs into its own share of `near` and `when`, then the shares are joined
+    (`_join_sorted`)."""
+    room = near.shape[0]
+    share = room // chunks
+    blocks = block_count(state)
+    found = np.zeros(chunks, np.int64)
+    for c in prange(chunks):
+        found[c] = _blocks_range(
+            body, ext, keys, state, c * blocks // chunks, (c + 1) * blocks // chunks, bands,
+            near, when, c * share, share, dt,
+        )
+    return _join_sorted(found, share, room, near, when)
+
+
 @njit(cache=True)
-def narrow(body, ext, keys, n_keys, near, when, dt, chunks):
-    """The narrow phase: `_overlapping`, split among `chunks` threads when more than one."""
+def _move_blocks(body, static, ext, anchor, dt, folds, n_folds, keys, state, params, start,
+                 first, last, near, when, base, room):
+    """Move blocks first ... last-1 one by one (fold rows from row n_folds), each block's own
+    pairs tested right after its move, while its rows are in the cache: the bands that its own
+    drift and `start` (where any object began the step, stepped_list.start_reach) allow, since
+    both objects are in it. Returns (fold rows now, the blocks' drift, how many pairs in
+    contact, written from near[base] while within room)."""
+    n = body.shape[0]
+    rows = block_rows(n, block_count(state))
+    drift = 0.0
+    k = 0
+    for block in range(first, last):
+        n_folds, d = move_range(
+            body, static, ext, anchor, min(n, block * rows), min(n, (block + 1) * rows), dt,
+            folds, n_folds,
+        )
+        drift = max(drift, d)
+        k += _tested_range(
+            body, ext, keys, state, 2 * block * BANDS, reach_bands(max(d, start), params), near,
+            when, base + k, room - k, dt,
+        )
+    return n_folds, drift, k
+
+
+@njit(cache=True)
+def move_narrow(body, static, ext, anchor, dt, folds, keys, state, params, near, when, chunks):
+    """The move (stepped_motion) and the narrow phase (`narrow`) together, block by block: each
+    block moved, then its own pairs tested while its rows are in the cache; then the pairs that
+    reach into earlier blocks, with the drift of every object moved by then. The same pairs in
+    contact as `narrow` after `move_walls` (the bands each pair needs are tested either way).
+    Split among `chunks` threads when more than one (`_move_narrow_split`). Returns (fold rows
+    and drift, as move_walls; how many pairs in contact, as narrow). params as the last step
+    left them (stepped_list.start_reach). The list must hold for this step: the caller makes it
+    anew and tests again when the drift says it did not."""
     if chunks > 1:
-        return _overlapping_split(body, ext, keys, n_keys, near, when, dt, chunks)
-    return _overlapping(body, ext, keys, n_keys, near, when, dt)
+        return _move_narrow_split(
+            body, static, ext, anchor, dt, folds, keys, state, params, near, when, chunks
+        )
+    room = near.shape[0]
+    start = start_reach(params)
+    n_folds = 0
+    drift = 0.0
+    k = 0
+    for block in range(block_count(state)):
+        n_folds, d, found = _move_blocks(
+            body, static, ext, anchor, dt, folds, n_folds, keys, state, params, start, block,
+            block + 1, near, when, k, room - k,
+        )
+        k += found
+        drift = max(drift, d)
+        k += _tested_range(
+            body, ext, keys, state, (2 * block + 1) * BANDS, reach_bands(max(drift, start), params),
+            near, when, k, room - k, dt,
+        )
+    if k <= room:
+        sort_by_time(when, near, k)
+    return n_folds, drift, k
+
+
+@njit(cache=True, parallel=True)
+def _move_narrow_split(body, static, ext, anchor, dt, folds, keys, state, params, near, when,
+                       chunks):
+    """`move_narrow` with the blocks cut into `chunks` contiguous runs, one per thread: each run
+    moves its blocks and tests their own pairs; once every block has moved, the pairs that reach
+    into earlier blocks (perhaps another run's), with the reach of all. Fold rows and pairs in
+    contact are joined in run order (stepped_motion.join_folds, `_join_sorted`)."""
+    n = body.shape[0]
+    room = near.shape[0]
+    share = room // chunks
+    blocks = block_count(state)
+    rows = block_rows(n, blocks)
+    start = start_reach(params)
+    found = np.zeros(chunks, np.int64)
+    fold_rows = np.zeros(chunks, np.int64)
+    firsts = np.zeros(chunks, np.int64)
+    drifts = np.zeros(chunks)
+    for c in prange(chunks):
+        first = min(n, (c * blocks // chunks) * rows)
+        n_folds, drifts[c], found[c] = _move_blocks(
+            body, static, ext, anchor, dt, folds, 2 * first, keys, state, params, start,
+            c * blocks // chunks, (c + 1) * blocks // chunks, near, when, c * share, share,
+        )
+        fold_rows[c] = n_folds - 2 * first
+        firsts[c] = first
+    drift = drifts.max()
+    bands = reach_bands(max(drift, start), params)
+    for c in prange(chunks):
+        for block in range(c * blocks // chunks, (c + 1) * blocks // chunks):
+            found[c] += _tested_range(
+                body, ext, keys, state, (2 * block + 1) * BANDS, bands, near, when,
+                c * share + found[c], share - found[c], dt,
+            )
+    n_folds = join_folds(folds, fold_rows, firsts)
+    return n_folds, drift, _join_sorted(found, share, room, near, when)

@@ -17,7 +17,7 @@ from __future__ import annotations
 from collide2d.engine.broadphase import KEY_MASK, KEY_SHIFT
 from collide2d.engine.events import EV_PAIR, log_event
 from collide2d.engine.jit import njit
-from collide2d.engine.models.stepped_list import ST_PAIRS
+from collide2d.engine.models.stepped_list import P_PUSHED, ST_PAIRS
 from collide2d.engine.models.stepped_motion import B_H, B_VX, B_VY, B_W, B_X, B_Y
 from collide2d.engine.response import exchange, separate
 from collide2d.engine.stepcontact import box_step_contact, step_contact
@@ -58,15 +58,18 @@ def _contact(a, b, ea, eb, body, dt, exact, shape, radius, start, verts, normals
 
 @njit(cache=True)
 def respond(
-    S, dt, width, height, exact, cores, near, n_near, inside, tick, t, log, rows, times, n_ev, state
+    S, dt, width, height, exact, cores, near, n_near, inside, tick, t, log, rows, times, n_ev,
+    state, params,
 ):
     """Respond to every overlapping, approaching pair of `near` (ascending keys of ids) in order,
-    after a step of dt s; count each in state[ST_PAIRS], log it when `log`. inside (k, 3) int64
-    is scratch (the move's fold rows, free by now)."""
+    after a step of dt s; count each in state[ST_PAIRS], log it when `log`; params[P_PUSHED] the
+    farthest from its anchor on an axis that an object pushed apart ended (px, 0 when none was).
+    inside (k, 3) int64 is scratch (the move's fold rows, free by now)."""
     body, inv_mass, static, movable, ext, rank, anchor = S
     shape, radius, start, verts, normals = cores
     pos = body  # its columns 0, 1: the corners, as response.separate reads them
     size = body[:, B_W : B_H + 1]
+    pushed = 0.0
     # First each pair's rows inside and a read of each row, in a short loop whose iterations do
     # not wait on each other: the reads from memory that a large scene needs (the pairs come in
     # the order of time, scattered over the state) then overlap instead of following one another.
@@ -121,8 +124,11 @@ def respond(
         separate(
             pos, size, a, b, inv_mass[a], inv_mass[b], code, nx, ny, depth, depth_y, width, height
         )
+        for i in (a, b):
+            pushed = max(pushed, abs(body[i, B_X] - anchor[i, 0]), abs(body[i, B_Y] - anchor[i, 1]))
         state[ST_PAIRS] += 1
         if log:
             rows, times = log_event(rows, times, n_ev, tick, t, EV_PAIR, ea, eb, code)
             n_ev += 1
+    params[P_PUSHED] = pushed
     return rows, times, n_ev

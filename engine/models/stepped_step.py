@@ -7,6 +7,10 @@ the exact shapes' cores, the event log's buffers and the broad phase's state and
 below). Output: the state advanced in place, the events logged, and the buffers that grew, which
 replace the caller's.
 
+While the candidate list holds, a step runs its move and narrow stages together, block by block
+(stepped_narrow.move_narrow: the same pairs, tested while their rows are in the cache); a step
+that may make the list anew runs them apart, as `stepped.Model.profile` always does.
+
 `run` takes any number of ticks per call (the runner asks for thousands at once), so the cost of
 entering the kernel from Python is paid once per call, not once per step. `stepped.Model.profile`
 runs the same `step` one stage at a time to time each.
@@ -19,18 +23,22 @@ import numpy as np
 from collide2d.engine.jit import njit
 from collide2d.engine.models.stepped_list import (
     P_DRIFT,
+    P_GROWTH,
     P_MARGIN,
+    P_REACH,
     P_SLACK,
     ST_CHUNKS,
+    ST_FUSED,
     ST_KEYS,
     ST_NEAR,
     ST_POSSIBLE,
     ST_WALLS,
     relist,
+    start_reach,
     within_reach,
 )
 from collide2d.engine.models.stepped_motion import log_walls, move_walls
-from collide2d.engine.models.stepped_narrow import narrow
+from collide2d.engine.models.stepped_narrow import move_narrow, narrow
 from collide2d.engine.models.stepped_pairs import respond
 
 # The stages of one step, in the order `step` runs them; `Model.profile` times each by name
@@ -42,6 +50,20 @@ _MOVE, _BROAD, _NARROW, _RESPONSE = range(len(STAGES))
 # `len(STAGES)`, which it passes as a number known only when run).
 _FIRST, _LAST = 0, 4
 assert _LAST == len(STAGES)
+# A step runs its move and narrow stages together when the drift, grown by this many times what
+# it grew in the last step, stays short of the margin (a step that then finds the margin reached
+# after all makes the list anew and tests again: the time of one narrow phase lost).
+AHEAD_STEPS = 1.25
+
+
+@njit(cache=True)
+def _holds(state, params):
+    """Whether the candidate list will hold for the coming step: there is one, and its drift,
+    grown by AHEAD_STEPS x what it grew in the last step, stays short of the margin."""
+    if state[ST_KEYS] < 0:
+        return False
+    ahead = params[P_DRIFT] + AHEAD_STEPS * params[P_GROWTH]
+    return ahead < params[P_MARGIN] - params[P_SLACK]
 
 
 @njit(cache=True)
@@ -72,10 +94,21 @@ def _stages(first, last, S, dt, width, height, exact, cores, tick, t, log, rows,
     _, _, order, lo, hi, folds, state, params, ws, _, finder, scratch, _ = bp
     keys, spare, near, when = lists
     chunks = state[ST_CHUNKS]
+    # the move and the narrow phase block by block, while the list will hold for this step
+    fused = first == _MOVE and last == _LAST and state[ST_POSSIBLE] != 0 and _holds(state, params)
     if first <= _MOVE < last:
         # move, walls: every object; the walls' events in id order; how far anything drifted
-        # from where the candidate list was made
-        n_folds, params[P_DRIFT] = move_walls(body, static, ext, anchor, dt, folds, chunks)
+        # from where the candidate list was made, and how far its path reached
+        if fused:
+            n_folds, drift, state[ST_NEAR] = move_narrow(
+                body, static, ext, anchor, dt, folds, keys, state, params, near, when, chunks
+            )
+            state[ST_FUSED] += 1
+        else:
+            n_folds, drift = move_walls(body, static, ext, anchor, dt, folds, chunks)
+        params[P_REACH] = max(drift, start_reach(params))
+        params[P_GROWTH] = max(drift - params[P_DRIFT], 0.0)
+        params[P_DRIFT] = drift
         if n_folds:
             for r in range(n_folds):  # one wall event per fold
                 state[ST_WALLS] += folds[r, 1] + folds[r, 2]
@@ -83,24 +116,27 @@ def _stages(first, last, S, dt, width, height, exact, cores, tick, t, log, rows,
                 rows, times, n_ev = log_walls(folds, n_folds, tick, t, rows, times, n_ev)
     if state[ST_POSSIBLE] == 0:  # no pair can happen
         return rows, times, n_ev, lists
+    tested = fused
     if first <= _BROAD < last:
-        # the candidate list made anew once an object drifted its margin
+        # the candidate list made anew once an object drifted its margin (what the step tested
+        # on the old list then does not count)
         if state[ST_KEYS] < 0 or params[P_DRIFT] >= params[P_MARGIN] - params[P_SLACK]:
             keys, spare, state[ST_KEYS] = relist(
                 S, dt,
                 (keys, near, order, lo, hi, folds, state, params, ws, when, finder, scratch, spare),
             )  # fmt: skip
             lists = (keys, spare, near, when)
-    if first <= _NARROW < last:
+            tested = False
+    if first <= _NARROW < last and not (tested and state[ST_NEAR] <= near.shape[0]):
         # the listed pairs in contact this step, in the order their contacts began, from the
         # bands near enough to touch by now
-        n_keys = within_reach(state, params)
-        state[ST_NEAR] = narrow(body, ext, keys, n_keys, near, when, dt, chunks)
+        bands = within_reach(params)
+        state[ST_NEAR] = narrow(body, ext, keys, state, bands, near, when, dt, chunks)
         while state[ST_NEAR] > near.shape[0]:
             near = np.empty(2 * state[ST_NEAR], np.int64)
             when = np.empty(2 * state[ST_NEAR])
             lists = (keys, spare, near, when)
-            state[ST_NEAR] = narrow(body, ext, keys, n_keys, near, when, dt, chunks)
+            state[ST_NEAR] = narrow(body, ext, keys, state, bands, near, when, dt, chunks)
     if first <= _RESPONSE < last:
         rows, times, n_ev = respond(
             S,
@@ -119,6 +155,7 @@ def _stages(first, last, S, dt, width, height, exact, cores, tick, t, log, rows,
             times,
             n_ev,
             state,
+            params,
         )
     return rows, times, n_ev, lists
 
@@ -130,7 +167,7 @@ def run(world, substeps, tick0, ticks, log, S, exact, cores, rows, times, bp):
 
     S: the state arrays (a `stepped.State`). bp = (keys, near, order, lo, hi, folds, state,
     params, ws, when, finder, scratch, spare): the candidate list kept between calls (sorted by
-    band, stepped_list.within_reach) and scratch
+    bucket, stepped_list) and scratch
     (`near`, `when`: this step's pairs in contact and the times their contacts began; `order`,
     `lo`, `hi`, `ws`: the broad phase's; `folds`: the move's fold rows; `finder`: the marker of
     the method, broadphase.marker, so that a kernel compiles only that pair finder; `scratch`:

@@ -25,6 +25,7 @@ from collide2d.engine.models.stepped_list import (
     REORDER_ROWS,
     ST_BANDS,
     ST_KEYS,
+    keys_within,
     within_reach,
 )
 from collide2d.engine.models.stepped_narrow import narrow
@@ -437,8 +438,9 @@ def test_the_objects_inside_follow_the_broad_phases_order(broadphase):
         order = model._bp[2]
         assert np.abs(order - np.arange(n)).sum() <= REORDER_ROWS * np.sqrt(n) * n
         keys, state = model._bp[0], model._bp[6]
-        starts = state[ST_BANDS : ST_BANDS + BANDS + 1]
+        starts = state[ST_BANDS:]
         assert starts[0] == 0 and starts[-1] == state[ST_KEYS] > 500
+        assert (np.diff(starts) >= 0).all()
         pairs = keys[: state[ST_KEYS]]
         assert (pairs >> KEY_SHIFT < (pairs & ((1 << KEY_SHIFT) - 1))).all()
         ids.append(model._S.ext.copy())
@@ -462,13 +464,13 @@ def test_the_bands_skipped_hold_no_pair_in_contact():
             if first == 2:
                 keys, state, params = model._bp[0], model._bp[6], model._bp[7]
                 found = []
-                for n_keys in (state[ST_KEYS], within_reach(state, params)):
+                for bands in (BANDS, within_reach(params)):
                     near, when = np.empty(4000, np.int64), np.empty(4000)
-                    k = narrow(model._S.body, model._S.ext, keys, n_keys, near, when, dt, 1)
+                    k = narrow(model._S.body, model._S.ext, keys, state, bands, near, when, dt, 1)
                     found.append(near[:k].tolist())
                 assert found[0] == found[1]
                 contacts += len(found[0])
-                shares.append(within_reach(state, params) / state[ST_KEYS])
+                shares.append(keys_within(state, within_reach(params)) / state[ST_KEYS])
             rows, times, _, model._bp = step(
                 first, last, model._S, dt, 900.0, 700.0, False, model._cores, tick, tick * dt,
                 False, rows, times, 0, model._bp,
