@@ -278,18 +278,17 @@ def cell_candidates(lo, hi, movable, cell, order, out, ws):
         order[i] = i
     if n < 2:
         return 0
-    nx, ny = _cell_grid(lo, hi, cell, order, ws)  # the counting sort by cell
-    cxy, start, box = ws[5], ws[3], ws[4]
-    return _cell_pairs(0, n, order, cxy, start, box, movable, nx, ny, out, 0, out.shape[0])
+    grid = _cell_grid(lo, hi, cell, order, ws)  # the counting sort by cell
+    return _cell_pairs(0, n, order, ws[3], ws[4], movable, grid, out, 0, out.shape[0])
 
 
 @njit(cache=True)
 def _cell_grid(lo, hi, cell, order, ws):
-    """The counting sort of `cell_candidates`: (nx, ny) of its grid; order, ws[2] (each box's
-    cell), ws[3] (cell starts), ws[4] (boxes by slot) and ws[5] (each box's column and row, in
-    its first two columns, so that the pair tests need no division) filled."""
+    """The counting sort of `cell_candidates`: its grid (nx, ny, x0, y0, 1 / cell: a box's column
+    and row are `_cell_of` its lower corner); order, ws[2] (each box's cell), ws[3] (cell starts)
+    and ws[4] (boxes by slot) filled."""
     n = lo.shape[0]
-    key, start, box, cxy = ws[2], ws[3], ws[4], ws[5]
+    key, start, box = ws[2], ws[3], ws[4]
     x0, y0, x1, y1, side = _bounds(lo, hi)
     span_x = x1 - x0
     span_y = y1 - y0
@@ -307,8 +306,6 @@ def _cell_grid(lo, hi, cell, order, ws):
     for i in range(n):
         cx = _cell_of(lo[i, 0], x0, inv, nx - 1)
         cy = _cell_of(lo[i, 1], y0, inv, ny - 1)
-        cxy[i, 0] = cx
-        cxy[i, 1] = cy
         c = cy * nx + cx
         key[i] = c
         start[index(c + 1)] += 1
@@ -325,21 +322,23 @@ def _cell_grid(lo, hi, cell, order, ws):
         box[slot, 1] = lo[i, 1]
         box[slot, 2] = hi[i, 0]
         box[slot, 3] = hi[i, 1]
-    return nx, ny
+    return nx, ny, x0, y0, inv
 
 
 @njit(cache=True)
-def _cell_pairs(s0, s1, order, cxy, start, box, movable, nx, ny, out, base, room):
-    """The pairs of `cell_candidates` for the boxes in slots s0 ... s1-1 (cxy: each box's
-    column and row), written to out[base:base + room] while they fit; returns how many.
-    Its indices go through `index` (unsigned when compiled)."""
+def _cell_pairs(s0, s1, order, start, box, movable, grid, out, base, room):
+    """The pairs of `cell_candidates` for the boxes in slots s0 ... s1-1 (grid from `_cell_grid`:
+    each box's column and row computed again from its corner, as the sort did, which costs less
+    than reading them from memory), written to out[base:base + room] while they fit; returns how
+    many. Its indices go through `index` (unsigned when compiled)."""
+    nx, ny, x0, y0, inv = grid
     k = 0
     m = room
     for s in range(index(s0), index(s1)):
         a = order[s]
         ia = index(a)
-        cx = cxy[ia, 0]
-        cy = cxy[ia, 1]
+        cx = _cell_of(box[s, 0], x0, inv, nx - 1)
+        cy = _cell_of(box[s, 1], y0, inv, ny - 1)
         c = cy * nx + cx
         ma = movable[ia]
         lax, lay, hax, hay = box[s, 0], box[s, 1], box[s, 2], box[s, 3]
@@ -372,7 +371,7 @@ def _cell_pairs(s0, s1, order, cxy, start, box, movable, nx, ny, out, base, room
 
 
 @njit(cache=True, parallel=True)
-def _cell_pairs_split(order, cxy, start, box, movable, nx, ny, out, n, found):
+def _cell_pairs_split(order, start, box, movable, grid, out, n, found):
     """`_cell_pairs` over all n slots cut into len(found) contiguous runs, one per thread, each
     writing into its own share of `out`; the shares are then moved together in run order, so the
     keys come in the order one thread gives. When a share is too small the count returned is
@@ -382,8 +381,8 @@ def _cell_pairs_split(order, cxy, start, box, movable, nx, ny, out, n, found):
     share = room // chunks
     for c in prange(chunks):
         found[c] = _cell_pairs(
-            c * n // chunks, (c + 1) * n // chunks, order, cxy, start, box, movable, nx, ny,
-            out, c * share, share,
+            c * n // chunks, (c + 1) * n // chunks, order, start, box, movable, grid, out,
+            c * share, share,
         )
     total = shares_total(found, share, room)
     if total > room:
@@ -401,8 +400,8 @@ def cell_candidates_split_into(lo, hi, movable, cell, order, out, ws, found):
         order[i] = i
     if n < 2:
         return 0
-    nx, ny = _cell_grid(lo, hi, cell, order, ws)
-    return _cell_pairs_split(order, ws[5], ws[3], ws[4], movable, nx, ny, out, n, found)
+    grid = _cell_grid(lo, hi, cell, order, ws)
+    return _cell_pairs_split(order, ws[3], ws[4], movable, grid, out, n, found)
 
 
 def choose(
