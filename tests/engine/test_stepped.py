@@ -19,11 +19,13 @@ from collide2d.engine.events import (
 )
 from collide2d.engine.invariants import kinetic_energy, momentum
 from collide2d.engine.models import make
+from collide2d.engine.models import stepped as stepped_model
 from collide2d.engine.models.stepped import STAGES
 from collide2d.engine.models.stepped_list import (
     BANDS,
     REORDER_ROWS,
     ST_BANDS,
+    ST_FUSED,
     ST_KEYS,
     keys_within,
     within_reach,
@@ -517,6 +519,28 @@ def test_no_pairs_between_static_objects_and_none_without_movers():
     assert len(make("stepped", world, frozen).advance(10)) == 0
 
 
+@pytest.mark.parametrize("blocks, chunks", [(1, 1), (5, 1), (5, 3), (60, 2)])
+def test_blocks_of_rows_change_nothing(monkeypatch, blocks, chunks):
+    # the objects inside in blocks of rows, each block's own pairs tested right behind its move
+    # and the pairs between blocks after (with one object per block, every pair is between
+    # blocks), on one thread and split: the events, positions and velocities of testing every
+    # pair, and most steps ran the move and the narrow phase together
+    monkeypatch.setattr(stepped_model, "blocks_for", lambda n: blocks)
+    monkeypatch.setattr(stepped_model, "chunks_for", lambda n: chunks)
+    world = WorldSpec(150, 110, 60)
+    bodies = crowd(60, 3, world, statics=0.05)
+    ref_log, ref_pos, ref_vel = reference(world, bodies, 60)
+    model = make("stepped", world, bodies)
+    events = np.concatenate([model.advance(1), model.advance(59)])
+    assert sum(1 for e in ref_log if e[1] == EV_PAIR) > 10
+    assert logged(events) == ref_log
+    assert model.positions().tobytes() == ref_pos.tobytes()
+    assert model.velocities().tobytes() == ref_vel.tobytes()
+    state = model._bp[6]
+    assert len(state) == ST_BANDS + 2 * blocks * BANDS + 1
+    assert state[ST_FUSED] > 30
+
+
 def test_profile_runs_the_same_ticks_as_advance():
     world = WorldSpec(300, 200, 20)
     bodies = crowd(200, 2, world)
@@ -529,6 +553,8 @@ def test_profile_runs_the_same_ticks_as_advance():
     assert a.positions().tobytes() == b.positions().tobytes()
     assert a.velocities().tobytes() == b.velocities().tobytes()
     assert a.event_counts() == b.event_counts() and min(a.event_counts()) > 0
+    # advance ran move and narrow together on most steps, profile always apart
+    assert a._bp[6][ST_FUSED] > 20 and b._bp[6][ST_FUSED] == 0
     assert a.advance(20).tobytes() == b.advance(20).tobytes()
 
 
