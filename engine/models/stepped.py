@@ -43,8 +43,8 @@ Events go to the one event log of events.py. The step's stages are one kernel,
 are kept in), `stepped_narrow` (the listed pairs in contact, in order) and `stepped_pairs` (the
 exchange and the push). `stepped_step.run` runs all of them every step of many ticks in one call,
 `Model.profile` the same kernel one stage at a time to time each. The state is a `State`: one row
-of 8 floats per object (position, velocity, size, room on each axis), so that a stage reads
-everything it needs of an object from one place in memory.
+of 6 floats per object (position, velocity, size), so that a stage reads everything it needs of
+an object from one place in memory.
 """
 
 from __future__ import annotations
@@ -93,8 +93,8 @@ class State(NamedTuple):
     """The stepped model's state arrays, every row in the broad phase's order (numba takes a
     named tuple as it takes a tuple; the kernels unpack it by position)."""
 
-    body: np.ndarray  # (n, 8) float64 per object x, y (top-left corner, px), vx, vy (px/s),
-    # w, h (px), and the world's side less the box's on x and y (px): stepped_motion.B_*
+    body: np.ndarray  # (n, 6) float64 per object x, y (top-left corner, px), vx, vy (px/s),
+    # w, h (px): stepped_motion.B_*
     inv_mass: np.ndarray  # (n,) float64, 0 for static objects
     static: np.ndarray  # (n,) bool
     movable: np.ndarray  # (n,) bool: what the broad phase pairs
@@ -133,13 +133,11 @@ class Model:
         vel = np.ascontiguousarray(bodies.vel, np.float64).copy()
         vel[static] = 0.0
         size = np.ascontiguousarray(bodies.size, np.float64).copy()
-        span = np.array([world.width, world.height], np.float64) - size
         movable = ~static if skip else np.ones(n, bool)
         body = np.empty((n, BODY_COLUMNS))
         body[:, 0:2] = pos
         body[:, 2:4] = vel
         body[:, 4:6] = size
-        body[:, 6:8] = span
         self._S = State(
             body,
             np.array(bodies.inv_mass, np.float64),

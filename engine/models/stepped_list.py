@@ -55,10 +55,10 @@ ST_KEYS, ST_METHOD, ST_POSSIBLE, ST_WALLS, ST_PAIRS, ST_NEAR, ST_CHUNKS, ST_FUSE
 # made, nearest first: a band whose pairs were farther apart than any two objects have drifted
 # since cannot touch yet, and the narrow phase skips it.
 BANDS = 16
-# The objects inside come in blocks of about this many rows (8 floats each: 512 KiB, half of the
-# second-level cache of a core here), so that a block moved is still in the cache when its pairs
-# are tested. Scenes large enough to split among threads have a multiple of SPLIT_BLOCKS blocks,
-# so that 2 or 4 threads get even shares.
+# The objects inside come in blocks of about this many rows (6 floats each: 384 KiB, under half
+# of the second-level cache of a core here), so that a block moved is still in the cache when its
+# pairs are tested. Scenes large enough to split among threads have a multiple of SPLIT_BLOCKS
+# blocks, so that 2 or 4 threads get even shares.
 BLOCK_ROWS = 8192
 SPLIT_BLOCKS = 4
 # A pair's distance is taken this much (px) short when its band is chosen: room for rounding.

@@ -1,7 +1,7 @@
 """The stepped model's first stage: every object moves for one step and folds back at the walls.
 
-Input: the model's state (`stepped.State`: one row of `body` per object, x, y, vx, vy, w, h and
-the room it has on each axis, in the broad phase's order) and the step dt. Output: the state moved
+Input: the model's state (`stepped.State`: one row of `body` per object, x, y, vx, vy, w, h, in
+the broad phase's order), the step dt and the world's sides. Output: the state moved
 in place, the wall folds as rows (object id and axis, folds at the low and the high wall, which
 came first) logged in id order, and how far any object now is from where the candidate list was
 made (its anchor), which tells the candidate list when to be made anew.
@@ -21,10 +21,11 @@ from collide2d.engine.jit import njit, prange
 from collide2d.engine.response import fold
 from collide2d.engine.sort import heap_argsort
 
-# The columns of a row of the state's `body` (n, 8) float64: the top-left corner (px), the
-# velocity (px/s), the box's size (px) and its span, the world's side less the box's (px).
-B_X, B_Y, B_VX, B_VY, B_W, B_H, B_SX, B_SY = range(8)
-BODY_COLUMNS = 8
+# The columns of a row of the state's `body` (n, 6) float64: the top-left corner (px), the
+# velocity (px/s) and the box's size (px). The room it has on each axis, the world's side less
+# the box's, is worked out where it is needed: a step costs less arithmetic than memory.
+B_X, B_Y, B_VX, B_VY, B_W, B_H = range(6)
+BODY_COLUMNS = 6
 
 
 @njit(cache=True, inline="always")
@@ -40,22 +41,22 @@ def _fold_row(folds, n_folds, e, axis, low, high, first_low):
 
 
 @njit(cache=True)
-def move_range(body, static, ext, anchor, first, last, dt, folds, n_folds):
+def move_range(body, static, ext, anchor, first, last, dt, sides, folds, n_folds):
     """Move objects first ... last-1 (inside) for dt seconds and reflect each back into the
-    world; their fold rows go to folds from row n_folds. Returns (rows now, the farthest any of
-    them is from its anchor on an axis, px)."""
+    world of `sides` (width, height) px; their fold rows go to folds from row n_folds. Returns
+    (rows now, the farthest any of them is from its anchor on an axis, px)."""
     drift = 0.0
     for i in range(index(first), index(last)):  # unsigned indices: broadphase.index
         if static[i]:
             continue
         x = body[i, B_X] + body[i, B_VX] * dt
         y = body[i, B_Y] + body[i, B_VY] * dt
-        sx = body[i, B_SX]
+        sx = sides[0] - body[i, B_W]
         if not (sx > 0.0 and 0.0 <= x and x <= sx):  # inside, fold would change nothing
             x, vx, low, high, first_low = fold(x, body[i, B_VX], sx)
             body[i, B_VX] = vx
             n_folds = _fold_row(folds, n_folds, ext[i], 0, low, high, first_low)
-        sy = body[i, B_SY]
+        sy = sides[1] - body[i, B_H]
         if not (sy > 0.0 and 0.0 <= y and y <= sy):
             y, vy, low, high, first_low = fold(y, body[i, B_VY], sy)
             body[i, B_VY] = vy
@@ -67,18 +68,18 @@ def move_range(body, static, ext, anchor, first, last, dt, folds, n_folds):
 
 
 @njit(cache=True)
-def move_walls(body, static, ext, anchor, dt, folds, chunks):
+def move_walls(body, static, ext, anchor, dt, sides, folds, chunks):
     """Move every object for dt seconds, then reflect it back into the world, split among
     `chunks` threads when more than one (`_move_chunks`). folds (2n, 4) int64 receives a row per
     object and axis that folded. Returns (how many rows, the farthest any object now is from its
     anchor on an axis, px)."""
     if chunks > 1:
-        return _move_chunks(body, static, ext, anchor, dt, folds, chunks)
-    return move_range(body, static, ext, anchor, 0, body.shape[0], dt, folds, 0)
+        return _move_chunks(body, static, ext, anchor, dt, sides, folds, chunks)
+    return move_range(body, static, ext, anchor, 0, body.shape[0], dt, sides, folds, 0)
 
 
 @njit(cache=True, parallel=True)
-def _move_chunks(body, static, ext, anchor, dt, folds, chunks):
+def _move_chunks(body, static, ext, anchor, dt, sides, folds, chunks):
     """Run c of `chunks` writes its fold rows from row 2 x its first object (each object folds
     on two axes at most); then the runs' rows are moved together in run order."""
     n = body.shape[0]
@@ -88,7 +89,7 @@ def _move_chunks(body, static, ext, anchor, dt, folds, chunks):
     for c in prange(chunks):
         first = c * n // chunks
         k, drifts[c] = move_range(
-            body, static, ext, anchor, first, (c + 1) * n // chunks, dt, folds, 2 * first
+            body, static, ext, anchor, first, (c + 1) * n // chunks, dt, sides, folds, 2 * first
         )
         rows[c] = k - 2 * first
         firsts[c] = first

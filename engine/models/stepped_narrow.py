@@ -40,8 +40,6 @@ from collide2d.engine.models.stepped_list import (
 )
 from collide2d.engine.models.stepped_motion import (
     B_H,
-    B_SX,
-    B_SY,
     B_VX,
     B_VY,
     B_W,
@@ -56,19 +54,22 @@ from collide2d.engine.threads import join_shares, shares_total
 
 
 @njit(cache=True, inline="always")
-def _swept_back(body, i, dt):
+def _swept_back(body, i, dt, sides):
     """Whether object i, moved back dt seconds on a straight line, is where it started the step:
-    inside the world (an object that folded at a wall this step is not, SPEC 3.2)."""
+    inside the world of `sides` (width, height) px (an object that folded at a wall this step is
+    not, SPEC 3.2)."""
     x = body[i, B_X] - body[i, B_VX] * dt
     y = body[i, B_Y] - body[i, B_VY] * dt
-    return 0.0 <= x <= max(body[i, B_SX], 0.0) and 0.0 <= y <= max(body[i, B_SY], 0.0)
+    span_x = max(sides[0] - body[i, B_W], 0.0)
+    span_y = max(sides[1] - body[i, B_H], 0.0)
+    return 0.0 <= x <= span_x and 0.0 <= y <= span_y
 
 
 @njit(cache=True)
-def _contact_range(body, ext, keys, first, last, near, when, base, room, dt):
-    """The listed pairs keys[first:last] in contact during the step of dt s just taken, written
-    to near[base:base + room] with the time each contact began in `when` while they fit;
-    returns how many."""
+def _contact_range(body, ext, keys, first, last, near, when, base, room, dt, sides):
+    """The listed pairs keys[first:last] in contact during the step of dt s just taken in a world
+    of `sides` (width, height) px, written to near[base:base + room] with the time each contact
+    began in `when` while they fit; returns how many."""
     k = 0
     for c in range(index(first), index(last)):  # unsigned indices: broadphase.index
         a = index(keys[c] >> KEY_SHIFT)
@@ -87,8 +88,8 @@ def _contact_range(body, ext, keys, first, last, near, when, base, room, dt):
         t_enter, _, _, _, _ = box_sweep(qx - ux * dt, qy - uy * dt, ux, uy, wa, ha, wb, hb)
         if not now and not (
             box_clip(qx, qy, ux, uy, wa, ha, wb, hb, dt)
-            and _swept_back(body, a, dt)
-            and _swept_back(body, b, dt)
+            and _swept_back(body, a, dt, sides)
+            and _swept_back(body, b, dt, sides)
         ):
             continue
         if k < room:
@@ -101,15 +102,17 @@ def _contact_range(body, ext, keys, first, last, near, when, base, room, dt):
 
 
 @njit(cache=True)
-def _tested_range(body, ext, keys, state, bucket, bands, near, when, base, room, dt):
+def _tested_range(body, ext, keys, state, bucket, bands, near, when, base, room, dt, sides):
     """`_contact_range` over the first `bands` bands of a bucket of the list (state[ST_BANDS +
     bucket] on, see stepped_list)."""
     at = ST_BANDS + bucket
-    return _contact_range(body, ext, keys, state[at], state[at + bands], near, when, base, room, dt)
+    return _contact_range(
+        body, ext, keys, state[at], state[at + bands], near, when, base, room, dt, sides
+    )
 
 
 @njit(cache=True)
-def _blocks_range(body, ext, keys, state, first, last, bands, near, when, base, room, dt):
+def _blocks_range(body, ext, keys, state, first, last, bands, near, when, base, room, dt, sides):
     """`_tested_range` over both buckets (own pairs, then those reaching into earlier blocks) of
     blocks first ... last-1."""
     k = 0
@@ -117,21 +120,23 @@ def _blocks_range(body, ext, keys, state, first, last, bands, near, when, base, 
         for kind in range(2):
             k += _tested_range(
                 body, ext, keys, state, (2 * block + kind) * BANDS, bands, near, when, base + k,
-                room - k, dt,
+                room - k, dt, sides,
             )
     return k
 
 
 @njit(cache=True)
-def narrow(body, ext, keys, state, bands, near, when, dt, chunks):
+def narrow(body, ext, keys, state, bands, near, when, dt, sides, chunks):
     """The narrow phase: the pairs in the first `bands` bands of every bucket of the list that
     are in contact during the step, sorted by the time in `when`, then by key, when they fit;
     returns how many (the caller grows `near` and `when` and asks again). Split among `chunks`
     threads when more than one (`_narrow_split`)."""
     if chunks > 1:
-        return _narrow_split(body, ext, keys, state, bands, near, when, dt, chunks)
+        return _narrow_split(body, ext, keys, state, bands, near, when, dt, sides, chunks)
     room = near.shape[0]
-    k = _blocks_range(body, ext, keys, state, 0, block_count(state), bands, near, when, 0, room, dt)
+    k = _blocks_range(
+        body, ext, keys, state, 0, block_count(state), bands, near, when, 0, room, dt, sides
+    )
     if k <= room:
         sort_by_time(when, near, k)
     return k
@@ -152,7 +157,7 @@ def _join_sorted(found, share, room, near, when):
 
 
 @njit(cache=True, parallel=True)
-def _narrow_split(body, ext, keys, state, bands, near, when, dt, chunks):
+def _narrow_split(body, ext, keys, state, bands, near, when, dt, sides, chunks):
     """`narrow` with the blocks cut into `chunks` contiguous runs, one per thread: run c writes
     its pairs into its own share of `near` and `when`, then the shares are joined
     (`_join_sorted`)."""
@@ -163,13 +168,13 @@ def _narrow_split(body, ext, keys, state, bands, near, when, dt, chunks):
     for c in prange(chunks):
         found[c] = _blocks_range(
             body, ext, keys, state, c * blocks // chunks, (c + 1) * blocks // chunks, bands,
-            near, when, c * share, share, dt,
+            near, when, c * share, share, dt, sides,
         )
     return _join_sorted(found, share, room, near, when)
 
 
 @njit(cache=True)
-def _move_blocks(body, static, ext, anchor, dt, folds, n_folds, keys, state, params, start,
+def _move_blocks(body, static, ext, anchor, dt, sides, folds, n_folds, keys, state, params, start,
                  first, last, near, when, base, room):
     """Move blocks first ... last-1 one by one (fold rows from row n_folds), each block's own
     pairs tested right after its move, while its rows are in the cache: the bands that its own
@@ -183,18 +188,20 @@ def _move_blocks(body, static, ext, anchor, dt, folds, n_folds, keys, state, par
     for block in range(first, last):
         n_folds, d = move_range(
             body, static, ext, anchor, min(n, block * rows), min(n, (block + 1) * rows), dt,
-            folds, n_folds,
+            sides, folds, n_folds,
         )
         drift = max(drift, d)
         k += _tested_range(
             body, ext, keys, state, 2 * block * BANDS, reach_bands(max(d, start), params), near,
-            when, base + k, room - k, dt,
+            when, base + k, room - k, dt, sides,
         )
     return n_folds, drift, k
 
 
 @njit(cache=True)
-def move_narrow(body, static, ext, anchor, dt, folds, keys, state, params, near, when, chunks):
+def move_narrow(
+    body, static, ext, anchor, dt, sides, folds, keys, state, params, near, when, chunks
+):
     """The move (stepped_motion) and the narrow phase (`narrow`) together, block by block: each
     block moved, then its own pairs tested while its rows are in the cache; then the pairs that
     reach into earlier blocks, with the drift of every object moved by then. The same pairs in
@@ -205,7 +212,7 @@ def move_narrow(body, static, ext, anchor, dt, folds, keys, state, params, near,
     anew and tests again when the drift says it did not."""
     if chunks > 1:
         return _move_narrow_split(
-            body, static, ext, anchor, dt, folds, keys, state, params, near, when, chunks
+            body, static, ext, anchor, dt, sides, folds, keys, state, params, near, when, chunks
         )
     room = near.shape[0]
     start = start_reach(params)
@@ -214,14 +221,14 @@ def move_narrow(body, static, ext, anchor, dt, folds, keys, state, params, near,
     k = 0
     for block in range(block_count(state)):
         n_folds, d, found = _move_blocks(
-            body, static, ext, anchor, dt, folds, n_folds, keys, state, params, start, block,
-            block + 1, near, when, k, room - k,
+            body, static, ext, anchor, dt, sides, folds, n_folds, keys, state, params, start,
+            block, block + 1, near, when, k, room - k,
         )
         k += found
         drift = max(drift, d)
         k += _tested_range(
             body, ext, keys, state, (2 * block + 1) * BANDS, reach_bands(max(drift, start), params),
-            near, when, k, room - k, dt,
+            near, when, k, room - k, dt, sides,
         )
     if k <= room:
         sort_by_time(when, near, k)
@@ -229,8 +236,8 @@ def move_narrow(body, static, ext, anchor, dt, folds, keys, state, params, near,
 
 
 @njit(cache=True, parallel=True)
-def _move_narrow_split(body, static, ext, anchor, dt, folds, keys, state, params, near, when,
-                       chunks):
+def _move_narrow_split(body, static, ext, anchor, dt, sides, folds, keys, state, params, near,
+                       when, chunks):
     """`move_narrow` with the blocks cut into `chunks` contiguous runs, one per thread: each run
     moves its blocks and tests their own pairs; once every block has moved, the pairs that reach
     into earlier blocks (perhaps another run's), with the reach of all. Fold rows and pairs in
@@ -248,7 +255,7 @@ def _move_narrow_split(body, static, ext, anchor, dt, folds, keys, state, params
     for c in prange(chunks):
         first = min(n, (c * blocks // chunks) * rows)
         n_folds, drifts[c], found[c] = _move_blocks(
-            body, static, ext, anchor, dt, folds, 2 * first, keys, state, params, start,
+            body, static, ext, anchor, dt, sides, folds, 2 * first, keys, state, params, start,
             c * blocks // chunks, (c + 1) * blocks // chunks, near, when, c * share, share,
         )
         fold_rows[c] = n_folds - 2 * first
@@ -259,7 +266,7 @@ def _move_narrow_split(body, static, ext, anchor, dt, folds, keys, state, params
         for block in range(c * blocks // chunks, (c + 1) * blocks // chunks):
             found[c] += _tested_range(
                 body, ext, keys, state, (2 * block + 1) * BANDS, bands, near, when,
-                c * share + found[c], share - found[c], dt,
+                c * share + found[c], share - found[c], dt, sides,
             )
     n_folds = join_folds(folds, fold_rows, firsts)
     return n_folds, drift, _join_sorted(found, share, room, near, when)

@@ -94,6 +94,7 @@ def _stages(first, last, S, dt, width, height, exact, cores, tick, t, log, rows,
     _, _, order, lo, hi, folds, state, params, ws, _, finder, scratch, _ = bp
     keys, spare, near, when = lists
     chunks = state[ST_CHUNKS]
+    sides = (width, height)
     # the move and the narrow phase block by block, while the list will hold for this step
     fused = first == _MOVE and last == _LAST and state[ST_POSSIBLE] != 0 and _holds(state, params)
     if first <= _MOVE < last:
@@ -101,11 +102,12 @@ def _stages(first, last, S, dt, width, height, exact, cores, tick, t, log, rows,
         # from where the candidate list was made, and how far its path reached
         if fused:
             n_folds, drift, state[ST_NEAR] = move_narrow(
-                body, static, ext, anchor, dt, folds, keys, state, params, near, when, chunks
+                body, static, ext, anchor, dt, sides, folds, keys, state, params, near, when,
+                chunks,
             )
             state[ST_FUSED] += 1
         else:
-            n_folds, drift = move_walls(body, static, ext, anchor, dt, folds, chunks)
+            n_folds, drift = move_walls(body, static, ext, anchor, dt, sides, folds, chunks)
         params[P_REACH] = max(drift, start_reach(params))
         params[P_GROWTH] = max(drift - params[P_DRIFT], 0.0)
         params[P_DRIFT] = drift
@@ -131,12 +133,12 @@ def _stages(first, last, S, dt, width, height, exact, cores, tick, t, log, rows,
         # the listed pairs in contact this step, in the order their contacts began, from the
         # bands near enough to touch by now
         bands = within_reach(params)
-        state[ST_NEAR] = narrow(body, ext, keys, state, bands, near, when, dt, chunks)
+        state[ST_NEAR] = narrow(body, ext, keys, state, bands, near, when, dt, sides, chunks)
         while state[ST_NEAR] > near.shape[0]:
             near = np.empty(2 * state[ST_NEAR], np.int64)
             when = np.empty(2 * state[ST_NEAR])
             lists = (keys, spare, near, when)
-            state[ST_NEAR] = narrow(body, ext, keys, state, bands, near, when, dt, chunks)
+            state[ST_NEAR] = narrow(body, ext, keys, state, bands, near, when, dt, sides, chunks)
     if first <= _RESPONSE < last:
         rows, times, n_ev = respond(
             S,

@@ -468,7 +468,10 @@ def test_the_bands_skipped_hold_no_pair_in_contact():
                 found = []
                 for bands in (BANDS, within_reach(params)):
                     near, when = np.empty(4000, np.int64), np.empty(4000)
-                    k = narrow(model._S.body, model._S.ext, keys, state, bands, near, when, dt, 1)
+                    k = narrow(
+                        model._S.body, model._S.ext, keys, state, bands, near, when, dt,
+                        (900.0, 700.0), 1,
+                    )
                     found.append(near[:k].tolist())
                 assert found[0] == found[1]
                 contacts += len(found[0])
