@@ -16,7 +16,7 @@ branches) drops them before any sweep.
 `narrow` tests the list after the move; `move_narrow`, which a step runs while the list holds,
 runs the move itself block by block and tests each block's own pairs right behind it, while the
 block's rows are still in the cache (a large scene's rows are not once the whole move has passed:
-at 100,000 objects that pass is 6.4 MB), then the pairs between blocks. Large scenes cut the
+at 100,000 objects that pass is 4.8 MB), then the pairs between blocks. Large scenes cut the
 blocks into contiguous runs, one per thread, each writing its own share of `near`, joined in run
 order before the sort.
 """
