@@ -23,8 +23,9 @@ The parts, each selectable with `--part`:
   model against itself with velocities nudged by 1e-9 px/s) and a scan of glancing contacts of two
   boxes at one substep (the largest speed that tunnels).
 - peers: with `--peers` and pymunk installed (the optional `bench` extra), pymunk steps the same
-  standard scene in the same run (`pymunk_steps_per_second`), and the stepped model's ratio to it
-  is printed.
+  standard scene in the same run, timed in turn with the stepped model's scaling runs (one pymunk
+  run in each of their rounds, `peers.PymunkTimer`), and the stepped model's ratio to it is
+  printed.
 - skips: for each thing a run skips when a scene does not need it, the same work with and
   without the skip, and the saving (time without / time with), with its range.
 - targets: the paper's section IV demo headless (ticks/s through the model's `advance`) and the

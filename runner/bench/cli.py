@@ -63,21 +63,21 @@ def cmd_bench(args: argparse.Namespace) -> int:
     echo = timing.Echo(args.quiet)
     began = time.perf_counter()
     rows: list[dict] = []
+    # pymunk is timed in turn with the stepped model's runs, when both are asked for (peers.py)
+    peer = peers.timer(quick) if "peers" in parts and peers.pymunk_available() else None
     if "scaling" in parts:
-        rows += scaling.scaling(models_, ns, quick, in_process, echo)
+        rows += scaling.scaling(models_, ns, quick, in_process, echo, peer)
     if "peers" in parts:
-        if peers.pymunk_available():
-            ours = {
-                r["n"]: r["steps_per_s"]
-                for r in rows
-                if r["part"] == "scaling" and r["model"] == "stepped"
-            }
-            missing = [n for n in ns if n not in ours]
+        if peer is not None:
+            stepped = [r for r in rows if r["part"] == "scaling" and r["model"] == "stepped"]
+            missing = [n for n in ns if n not in {r["n"] for r in stepped}]
             if missing:
-                extra = scaling.scaling(["stepped"], missing, quick, in_process, echo)
-                ours.update({r["n"]: r["steps_per_s"] for r in extra})
+                extra = scaling.scaling(["stepped"], missing, quick, in_process, echo, peer)
+                stepped += extra
                 rows += extra
-            rows += peers.peers(ns, ours, quick, echo)
+            ours = {r["n"]: r["steps_per_s"] for r in stepped}
+            timed = {r["n"]: (r["peer_steps_per_s"], r["peer_how"]) for r in stepped}
+            rows += peers.peers(ns, ours, quick, echo, timed)
         else:
             print(
                 "collide2d bench: pymunk is not installed (pip install 'collide2d[bench]'); "

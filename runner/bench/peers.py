@@ -1,8 +1,13 @@
 """The peers part of `collide2d bench`: pymunk steps the same standard scene (the `bench` extra).
 
 pymunk's space steps at 1/STANDARD_FPS s with boxes of mass 1 and infinite moment, elasticity 1,
-friction 0 and four static walls; the better of its bounding-box tree and its spatial hash is kept,
-and the stepped model's steps/s from the scaling part is divided by pymunk's.
+friction 0 and four static walls; the faster of its bounding-box tree and its spatial hash is
+kept (`PymunkTimer`), and the stepped model's steps/s from the scaling part is divided by
+pymunk's. When the scaling part times the stepped model in the same run, it times pymunk in turn
+with it (`scaling`'s `peer`): each round one pymunk run between the stepped model's two, so that a
+machine whose speed drifts over minutes (a shared virtual machine's does, by a quarter) slows
+both sides of the ratio alike. Timed apart, minutes after the stepped model, the ratio took that
+drift in.
 """
 
 from __future__ import annotations
@@ -60,47 +65,75 @@ def _pymunk_space(scenario, hashed: bool):
     return space
 
 
+class PymunkTimer:
+    """pymunk on the standard scene with n boxes, its broad phase chosen: both its default tree
+    and its spatial hash step a probe of about PROBE_S s (or `target`, when shorter) after a
+    warm-up, and the faster is kept (`how` names it). Each `sample()` then times one run of
+    about `target` s of it and returns steps/s."""
+
+    def __init__(self, n: int, target: float):
+        from collide2d.runner.scenario import loads
+
+        scenario = loads(standard_scene(n, "stepped"))
+        self.dt = 1.0 / STANDARD_FPS
+        best = 0.0
+        for hashed in (False, True):
+            space = _pymunk_space(scenario, hashed)
+            for _ in range(PYMUNK_WARMUP_STEPS):
+                space.step(self.dt)
+            began = time.perf_counter()
+            steps = 0
+            while time.perf_counter() - began < min(target, PROBE_S) or steps < 2:
+                space.step(self.dt)
+                steps += 1
+            rate = steps / (time.perf_counter() - began)
+            if rate > best:
+                best = rate
+                self.space = space
+                self.how = "spatial hash" if hashed else "bounding-box tree"
+        self.ticks = max(2, int(target * best))
+
+    def sample(self) -> float:
+        """Steps/s of one timed run."""
+        began = time.perf_counter()
+        for _ in range(self.ticks):
+            self.space.step(self.dt)
+        return self.ticks / (time.perf_counter() - began)
+
+
+def timer(quick: bool):
+    """The peer timers the scaling part interleaves with the stepped model's runs: n -> a
+    `PymunkTimer` of this run's length (`peers`' own)."""
+    target = QUICK_TARGET_S if quick else TARGET_S / 2
+    return lambda n: PymunkTimer(n, target)
+
+
 def pymunk_steps_per_second(n: int, target: float, repeats: int) -> tuple[float, str]:
     """pymunk's steps/s on the standard scene with n boxes, the median of `repeats` timed runs of
-    about `target` s after a warm-up; the better of its default tree and its spatial hash."""
-    from collide2d.runner.scenario import loads
-
-    scenario = loads(standard_scene(n, "stepped"))
-    dt = 1.0 / STANDARD_FPS
-    best, how = 0.0, ""
-    for hashed in (False, True):
-        space = _pymunk_space(scenario, hashed)
-        for _ in range(PYMUNK_WARMUP_STEPS):
-            space.step(dt)
-        began = time.perf_counter()
-        steps = 0
-        while time.perf_counter() - began < min(target, PROBE_S) or steps < 2:
-            space.step(dt)
-            steps += 1
-        per = (time.perf_counter() - began) / steps
-        ticks = max(2, int(target / per))
-        rates = []
-        for _ in range(repeats):
-            began = time.perf_counter()
-            for _ in range(ticks):
-                space.step(dt)
-            rates.append(ticks / (time.perf_counter() - began))
-        rate = median(rates)
-        if rate > best:
-            best, how = rate, "spatial hash" if hashed else "bounding-box tree"
-    return best, how
+    about `target` s, and its broad phase (`PymunkTimer`)."""
+    clock = PymunkTimer(n, target)
+    return median([clock.sample() for _ in range(repeats)]), clock.how
 
 
-def peers(ns: list[int], ours: dict[int, float], quick: bool, echo) -> list[dict]:
+def peers(
+    ns: list[int], ours: dict[int, float], quick: bool, echo, timed: dict | None = None
+) -> list[dict]:
     """pymunk on the standard scene at each N, and the stepped model's ratio to it (`ours`: the
-    stepped model's steps/s by N, from this run's scaling part)."""
+    stepped model's steps/s by N, from this run's scaling part; `timed`: pymunk's (steps/s, broad
+    phase) by N where the scaling part timed it in turn with the stepped model, else it is timed
+    here)."""
     import pymunk
 
     rows = []
     target = QUICK_TARGET_S if quick else TARGET_S / 2
     repeats = 1 if quick else REPEATS
+    timed = timed or {}
     for n in ns:
-        rate, how = pymunk_steps_per_second(n, target, repeats)
+        if n in timed:
+            rate, how = timed[n]
+            how += ", timed in turn with the stepped model's runs"
+        else:
+            rate, how = pymunk_steps_per_second(n, target, repeats)
         row = {
             "part": "peers",
             "scene": "standard",

@@ -2,7 +2,9 @@
 
 One row per model and N: steps/s through `collide2d run` in a subprocess (or `runner.run.drive`
 in process), start-up excluded by subtracting a 1-tick run (the two interleaved, medians of
-REPEATS, the run's min-max, spread and noisy flag kept); body-steps/s; events/s (events per
+REPEATS, the run's min-max, spread and noisy flag kept; with a `peer`, the stepped model's rounds
+also time the peer once each, between the two, so that a ratio of the two medians holds no drift
+of the machine's speed); body-steps/s; events/s (events per
 tick of a logged run times steps/s); the time per step of each stage (`Model.profile`, where the
 model has stages); and the time to render one frame.
 """
@@ -33,8 +35,13 @@ QUICK_N = (50, 400)
 RENDER_FRAMES = 4
 
 
-def scaling(models_: list[str], ns: list[int], quick: bool, in_process: bool, echo) -> list[dict]:
-    """The standard scene under each model at each N: one row each (see the module docstring)."""
+def scaling(
+    models_: list[str], ns: list[int], quick: bool, in_process: bool, echo, peer=None
+) -> list[dict]:
+    """The standard scene under each model at each N: one row each (see the module docstring).
+    peer: n -> a timer whose `sample()` gives a peer's steps/s on the same scene (peers.timer);
+    the stepped model's rows then hold its median as `peer_steps_per_s` and its broad phase as
+    `peer_how`."""
     import tempfile
 
     rows = []
@@ -45,11 +52,14 @@ def scaling(models_: list[str], ns: list[int], quick: bool, in_process: bool, ec
         tmp = Path(tmp)
         for model in models_:
             for n in ns:
-                rows.append(_scaling_row(model, n, target, probe, repeats, in_process, tmp, echo))
+                clock = peer(n) if peer is not None and model == "stepped" else None
+                rows.append(
+                    _scaling_row(model, n, target, probe, repeats, in_process, tmp, echo, clock)
+                )
     return rows
 
 
-def _scaling_row(model, n, target, probe_s, repeats, in_process, tmp: Path, echo) -> dict:
+def _scaling_row(model, n, target, probe_s, repeats, in_process, tmp: Path, echo, peer) -> dict:
     from collide2d.engine.raster import Renderer
     from collide2d.runner.scenario import loads
 
@@ -70,10 +80,14 @@ def _scaling_row(model, n, target, probe_s, repeats, in_process, tmp: Path, echo
         cli_seconds(path, 1, out)  # warm the file cache and the kernels
         short, full = (lambda: cli_seconds(path, 1, out)), (lambda: cli_seconds(path, ticks, out))
         how = "collide2d run"
-    # interleaved: 1 tick, the run, the run, 1 tick, ... so that a drift shows in both alike
-    t1s, tts = [], []
+    # interleaved: 1 tick, the run, the run, 1 tick, ... so that a drift shows in both alike (and
+    # the peer's run between the two, each round)
+    t1s, tts, peer_rates = [], [], []
     for r in range(repeats):
-        for which in ((t1s, short), (tts, full)) if r % 2 == 0 else ((tts, full), (t1s, short)):
+        round_ = [(t1s, short), (tts, full)]
+        if peer is not None:
+            round_.insert(1, (peer_rates, peer.sample))
+        for which in round_ if r % 2 == 0 else round_[::-1]:
             which[0].append(which[1]())
     t1, tt = median(t1s), median(tts)
     if not tt > 1.5 * t1:  # too short to stand out of the start-up's noise: say so
@@ -105,6 +119,9 @@ def _scaling_row(model, n, target, probe_s, repeats, in_process, tmp: Path, echo
         "spread": (max(tts) - min(tts)) / max(tt, 1e-12),
         "noisy": "yes" if max(tts) - min(tts) > NOISY_SPREAD * tt else "no",
     }
+    if peer is not None:
+        row["peer_steps_per_s"] = median(peer_rates)
+        row["peer_how"] = peer.how
     # time per stage, where the model has stages (state as after the logged run)
     if hasattr(logged, "profile"):
         prof_ticks = max(1, min(ticks, int(probe_s * rate) + 1))

@@ -6,6 +6,8 @@ from __future__ import annotations
 import csv
 import math
 
+import pytest
+
 from collide2d.runner.bench import peers
 from collide2d.runner.cli import main
 
@@ -49,3 +51,44 @@ def test_a_folder_without_the_benchmark_scenarios_is_refused(tmp_path, capsys):
     assert code == 2
     assert "lacks bench_tunnelling.yaml" in capsys.readouterr().err
     assert not (tmp_path / "bench").exists()
+
+
+def test_pymunk_is_timed_in_turn_with_the_stepped_runs(tmp_path, monkeypatch):
+    """With --peers, each round of the stepped model's timings times pymunk once, between its
+    1-tick run and its full run (in either order), and the ratio divides the two medians."""
+    pytest.importorskip("pymunk")
+    from collide2d.runner.bench import scaling
+
+    timeline = []
+
+    def drive_seconds(text, ticks):
+        timeline.append("1 tick" if ticks == 1 else "run")
+        return 0.001 if ticks == 1 else 0.5
+
+    class Peer:
+        how = "bounding-box tree"
+        rates = iter([900.0, 1000.0, 1100.0])
+
+        def sample(self):
+            timeline.append("pymunk")
+            return next(self.rates)
+
+    monkeypatch.setattr(scaling, "drive_seconds", drive_seconds)
+    monkeypatch.setattr(peers, "timer", lambda quick: lambda n: Peer())
+    code = main(
+        ["bench", "--quick", "--peers", "--part", "scaling", "--n", "40", "--model", "stepped"]
+        + ["--out", str(tmp_path), "--quiet"]
+    )
+    assert code == 0
+    rounds = [timeline[k : k + 3] for k in range(0, len(timeline), 3)]
+    assert rounds == [
+        ["1 tick", "pymunk", "run"],
+        ["run", "pymunk", "1 tick"],
+        ["1 tick", "pymunk", "run"],
+    ]
+    rows = rows_of(tmp_path / "bench" / "bench.csv")
+    ours = next(r for r in rows if r["part"] == "scaling")
+    peer = next(r for r in rows if r["part"] == "peers")
+    assert float(peer["steps_per_s"]) == 1000.0
+    assert math.isclose(float(peer["ratio"]), float(ours["steps_per_s"]) / 1000.0, rel_tol=1e-9)
+    assert "timed in turn" in peer["note"]
