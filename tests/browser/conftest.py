@@ -46,6 +46,14 @@ def browser_type_launch_args(browser_type_launch_args):
     return {**browser_type_launch_args, "executable_path": path}
 
 
+@pytest.fixture(scope="session")
+def base_url():
+    """No base URL: every page here is opened by its file URI. Defined here so that the plugin's
+    own `base_url` is never set up: pytest-playwright 0.10 defines it as a session-scoped
+    fixture on an instance, which pytest 9 warns of and pytest 10 refuses."""
+    return None
+
+
 @pytest.fixture
 def browser_context_args(browser_context_args):
     return {
