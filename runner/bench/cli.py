@@ -77,7 +77,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
                 rows += extra
             ours = {r["n"]: r["steps_per_s"] for r in stepped}
             timed = {r["n"]: (r["peer_steps_per_s"], r["peer_how"]) for r in stepped}
-            rows += peers.peers(ns, ours, quick, echo, timed)
+            rows += peers.peers(ns, ours, timed, echo)
         else:
             print(
                 "collide2d bench: pymunk is not installed (pip install 'collide2d[bench]'); "

@@ -2,12 +2,11 @@
 
 pymunk's space steps at 1/STANDARD_FPS s with boxes of mass 1 and infinite moment, elasticity 1,
 friction 0 and four static walls; the faster of its bounding-box tree and its spatial hash is
-kept (`PymunkTimer`), and the stepped model's steps/s from the scaling part is divided by
-pymunk's. When the scaling part times the stepped model in the same run, it times pymunk in turn
-with it (`scaling`'s `peer`): each round one pymunk run between the stepped model's two, so that a
+kept (`PymunkTimer`). The scaling part times pymunk in turn with the stepped model (`timer`,
+`scaling`'s `peer`): each round one pymunk run between the stepped model's two, so that a
 machine whose speed drifts over minutes (a shared virtual machine's does, by a quarter) slows
-both sides of the ratio alike. Timed apart, minutes after the stepped model, the ratio took that
-drift in.
+both sides of the ratio alike (timed apart, minutes after the stepped model, the ratio took that
+drift in); `peers` then divides the stepped model's steps/s by pymunk's.
 """
 
 from __future__ import annotations
@@ -16,7 +15,7 @@ import math
 import time
 
 from collide2d.runner.bench.scenes import STANDARD_FPS, STANDARD_SIZE_PX, standard_scene
-from collide2d.runner.bench.timing import PROBE_S, QUICK_TARGET_S, REPEATS, TARGET_S, median
+from collide2d.runner.bench.timing import PROBE_S, QUICK_TARGET_S, TARGET_S, median
 
 # pymunk's spatial hash gets cells of this many box sides and this many cells per object.
 PYMUNK_HASH_SIDES = 2.0
@@ -115,25 +114,16 @@ def pymunk_steps_per_second(n: int, target: float, repeats: int) -> tuple[float,
     return median([clock.sample() for _ in range(repeats)]), clock.how
 
 
-def peers(
-    ns: list[int], ours: dict[int, float], quick: bool, echo, timed: dict | None = None
-) -> list[dict]:
-    """pymunk on the standard scene at each N, and the stepped model's ratio to it (`ours`: the
-    stepped model's steps/s by N, from this run's scaling part; `timed`: pymunk's (steps/s, broad
-    phase) by N where the scaling part timed it in turn with the stepped model, else it is timed
-    here)."""
+def peers(ns: list[int], ours: dict[int, float], timed: dict, echo) -> list[dict]:
+    """pymunk on the standard scene at each N, and the stepped model's ratio to it: `ours` the
+    stepped model's steps/s by N and `timed` pymunk's (steps/s, broad phase) by N, both from this
+    run's scaling part, which timed them in turn (`timer`)."""
     import pymunk
 
     rows = []
-    target = QUICK_TARGET_S if quick else TARGET_S / 2
-    repeats = 1 if quick else REPEATS
-    timed = timed or {}
     for n in ns:
-        if n in timed:
-            rate, how = timed[n]
-            how += ", timed in turn with the stepped model's runs"
-        else:
-            rate, how = pymunk_steps_per_second(n, target, repeats)
+        rate, how = timed[n]
+        how += ", timed in turn with the stepped model's runs"
         row = {
             "part": "peers",
             "scene": "standard",
@@ -145,10 +135,11 @@ def peers(
             "ns_per_body_step": 1e9 / (rate * n),
             "peer_steps_per_s": rate,
             "note": how,
+            "ratio": ours[n] / rate,
         }
-        if n in ours:
-            row["ratio"] = ours[n] / rate
         rows.append(row)
-        said = f", stepped/pymunk = {row['ratio']:.2f}" if "ratio" in row else ""
-        echo(f"peers    pymunk  n={n:<7d} {rate:12,.1f} steps/s ({how}){said}")
+        echo(
+            f"peers    pymunk  n={n:<7d} {rate:12,.1f} steps/s ({how}), "
+            f"stepped/pymunk = {row['ratio']:.2f}"
+        )
     return rows
