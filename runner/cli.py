@@ -14,8 +14,11 @@ line naming the scenario; the traceback too with `--debug`). A refused scenario 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
+import signal
 import sys
+import threading
 import traceback
 from importlib import resources
 
@@ -266,7 +269,8 @@ def main(argv: list[str] | None = None) -> int:
         compiling.install(None if quiet else compile_notice)
 
     try:
-        return args.func(args)
+        with _ctrl_c_answered():
+            return args.func(args)
     except ScenarioError as err:  # a refused scenario, or a refused [tool.collide2d] table
         print(str(err), file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -282,6 +286,22 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("collide2d: interrupted; outputs already written are whole", file=sys.stderr)
         return EXIT_INTERRUPTED
+
+
+@contextlib.contextmanager
+def _ctrl_c_answered():
+    """Ctrl-C (SIGINT) raises KeyboardInterrupt while a command runs, also when the process
+    started with SIGINT ignored, as a shell starts a job in the background of a script (Python
+    keeps it ignored then); the handler it had is put back after. Commands that stop more
+    gently (`run` at the end of a chunk, a sweep cancelling its tasks) set their own inside."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, before)
 
 
 def unexpected(err: Exception, args: argparse.Namespace) -> int:

@@ -341,3 +341,33 @@ def test_a_wedged_object_between_statics_is_named(tmp_path, capsys):
     # the other models run the same scene to its end (no hang, no crash)
     for model in ("paper", "stepped"):
         assert run([path, "--out", tmp_path / model, "--quiet", "--model", model]) == 0
+
+
+@pytest.mark.parametrize("started", ["foreground", "background"])
+def test_ctrl_c_stops_any_command_even_started_with_sigint_ignored(tmp_path, started):
+    """A command that sets no handler of its own (here `bench`) stops on Ctrl-C with exit 130
+    and writes nothing half, also when started as a script's background job, with SIGINT
+    ignored (`sh -c 'trap "" INT; exec ...'`), which Python would otherwise keep."""
+    import os
+    import signal
+
+    prefix = ["sh", "-c", 'trap "" INT; exec "$@"', "sh"] if started == "background" else []
+    proc = subprocess.Popen(
+        [*prefix, sys.executable, "-m", "collide2d", "bench", "--quick", "--part", "error",
+         "--out", str(tmp_path)],
+        cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL,
+        text=True, start_new_session=True,
+    )  # fmt: skip
+    try:
+        first = proc.stderr.readline()  # the first progress line: the bench is under way
+        assert first.startswith("error"), first
+        os.killpg(proc.pid, signal.SIGINT)  # as a terminal's Ctrl-C: the whole group
+        _, err = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+    assert proc.returncode == 130, err
+    assert "interrupted; outputs already written are whole" in err
+    assert "Traceback" not in err
+    assert not (tmp_path / "bench").exists()
