@@ -12,6 +12,7 @@ from pathlib import Path
 import imageio.v3 as iio
 import numpy as np
 import pytest
+from interrupt import STARTED, interrupted
 
 from collide2d.runner.cli import demo_path, main
 
@@ -343,30 +344,18 @@ def test_a_wedged_object_between_statics_is_named(tmp_path, capsys):
         assert run([path, "--out", tmp_path / model, "--quiet", "--model", model]) == 0
 
 
-@pytest.mark.parametrize("started", ["foreground", "background"])
+@pytest.mark.parametrize("started", sorted(STARTED))
 def test_ctrl_c_stops_any_command_even_started_with_sigint_ignored(tmp_path, started):
     """A command that sets no handler of its own (here `bench`) stops on Ctrl-C with exit 130
     and writes nothing half, also when started as a script's background job, with SIGINT
-    ignored (`sh -c 'trap "" INT; exec ...'`), which Python would otherwise keep."""
-    import os
-    import signal
-
-    prefix = ["sh", "-c", 'trap "" INT; exec "$@"', "sh"] if started == "background" else []
-    proc = subprocess.Popen(
-        [*prefix, sys.executable, "-m", "collide2d", "bench", "--quick", "--part", "error",
-         "--out", str(tmp_path)],
-        cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL,
-        text=True, start_new_session=True,
-    )  # fmt: skip
-    try:
-        first = proc.stderr.readline()  # the first progress line: the bench is under way
-        assert first.startswith("error"), first
-        os.killpg(proc.pid, signal.SIGINT)  # as a terminal's Ctrl-C: the whole group
-        _, err = proc.communicate(timeout=120)
-    finally:
-        if proc.poll() is None:
-            os.killpg(proc.pid, signal.SIGKILL)
-            proc.wait()
+    ignored, which Python would otherwise keep."""
+    first, proc, _, err = interrupted(
+        started,
+        [sys.executable, "-m", "collide2d", "bench", "--quick", "--part", "error"]
+        + ["--out", tmp_path],
+        ROOT,
+    )
+    assert first.startswith("error"), first  # the first progress line: the bench was under way
     assert proc.returncode == 130, err
     assert "interrupted; outputs already written are whole" in err
     assert "Traceback" not in err

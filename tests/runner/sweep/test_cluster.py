@@ -15,6 +15,7 @@ import time
 from pathlib import Path
 
 import pytest
+from interrupt import STARTED, interrupted
 
 from collide2d.runner.sweep import driver, results
 from collide2d.runner.sweep.matrix import columns, expand, parse_set
@@ -191,35 +192,17 @@ def test_a_worker_killed_mid_sweep_loses_no_row(tmp_path):
             _stop(proc)
 
 
-# The sweep started as a shell starts it: in the foreground (SIGINT as the shell had it), or in
-# the background of a script (`collide2d sweep ... &`: SIGINT ignored, which the sweep's process
-# would keep but for its own handler). `sh -c 'trap "" INT; exec ...'` starts it with SIGINT
-# ignored.
-STARTED = {
-    "foreground": [],
-    "background": ["sh", "-c", 'trap "" INT; exec "$@"', "sh"],
-}
-
-
 @pytest.mark.parametrize("started", sorted(STARTED))
 def test_ctrl_c_writes_the_rows_done_marked_incomplete(tmp_path, started):
     out = tmp_path / "out"
-    proc = subprocess.Popen(
-        [*STARTED[started], str(BIN / "collide2d"), "sweep", FIFTY, "--set", "ticks=20000",
-         "--seeds", "1-40", "--workers", "2", "--out", str(out)],
-        cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL,
-        text=True, start_new_session=True,
+    first, proc, out_text, err_text = interrupted(
+        started,
+        [BIN / "collide2d", "sweep", FIFTY, "--set", "ticks=20000", "--seeds", "1-40",
+         "--workers", "2", "--out", out],
+        ROOT,
+        wait_s=1.5,
     )  # fmt: skip
-    try:
-        first = proc.stderr.readline()  # printed once the cluster is up
-        assert first == "sweep: 40 runs on 2 local workers\n"
-        time.sleep(1.5)
-        os.killpg(proc.pid, signal.SIGINT)  # as a terminal's Ctrl-C: the whole group
-        out_text, err_text = proc.communicate(timeout=120)
-    finally:
-        if proc.poll() is None:
-            os.killpg(proc.pid, signal.SIGKILL)
-            proc.wait()
+    assert first == "sweep: 40 runs on 2 local workers\n"  # printed once the cluster is up
     assert proc.returncode == 130, f"stdout: {out_text!r}; stderr: {err_text!r}"
     assert _group_ends(proc.pid), "a worker process outlived the sweep"
     assert "Traceback" not in err_text and "KeyboardInterrupt" not in err_text
