@@ -288,20 +288,42 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_INTERRUPTED
 
 
+# A Ctrl-C that arrives while Python runs a finalizer (`__del__`: numba's compiler frees LLVM
+# objects so, often, while it compiles a kernel) would be lost there: Python prints "Exception
+# ignored" and goes on. The interrupt is raised this many seconds later instead, once out of it.
+INTERRUPT_RETRY_S = 0.01
+
+
+def _interrupt(signum, frame):
+    """Raise KeyboardInterrupt, or, inside a finalizer, raise it a moment later (SIGALRM)."""
+    while frame is not None:
+        if frame.f_code.co_name == "__del__" and hasattr(signal, "setitimer"):
+            signal.setitimer(signal.ITIMER_REAL, INTERRUPT_RETRY_S)
+            return
+        frame = frame.f_back
+    raise KeyboardInterrupt
+
+
 @contextlib.contextmanager
 def _ctrl_c_answered():
-    """Ctrl-C (SIGINT) raises KeyboardInterrupt while a command runs, also when the process
-    started with SIGINT ignored, as a shell starts a job in the background of a script (Python
-    keeps it ignored then); the handler it had is put back after. Commands that stop more
-    gently (`run` at the end of a chunk, a sweep cancelling its tasks) set their own inside."""
+    """Ctrl-C (SIGINT) raises KeyboardInterrupt while a command runs (`_interrupt`), also when
+    the process started with SIGINT ignored, as a shell starts a job in the background of a
+    script (Python keeps it ignored then); the handlers it had are put back after. Commands that
+    stop more gently (`run` at the end of a chunk, a sweep cancelling its tasks) set their own
+    inside."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-    before = signal.signal(signal.SIGINT, signal.default_int_handler)
+    retry = hasattr(signal, "setitimer")  # not on Windows: there a Ctrl-C in a finalizer is lost
+    signals = (signal.SIGINT, signal.SIGALRM) if retry else (signal.SIGINT,)
+    before = {sig: signal.signal(sig, _interrupt) for sig in signals}
     try:
         yield
     finally:
-        signal.signal(signal.SIGINT, before)
+        if retry:
+            signal.setitimer(signal.ITIMER_REAL, 0)
+        for sig, handler in before.items():
+            signal.signal(sig, handler)
 
 
 def unexpected(err: Exception, args: argparse.Namespace) -> int:

@@ -360,3 +360,25 @@ def test_ctrl_c_stops_any_command_even_started_with_sigint_ignored(tmp_path, sta
     assert "interrupted; outputs already written are whole" in err
     assert "Traceback" not in err
     assert not (tmp_path / "bench").exists()
+
+
+def test_a_ctrl_c_that_lands_in_a_finalizer_is_raised_just_after_it():
+    """Python swallows an exception raised in `__del__` (numba's compiler frees LLVM objects so,
+    while it compiles): a Ctrl-C that lands there still stops the command, a moment later."""
+    import os
+    import signal
+
+    from collide2d.runner import cli
+
+    class Freed:
+        def __del__(self):
+            os.kill(os.getpid(), signal.SIGINT)  # handled at the next bytecode: still in here
+            for _ in range(1000):
+                pass
+
+    with pytest.raises(KeyboardInterrupt), cli._ctrl_c_answered():
+        Freed()  # freed at once, its __del__ sends the signal
+        deadline = time.monotonic() + 2.0
+        while time.monotonic() < deadline:  # the interrupt comes here, out of the finalizer
+            time.sleep(0.001)
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
