@@ -148,6 +148,12 @@ def cmd_run(args: argparse.Namespace) -> int:
     from collide2d.runner.scenario import load
 
     project = config.find()
+    if args.out and (project.file or project.scenarios.is_dir()):
+        try:  # a folder of its own, apart from the project's other folders (runner.config)
+            project.apart("out", args.out, "--out")
+        except config.FolderClash as exc:
+            print(f"collide2d: error: {exc}", file=sys.stderr)
+            return EXIT_BAD_INPUT
     apply_threads(args, project)
     apply_jit(args, project)
     path = args.scenario or demo_path()

@@ -19,8 +19,10 @@ with its value and where it came from. The table (every key optional):
 Precedence: the command line, then the scenario file, then this table, then the defaults;
 `collide2d config` prints each value and its source. A bad table is refused like a bad scenario:
 `pyproject.toml:LINE:COL: error: ...` (exit 2), with a did-you-mean for a misspelt key. Folders are
-relative to the project folder and must stay inside it. Read with `tomllib` (Python 3.11+) or
-`tomli` (3.10).
+relative to the project folder and must stay inside it; the four are apart: none is the project
+folder, another's folder, or inside another (`Config.apart` holds a folder named on the command
+line, as `check --report DIR`, to the same rule). Model settings have the bounds a scenario file's
+`model` has (runner.scenario). Read with `tomllib` (Python 3.11+) or `tomli` (3.10).
 """
 
 from __future__ import annotations
@@ -50,6 +52,11 @@ COMMAND_LINE = "command line"
 
 class ConfigError(ScenarioError):
     """The `[tool.collide2d]` table refused: str(err) is `PATH:LINE:COL: error: MESSAGE`."""
+
+
+class FolderClash(ValueError):
+    """A folder named on the command line is the project folder, holds it, or meets one of the
+    project's folders (`Config.apart`): str(err) is the message for the user."""
 
 
 @dataclass(frozen=True)
@@ -104,6 +111,16 @@ class Config:
         if self.model_defaults():
             options["defaults"] = self.model_defaults()
         return options
+
+    def apart(self, key: str, given, option: str) -> Path:
+        """The folder `given` (named by the command-line `option` in place of the setting `key`),
+        when it holds neither the project folder nor another of the project's folders and lies
+        in none; FolderClash if not."""
+        others = {k: self.folder(k) for k in FOLDER_KEYS if k != key}
+        why = _clash(Path(given), self.root, others)
+        if why is not None:
+            raise FolderClash(f"{option} {given} {why}; name a folder of its own")
+        return Path(given)
 
     def override(self, key: str, value) -> None:
         """Set `key` from the command line (when `value` is not None)."""
@@ -226,15 +243,18 @@ def _config(root: Path, pyproject: Path | None, table: dict) -> Config:
                 hint = f"; did you mean '{near[0]}'?" if near else f"; expected {', '.join(keys)}"
                 raise fail(k, f"[{where}] has no setting '{k}'{hint}")
 
-    def whole(key: str, value, lo: int = 1) -> int:
+    def whole(key: str, value, lo: int = 1, hi: int | None = None) -> int:
         if isinstance(value, bool) or not isinstance(value, int) or value < lo:
-            raise fail(key, f"{key} must be a whole number >= {lo}, not {value!r}")
+            raise fail(key, f"{key} must be a whole number >= {lo}, not {_brief(value)}")
+        if hi is not None and value > hi:
+            raise fail(key, f"{key} must be at most {hi}, not {_brief(value)}")
         return value
 
     known(TOP_KEYS, table, TABLE)
     for key in FOLDER_KEYS:
         if key in table:
             config.settings[key] = Setting(_folder(table[key], key, root, fail), source)
+    _apart(config, table, fail)
     if "threads" in table:
         config.settings["threads"] = Setting(whole("threads", table["threads"]), source)
     if "jit" in table:
@@ -248,21 +268,85 @@ def _config(root: Path, pyproject: Path | None, table: dict) -> Config:
         known(keys, given, f"{TABLE}.{section}")
         for k, v in given.items():
             name = f"{section}.{k}"
-            if k in MODEL_CHOICES:
+            if section == "model" and k in _model_bounds():  # a scenario file's own bounds
+                v = whole(name, v, *_model_bounds()[k])
+            elif k in MODEL_CHOICES:
                 if v not in MODEL_CHOICES[k]:
                     choices = " | ".join(MODEL_CHOICES[k])
-                    raise fail(k, f"{name} must be one of {choices}, not {v!r}")
+                    raise fail(k, f"{name} must be one of {choices}, not {_brief(v)}")
             else:
                 v = whole(name, v)
             config.settings[name] = Setting(v, source)
     return config
 
 
+def _model_bounds() -> dict:
+    """The whole-number model settings and their (lowest, highest): runner.scenario's, read when a
+    table sets one (the scenario reader is not loaded for a project that sets none)."""
+    from collide2d.runner.scenario import MODEL_BOUNDS
+
+    return MODEL_BOUNDS
+
+
+def _brief(value) -> str:
+    """A value as a message shows it: a huge number by its digit count, long text cut."""
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) >= 10**24:
+        return f"a number of {len(str(abs(value)))} digits"
+    text = repr(value)
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
 def _folder(value, key: str, root: Path, fail) -> str:
     if not isinstance(value, str) or not value.strip():
-        raise fail(key, f"{key} must be a folder name (text), not {value!r}")
+        raise fail(key, f"{key} must be a folder name (text), not {_brief(value)}")
+    if any(ord(c) < 32 or ord(c) == 127 for c in value):
+        raise fail(key, f"{key} = {_brief(value)} holds a control character; name a plain folder")
     path = Path(value)
     inside = (root / path).resolve()
     if path.is_absolute() or (inside != root and root not in inside.parents):
         raise fail(key, f"{key} = {value!r} leads outside the project folder {root}")
     return value
+
+
+def _apart(config: Config, table: dict, fail) -> None:
+    """Refuse a folder of the table that is the project folder or meets another (the same folder,
+    or one inside the other), at the line of the setting the table gives (the later one when it
+    gives both)."""
+    given = [k for k in table if k in FOLDER_KEYS]  # in the file's order
+    for i, key in enumerate(given):
+        others = {k: config.folder(k) for k in FOLDER_KEYS if k not in table or k in given[:i]}
+        why = _clash(config.folder(key), config.root, others)
+        if why is not None:
+            raise fail(
+                key,
+                f"{key} = {_brief(table[key])} {why}; scenarios, goldens, report and out each "
+                "need a folder of their own inside the project",
+            )
+
+
+def _clash(path: Path, root: Path, others: dict) -> str | None:
+    """Why the folder `path` cannot serve beside the project folder `root` and its folders
+    `others` (setting -> path), or None when it is apart from them all."""
+    path, root = path.resolve(), root.resolve()
+    if path == root:
+        return f"is the project folder {root}"
+    if path in root.parents:
+        return f"holds the project folder {root}"
+    for key, other in others.items():
+        other = other.resolve()
+        shown = f"the {key} folder {_under(other, root)}"
+        if path == other:
+            return f"is {shown}"
+        if other in path.parents:
+            return f"is inside {shown}"
+        if path in other.parents:
+            return f"holds {shown}"
+    return None
+
+
+def _under(path: Path, root: Path) -> str:
+    """`path` as shown in messages: relative to `root` when inside it, with a trailing slash."""
+    try:
+        return path.relative_to(root).as_posix() + "/"
+    except ValueError:
+        return path.as_posix() + "/"

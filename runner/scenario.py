@@ -128,6 +128,7 @@ __all__ = [
     "MAX_SPEED",
     "MAX_SUBSTEPS",
     "MIN_MASS",
+    "MODEL_BOUNDS",
     "MODEL_KEYS",
     "NAME_FOR_TEXT",
     "NAME_PATTERN",
@@ -161,6 +162,9 @@ MAX_SUBSTEPS = 10_000  # substeps per tick of the stepped model
 # --max-events-per-tick may ask for (counted exactly in the kernel's int64 and in float64).
 DEFAULT_MAX_EVENTS_PER_TICK = MAX_EVENTS_PER_TICK
 MAX_EVENT_CAP = 2**53
+# The whole-number model settings and their (lowest, highest): of a scenario's `model`, and of a
+# project's [tool.collide2d.model] alike (runner.config).
+MODEL_BOUNDS = {"substeps": (1, MAX_SUBSTEPS), "max_events_per_tick": (1, MAX_EVENT_CAP)}
 MAX_NAME_LENGTH = 100  # characters in a scenario name (it names a folder)
 NAME_PATTERN = r"[a-z0-9_-][a-z0-9._-]*"  # scenario names; never "." or "..", never a path
 NAME_FOR_TEXT = "scenario"  # the name of a scenario read from text without one
@@ -431,16 +435,16 @@ class _Reader(Nodes):
                 kind = self.choice(m["kind"][1], "model", MODEL_NAMES)
                 if "substeps" in m:
                     sub_node = m["substeps"][1]
-                    substeps = self.integer(sub_node, "model.substeps", lo=1, hi=MAX_SUBSTEPS)
+                    lo, hi = MODEL_BOUNDS["substeps"]
+                    substeps = self.integer(sub_node, "model.substeps", lo=lo, hi=hi)
                     if kind != "stepped":
                         raise self.error(
                             sub_node, f"substeps applies to the stepped model only, not to {kind}"
                         )
                 if "max_events_per_tick" in m:
                     cap_node = m["max_events_per_tick"][1]
-                    cap = self.integer(
-                        cap_node, "model.max_events_per_tick", lo=1, hi=MAX_EVENT_CAP
-                    )
+                    lo, hi = MODEL_BOUNDS["max_events_per_tick"]
+                    cap = self.integer(cap_node, "model.max_events_per_tick", lo=lo, hi=hi)
                     if kind != "exact":
                         raise self.error(
                             cap_node,

@@ -10,7 +10,7 @@ import pytest
 from collide2d.runner import config
 from collide2d.runner.cli import main
 from collide2d.runner.limits import Limits
-from collide2d.runner.scenario import loads
+from collide2d.runner.scenario import ScenarioError, loads
 
 SCENARIO = "version: 1\nticks: 3\nobjects:\n  - {shape: box, size: 4, position: [1, 1]}\n"
 
@@ -138,3 +138,95 @@ def test_the_tables_threads_are_put_in_force_unless_the_command_line_names_some(
         assert threads.threads() == everything
     finally:
         threads.set_threads(None)
+
+
+@pytest.mark.parametrize(
+    "table, line, says",
+    [
+        ('goldens = "."\n', 5, "goldens = '.' is the project folder"),
+        ('scenarios = "./"\n', 5, "scenarios = './' is the project folder"),
+        ('report = "goldens/r"\n', 5, "report = 'goldens/r' is inside the goldens folder goldens/"),
+        ('out = "scenarios"\n', 5, "out = 'scenarios' is the scenarios folder scenarios/"),
+        ('goldens = "out/g"\nout = "out"\n', 6, "out = 'out' holds the goldens folder out/g/"),
+        ('report = "r"\ngoldens = "r/../r"\n', 6, "goldens = 'r/../r' is the report folder r/"),
+    ],
+)
+def test_the_tables_folders_are_apart_from_the_project_and_each_other(tmp_path, table, line, says):
+    project(tmp_path, "[tool.collide2d]\n" + table)
+    with pytest.raises(config.ConfigError) as info:
+        config.find(tmp_path)
+    text = str(info.value)
+    assert text.startswith(f"{tmp_path / 'pyproject.toml'}:{line}:1: error: ") and says in text
+    assert "need a folder of their own" in text
+
+
+def test_a_folder_named_on_the_command_line_is_apart_too(tmp_path, monkeypatch, capsys):
+    (tmp_path / "p").mkdir()
+    root = project(tmp_path / "p", '[tool.collide2d]\nout = "runs"\n')
+    (root / "s.yaml").write_text(SCENARIO)
+    found = config.find(root)
+    for given, says in (
+        (root, "is the project folder"),
+        (tmp_path, "holds the project folder"),
+        (root / "scenarios" / "x", "is inside the scenarios folder scenarios/"),
+        (root / "goldens", "is the goldens folder goldens/"),
+        (root / "report", "is the report folder report/"),
+    ):
+        with pytest.raises(config.FolderClash, match=says):
+            found.apart("out", given, "--out")
+    assert found.apart("out", root / "runs", "--out") == root / "runs"  # its own setting's folder
+    assert found.apart("report", tmp_path / "elsewhere", "--report") == tmp_path / "elsewhere"
+    monkeypatch.chdir(root)
+    assert main(["run", "s.yaml", "--out", ".", "--quiet"]) == 2
+    assert "--out . is the project folder" in capsys.readouterr().err
+    assert sorted(p.name for p in root.iterdir()) == ["pyproject.toml", "s.yaml"]
+
+
+def test_a_control_character_in_a_folder_setting_is_refused_at_its_line(tmp_path, monkeypatch):
+    project(tmp_path, '[tool.collide2d]\nout = "runs"\ngoldens = "g\\u0000old"\n')
+    with pytest.raises(config.ConfigError) as info:
+        config.find(tmp_path)
+    text = str(info.value)
+    assert text.startswith(f"{tmp_path / 'pyproject.toml'}:6:1: error: goldens = ")
+    assert "holds a control character" in text
+
+
+@pytest.mark.parametrize(
+    "setting, line, says",
+    [
+        ("substeps = 100000000000000000000", 6, "model.substeps must be at most 10000"),
+        ("substeps = 10001", 6, "model.substeps must be at most 10000, not 10001"),
+        ("max_events_per_tick = 9007199254740993", 6, "must be at most 9007199254740992"),
+        ("substeps = 0", 6, "model.substeps must be a whole number >= 1"),
+    ],
+)
+def test_the_tables_model_settings_have_a_scenarios_bounds(
+    tmp_path, monkeypatch, capsys, setting, line, says
+):
+    project(tmp_path, f'[tool.collide2d]\n[tool.collide2d.model]\n{setting}\nkind = "stepped"\n')
+    (tmp_path / "s.yaml").write_text(SCENARIO)
+    monkeypatch.chdir(tmp_path)
+    for argv in (["config"], ["run", "s.yaml", "--quiet"]):
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert err.startswith(f"{tmp_path / 'pyproject.toml'}:{line}:1: error: ") and says in err
+    # the same value in a scenario file is refused by the same bound
+    key, value = setting.split(" = ")
+    kind = "stepped" if key == "substeps" else "exact"
+    with pytest.raises(
+        ScenarioError, match=says.replace("must be a whole number >= 1", "must be at least 1")
+    ):
+        loads(SCENARIO + f"model: {{kind: {kind}, {key}: {value}}}\n")
+    assert not (tmp_path / "out").exists()
+
+
+def test_the_tables_model_settings_at_their_bounds_are_taken(tmp_path):
+    project(
+        tmp_path,
+        "[tool.collide2d]\n[tool.collide2d.model]\n"
+        "substeps = 10000\nmax_events_per_tick = 9007199254740992\n",
+    )
+    assert config.find(tmp_path).model_defaults() == {
+        "substeps": 10000,
+        "max_events_per_tick": 2**53,
+    }
