@@ -37,6 +37,7 @@ from collide2d.runner.golden.store import (
     GoldenStore,
     ci_active,
     find_root,
+    same_names,
     scenario_files,
 )
 
@@ -168,10 +169,8 @@ def check_command(args, *, load=default_load, simulate=default_simulate) -> int:
     3 on an unexpected error in any scenario (the others are still checked)."""
     try:
         root, scenarios = _prepare(args, load)
-        report_dir = Path(args.report) if args.report else None
+        report_dir = _report_dir(args)
         store = _store(args, root)
-        if report_dir is not None and _inside(report_dir, store.dir):
-            raise _Usage(f"--report {args.report} is inside {GOLDENS_DIR}/; name another folder")
         if report_dir is not None:
             try:
                 report.check_target(report_dir, [scn.name for _p, scn in scenarios])
@@ -316,14 +315,8 @@ def _prepare(args, load):
     if cap is not None:
         load = partial(load, overrides={"max_events_per_tick": cap})
     scenarios = _load_all(paths, load)
-    seen = {}
-    for path, scn in scenarios:
-        if scn.name in seen:
-            raise _Usage(
-                f"{shown_path(path)} and {shown_path(seen[scn.name])} are both named "
-                f"{scn.name!r}; a golden belongs to one scenario"
-            )
-        seen[scn.name] = path
+    for refusal in same_names((path, scn.name) for path, scn in scenarios).values():
+        raise _Usage(refusal)
     return root, scenarios
 
 
@@ -392,9 +385,17 @@ def _all_names(root, scenarios, load, project) -> list[str]:
     return sorted(set(loaded.values()) | {s.name for _p, s in _load_all(rest, load)})
 
 
-def _inside(path: Path, folder: Path) -> bool:
-    path, folder = path.resolve(), folder.resolve()
-    return path == folder or folder in path.parents
+def _report_dir(args) -> Path | None:
+    """The folder of `--report`, None without it; _Usage when it is the project folder, holds
+    it, or meets another of the project's folders (runner.config.Config.apart)."""
+    if not args.report:
+        return None
+    from collide2d.runner.config import FolderClash
+
+    try:
+        return args.project.apart("report", args.report, "--report")
+    except FolderClash as exc:
+        raise _Usage(str(exc)) from None
 
 
 def _show_progress(args) -> bool:

@@ -12,14 +12,17 @@ failing scenario, and with `--update-goldens` the goldens of the tests that ran.
 
     --update-goldens     bless what runs instead of comparing (refused with exit status 2 when the
                          CI environment variable is set)
-    --golden-report DIR  write failure reports under DIR (default: pytest's temporary folder)
+    --golden-report DIR  write failure reports under DIR (default: pytest's temporary folder); a
+                         folder of its own, as `collide2d check --report DIR` needs
     --golden-root DIR    the project folder holding scenarios/ and goldens/
 
-A test function asks for the `golden_scenario` argument to be parametrised over the scenario
-files, and calls the `golden_check` fixture with it. Each test writes only its own scenario's
-golden and report folder, so `pytest -n auto` (pytest-xdist) has no write races. The fixtures
-`golden_load` and `golden_simulate` give the scenario loader and the simulator; a conftest can
-override them. The terminal summary lists the goldens written and the goldens no scenario uses.
+Two scenario files with one name fail both their tests, as `collide2d check` refuses them, and
+neither golden is written. A test function asks for the `golden_scenario` argument to be
+parametrised over the scenario files, and calls the `golden_check` fixture with it. Each test
+writes only its own scenario's golden and report folder, so `pytest -n auto` (pytest-xdist) has
+no write races. The fixtures `golden_load` and `golden_simulate` give the scenario loader and the
+simulator; a conftest can override them. The terminal summary lists the goldens written and the
+goldens no scenario uses.
 """
 
 from __future__ import annotations
@@ -60,6 +63,8 @@ def pytest_addoption(parser) -> None:
 
 
 def pytest_configure(config) -> None:
+    if config.getoption("golden_report"):
+        _check_report_option(config)
     if not config.getoption("update_goldens"):
         return
     from collide2d.runner.golden.store import ci_active
@@ -70,6 +75,24 @@ def pytest_configure(config) -> None:
             "bless locally and commit goldens/",
             returncode=2,
         )
+
+
+def _check_report_option(config) -> None:
+    """--golden-report DIR by the rule of `collide2d check --report DIR`: a folder of its own,
+    neither the project folder, nor holding it, nor meeting one of its folders (exit status 2;
+    runner.config.Config.apart). A project that cannot be found is left to the golden tests,
+    which fail saying why."""
+    from collide2d.runner.config import ConfigError, FolderClash
+    from collide2d.runner.golden.store import GoldenError
+
+    try:
+        project = _project(config)
+    except (GoldenError, ConfigError):
+        return
+    try:
+        project.apart("report", config.getoption("golden_report"), "--golden-report")
+    except FolderClash as exc:
+        pytest.exit(f"collide2d: error: {exc}", returncode=2)
 
 
 def _project(config):
@@ -228,6 +251,9 @@ def check_golden(node, path, project, load, simulate, basetemp) -> None:
         scenario = load(shown_path(path))
     except scenario_errors() as exc:
         pytest.fail(str(exc), pytrace=False)
+    refusal = _same_name(config, project, load, Path(path), scenario.name)
+    if refusal is not None:  # as `collide2d check` and `bless` refuse it: no golden is written
+        pytest.fail(refusal, pytrace=False)
     node.user_properties.append((PROP_NAME, scenario.name))
     result = run_scenario(scenario, simulate)
     store = GoldenStore(project.root, project.value("goldens"))
@@ -246,6 +272,33 @@ def check_golden(node, path, project, load, simulate, basetemp) -> None:
         pytest.fail(str(exc), pytrace=False)
     if not outcome.ok:
         pytest.fail(outcome.message(), pytrace=False)
+
+
+# The names of the scenario files of the project's scenarios folder, read once a session.
+_NAMES = pytest.StashKey[dict]()
+
+
+def _same_name(config, project, load, path: Path, name: str) -> str | None:
+    """The refusal of the scenario file `path` named `name` when another scenario file of the
+    project has its name (the rule of `collide2d check`: runner.golden.store.same_names), else
+    None. The other files' names are read once a session; a file that does not load is left to
+    its own test."""
+    from collide2d.runner.golden import shown_path
+    from collide2d.runner.golden.cli import scenario_errors
+    from collide2d.runner.golden.store import same_names
+
+    cache = config.stash.setdefault(_NAMES, {})
+    if project.root not in cache:
+        names = {}
+        for file in _scenario_files(project):
+            try:
+                names[file.resolve()] = (file, load(shown_path(file)).name)
+            except scenario_errors():
+                continue
+        cache[project.root] = names
+    named = dict(cache[project.root])
+    named[path.resolve()] = (path, name)
+    return same_names(named.values()).get(path)
 
 
 def pytest_terminal_summary(terminalreporter, exitstatus, config) -> None:

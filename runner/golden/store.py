@@ -20,7 +20,8 @@ Leftovers are recognised by that exact name pattern, only as real folders, and a
 temporaries are left alone (the names, the swap and the recovery are `runner.swapdir`'s). A golden
 whose files all equal what is on disk is not rewritten. Nothing is ever written when the `CI`
 environment variable is set, and a golden folder is only removed by `remove` (the `--prune` of
-`bless`).
+`bless`), and only when it holds a golden's manifest (`is_golden`): a folder of anything else is
+never listed as an unused golden, nor removed.
 """
 
 from __future__ import annotations
@@ -101,6 +102,25 @@ def scenario_files(root, folder: str = SCENARIOS_DIR) -> list[Path]:
     return sorted(files, key=lambda p: p.name)
 
 
+def same_names(named) -> dict:
+    """The refusal of scenario files that share a name, a golden belonging to one scenario:
+    {path: message} for every file of `named` ((path, name) pairs, in order) whose name another
+    file has too; {} when every name is its own. `check`, `bless` and the pytest plugin refuse
+    by this one rule."""
+    by_name: dict = {}
+    for path, name in named:
+        by_name.setdefault(name, []).append(path)
+    refused = {}
+    for name, paths in by_name.items():
+        if len(paths) > 1:
+            message = (
+                f"{shown_path(paths[1])} and {shown_path(paths[0])} are both named {name!r}; "
+                "a golden belongs to one scenario"
+            )
+            refused.update((p, message) for p in paths)
+    return refused
+
+
 def check_name(name: str) -> str:
     """`name` if it can name a golden folder, else GoldenError."""
     if not isinstance(name, str) or not _NAME_RE.fullmatch(name):
@@ -154,15 +174,18 @@ class GoldenStore:
             raise GoldenError(f"{shown_path(self.dir)} is not a folder")
 
     def names(self) -> list[str]:
-        """The golden folders present, sorted (temporary and hidden entries left out; a link
-        with a golden's name is listed, and refused by whatever then uses it)."""
+        """The golden folders present, sorted: the folders holding a golden's manifest
+        (`is_golden`); temporary and hidden entries, and folders of anything else, left out. A
+        link with a golden's name is listed, and refused by whatever then uses it."""
         self.check_dir()
         if _lstat(self.dir) is None:
             return []
         out = []
         for entry in os.scandir(self.dir):
-            if _NAME_RE.fullmatch(entry.name) and (
-                entry.is_symlink() or entry.is_dir(follow_symlinks=False)
+            if not _NAME_RE.fullmatch(entry.name):
+                continue
+            if entry.is_symlink() or (
+                entry.is_dir(follow_symlinks=False) and is_golden(Path(entry.path))
             ):
                 out.append(entry.name)
         return sorted(out)
@@ -250,6 +273,11 @@ class GoldenStore:
             raise GoldenError(link_message(folder))
         if not stat.S_ISDIR(st.st_mode):
             raise GoldenError(f"{shown_path(folder)} is not a folder; remove it by hand")
+        if not is_golden(folder):
+            raise GoldenError(
+                f"{shown_path(folder)} holds no golden's {ser.MANIFEST_FILE}; it is not a golden, "
+                "and is left alone"
+            )
         aside = swapdir.temp_path(self.dir, name, OLD)
         os.rename(folder, aside)
         swapdir.remove_tree(aside)
@@ -269,6 +297,17 @@ class GoldenStore:
         """(path, pid, kind) of the temporary folders of golden `name` in goldens/, real folders
         only."""
         return swapdir.leftovers(self.dir, check_name(name), (NEW, OLD))
+
+
+def is_golden(folder: Path) -> bool:
+    """Whether `folder` holds a golden's manifest: a regular file manifest.json (not a link) whose
+    JSON object names a format and a scenario. Only such folders are goldens that `unused` lists
+    and `remove` deletes; any other folder is left alone."""
+    try:
+        manifest = ser.load_json(_read_regular(folder / ser.MANIFEST_FILE, folder.name))
+    except (GoldenError, ValueError):
+        return False
+    return isinstance(manifest, dict) and "format" in manifest and "scenario" in manifest
 
 
 def _ci_message() -> str:

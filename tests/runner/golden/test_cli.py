@@ -99,6 +99,37 @@ def test_unused_goldens_are_reported_and_pruned_only_when_asked(tree, capsys):
     assert (tree / "goldens" / "demo").is_dir()
 
 
+def test_prune_removes_only_folders_that_hold_a_goldens_manifest(tree, capsys):
+    _write(tree, "gone")
+    assert _run("bless") == 0
+    (tree / "scenarios" / "gone.yaml").unlink()
+    goldens = tree / "goldens"
+    (goldens / "notes").mkdir()
+    (goldens / "notes" / "todo.txt").write_text("keep me\n")
+    (goldens / "web").mkdir()  # a manifest.json of something else
+    (goldens / "web" / "manifest.json").write_text('{"name": "app", "icons": []}\n')
+    (goldens / "junk").mkdir()
+    (goldens / "junk" / "manifest.json").write_text("not json\n")
+    capsys.readouterr()
+    assert _run("check") == 0
+    assert "unused goldens (no scenario uses them): gone;" in capsys.readouterr().out
+    assert _run("bless", "--prune") == 0
+    out = capsys.readouterr().out
+    assert "removed   gone: no scenario uses it" in out and out.count("removed") == 1
+    assert sorted(p.name for p in goldens.iterdir()) == ["demo", "junk", "notes", "web"]
+    assert (goldens / "notes" / "todo.txt").read_text() == "keep me\n"
+
+
+def test_a_goldens_folder_that_is_the_project_is_refused_before_anything(tree, capsys):
+    (tree / "pyproject.toml").write_text('[tool.collide2d]\ngoldens = "."\n')
+    before = sorted(p.relative_to(tree).as_posix() for p in tree.rglob("*"))
+    for argv in (["bless", "--prune"], ["check"]):
+        assert _run(*argv) == 2
+        err = capsys.readouterr().err
+        assert err.startswith(f"{tree / 'pyproject.toml'}:2:1: error: goldens = '.' is the project")
+    assert sorted(p.relative_to(tree).as_posix() for p in tree.rglob("*")) == before
+
+
 def test_ci_refuses_bless_and_check_writes_nothing_to_goldens(tree, monkeypatch, capsys):
     monkeypatch.setenv("CI", "true")
     assert _run("bless") == 2
@@ -114,7 +145,10 @@ def test_ci_refuses_bless_and_check_writes_nothing_to_goldens(tree, monkeypatch,
     [
         (["check", "nosuch"], "no scenario 'nosuch'"),
         (["bless", "nosuch"], "no scenario 'nosuch'"),
-        (["check", "--report", "goldens/rep"], "is inside goldens/"),
+        (["check", "--report", "goldens/rep"], "is inside the goldens folder goldens/"),
+        (["check", "--report", "."], "--report . is the project folder"),
+        (["check", "--report", ".."], "--report .. holds the project folder"),
+        (["check", "--report", "scenarios"], "--report scenarios is the scenarios folder"),
         (["check", "--root", "scenarios"], "has no scenarios/ folder"),
     ],
 )

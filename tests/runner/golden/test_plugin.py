@@ -151,3 +151,40 @@ def test_links_in_goldens_fail_the_tests_clearly(project, tmp_path_factory):
         result.stdout.no_fnmatch_line("*Traceback*")
     after = sorted((p.as_posix(), p.read_bytes()) for p in outside.rglob("*") if p.is_file())
     assert after == before and golden.is_symlink()
+
+
+@pytest.mark.parametrize("folder", ["goldens", "."])
+def test_golden_report_obeys_the_rule_of_check_report(project, folder):
+    project.runpytest("--update-goldens").assert_outcomes(passed=2)
+    synthetic.write(
+        project.path / "scenarios" / "b.yaml",
+        synthetic.spec(name="b", pixels=synthetic.BASE["pixels"] + [[0, 0, 0, 7, 7, 7]]),
+    )
+    mine = ("goldens", "scenarios", "b", "index.html", "summary.json", "rep")
+
+    def tree():
+        return sorted(
+            (p.relative_to(project.path).as_posix(), p.read_bytes() if p.is_file() else None)
+            for top in mine
+            for p in [project.path / top, *(project.path / top).rglob("*")]
+            if p.exists()
+        )
+
+    before = tree()
+    result = project.runpytest_subprocess("--golden-report", folder)
+    assert result.ret == 2
+    assert f"--golden-report {folder} " in result.stdout.str() + result.stderr.str()
+    assert tree() == before  # no report written anywhere in the project
+
+
+def test_two_scenarios_with_one_name_fail_as_the_cli_refuses_them(project):
+    synthetic.write(project.path / "scenarios" / "twin.yaml", synthetic.spec(name="a"))
+    argv = ["check", "--root", str(project.path)]
+    assert cli.main(argv, load=synthetic.load, simulate=synthetic.simulate) == 2
+    for argv in (["--update-goldens", "-v"], ["-v"]):
+        result = project.runpytest(*argv)
+        result.assert_outcomes(passed=1, failed=2)
+        result.stdout.fnmatch_lines(
+            ["*scenarios/twin.yaml and scenarios/a.yaml are both named 'a'; a golden belongs*"]
+        )
+        assert GoldenStore(project.path).names() == ["b"]
