@@ -271,7 +271,7 @@ class _Reader(Nodes):
         nothing is edited, and anything it declines or any error it meets is read again through
         the general path, which alone decides what a file means or why it is refused."""
         fast = yamlfast.split(text) if edit is None else None
-        if fast is not None and yamlfast.nodes(fast) + len(fast.rest) <= self.limits.max_yaml_nodes:
+        if fast is not None and yamlfast.bound(fast) <= self.limits.max_yaml_nodes:
             try:
                 return self._scenario(fast.rest, digest, fast)
             except (yamlfast.FallBack, ScenarioError):

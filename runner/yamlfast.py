@@ -1,32 +1,44 @@
-"""The fast lane for long object lists in YAML: one flow mapping per line, read by column.
+"""The fast lane for long object lists in YAML, flow or block style, read by column.
 
 A scenario that lists thousands of objects usually writes one per line,
 
     objects:
       - {shape: box, size: [10, 10], position: [40, 60], velocity: [12.5, -3], color: red}
 
+or, as `yaml.safe_dump` and most generators write it, in block style,
+
+    objects:
+    - shape: box
+      position:
+      - 40
+      - 60
+
 and reading that through the general path (an event pass, a node tree, a reader per object) costs
-tens of microseconds per value. When every line of the `objects` list has that form, with only
-plain values of the simplest kinds (decimal numbers, [x, y] pairs of them, and words), this lane
-takes the values of each key from the lines (when every line has the first line's keys, in its
-order, with values of the same forms, by one pattern over the whole list, its groups the columns;
-else line by line), converts and checks them a column at a time with numpy, and hands the result
-on as a `runner.table.Table`; the rest of
+tens of microseconds per value. When every item of the `objects` list has one of those forms, with
+only plain values of the simplest kinds (decimal numbers, [x, y] pairs of them, and words), this
+lane reads it instead. A block-style item is first written as the one flow mapping it means
+(`_block_items`) when it has the simplest block form: its keys at one indent, each value plain on
+its key's line, or an [x, y] pair as two `- number` lines. Then the values of each key are taken
+from the lines (when every line has the first line's keys, in its order, with values of the same
+forms, by one pattern over the whole list, its groups the columns; else line by line), converted
+and checked a column at a time with numpy, and handed on as a `runner.table.Table`; the rest of
 the file, with the list's lines blanked (so every line keeps its number), goes through the general
 path as before.
 
-The lane only ever accepts: a file it would read differently from the general path, or one with
-anything wrong in its objects (a value out of range, an overlap, a rule of the model), goes through
-the general path whole (`FallBack`), which reads it, or refuses it at its place with its usual
-message. So the lane changes how long a file takes, never what it means. What it leaves to the
-general path: block-style or multi-line mappings, quoted or tagged values, anchors and aliases,
-comments or blank lines inside the list, polygons, numbers with leading zeros (YAML 1.1 octal),
-exponents, underscores, or other YAML 1.1 forms, words YAML reads as booleans or null where a text
-is asked for, and lists shorter than FAST_MIN_OBJECTS.
+The lane never decides what a file means: a file it would read differently from the general path,
+or one with anything wrong in its objects (a value out of range, an overlap, a rule of the model),
+goes through the general path whole (`FallBack`), which reads it, or refuses it at its place with
+its usual message. So the lane changes how long a file takes, never what it means. What it leaves
+to the general path: other block forms (values on lines of their own, other indents), multi-line
+flow mappings, quoted or tagged values, anchors and aliases, comments or blank lines inside the
+list, polygons, numbers with leading zeros (YAML 1.1 octal), exponents, underscores, or other YAML
+1.1 forms, words YAML reads as booleans or null where a text is asked for, and lists shorter than
+FAST_MIN_OBJECTS.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 from dataclasses import dataclass
@@ -45,6 +57,9 @@ _WORD = r"[A-Za-z_][A-Za-z0-9_.-]{0,99}"
 _VALUE = rf"(?:{_NUM}|\[ *{_NUM} *, *{_NUM} *\]|{_WORD})"
 _ITEM_RE = re.compile(rf" *- \{{ *[a-z]+: {_VALUE}(?: *, *[a-z]+: {_VALUE})* *\}} *")
 _FIELD_RE = re.compile(rf"([a-z]+): (?:\[ *({_NUM}) *, *({_NUM}) *\]|({_NUM}|{_WORD}))")
+_BLOCK_FIELD_RE = re.compile(
+    rf"([a-z]+):(?: ({_NUM}|{_WORD}|\[ *{_NUM} *, *{_NUM} *\])|\n *- ({_NUM})\n *- ({_NUM}))\n"
+)
 _HEAD_RE = re.compile(r"objects: *\n")
 _BLOCK_RE = re.compile(r"(?: *- [^\n]*(?:\n|\Z))*")
 KEYS = (
@@ -80,6 +95,8 @@ class Split:
     lines: list[str]
     first_line: int
     same: dict | None = None  # the columns when every line has the first's form (_same_as_first)
+    starts: tuple | None = None  # each object's first line (from 1) when not one line each
+    blanked: int = 0  # lines of the list blanked in `rest` (block style: more than one an item)
 
     @property
     def n(self) -> int:
@@ -98,6 +115,11 @@ def split(text: str) -> Split | None:
     if m is None:
         return None
     start = m.end()
+    head_line = text.count("\n", 0, m.start())
+    if text.startswith("-", len(text) - len(text[start:].lstrip(" "))) and not _ITEM_RE.match(
+        text, start
+    ):
+        return _block_split(text, m, head_line)
     pos = _BLOCK_RE.match(text, start).end()
     block = text[start:pos]
     if block.endswith("\n"):
@@ -116,11 +138,72 @@ def split(text: str) -> Split | None:
             len(line) - len(line.lstrip()) != indent for line in lines
         ):
             return None
-    head_line = text.count("\n", 0, m.start())
     rest = text[: m.start()] + "objects: []\n" + "\n" * len(lines) + text[pos:]
     if pos >= len(text) and not text.endswith("\n"):
         rest = rest[:-1]
-    return Split(rest, lines, head_line + 1, rows)
+    return Split(rest, lines, head_line + 1, rows, blanked=len(lines))
+
+
+def _block_split(text: str, m: re.Match, head_line: int) -> Split | None:
+    """The Split of a block-style `objects:` list (its items written as flow lines), or None."""
+    found = _block_items(text, m.end())
+    if found is None:
+        return None
+    lines, starts, pos = found
+    if len(lines) < FAST_MIN_OBJECTS:
+        return None
+    if pos < len(text) and not (text[pos].isalpha() or text[pos] == "#"):
+        return None  # the list must end at the next top-level key (or a comment, or the end)
+    taken = text.count("\n", m.end(), pos)
+    rest = text[: m.start()] + "objects: []\n" + "\n" * taken + text[pos:]
+    if pos >= len(text) and not text.endswith("\n"):
+        rest = rest[:-1]
+    first = head_line + 2  # the first item's line, from 1
+    starts = tuple(first + s for s in starts)
+    same = _same_as_first(lines[0], "\n".join(lines), len(lines))
+    return Split(rest, lines, head_line + 1, same, starts, taken)
+
+
+def _block_items(text: str, start: int):
+    """The items of the block-style list at `start` as one-line flow mappings, with each item's
+    line counted from the list's first (0-based) and the offset just past the list; None unless
+    every item has the simplest block form (see the module's docstring) at the first one's indent.
+
+    An item is `- key: value` followed by `  key: value` lines at the key's indent; a value is a
+    plain simple value (_VALUE) on its line, or nothing there and an [x, y] pair as two lines
+    `- number` at the key's indent or two spaces deeper. Whatever else YAML allows (comments,
+    blank lines, quotes, longer lists, other indents) ends the match, and the list is declined
+    when the match does not reach its end."""
+    indent = len(text[start:]) - len(text[start:].lstrip(" "))
+    item_re = _block_item_re(indent)
+    lines: list[str] = []
+    starts: list[int] = []
+    at_line = 0
+    pos = start
+    pad = " " * indent
+    while pos < len(text) and text.startswith(pad + "- ", pos):
+        item = item_re.match(text, pos)
+        if item is None:
+            return None
+        fields = []
+        for key, one, x, y in _BLOCK_FIELD_RE.findall(item.group(0)):
+            fields.append(f"{key}: {one}" if one else f"{key}: [{x}, {y}]")
+        lines.append(f"{pad}- {{{', '.join(fields)}}}")
+        starts.append(at_line)
+        at_line += item.group(0).count("\n")
+        pos = item.end()
+    if pos < len(text) and text[pos] == " ":
+        return None  # a line of the list the item form does not take
+    return lines, starts, pos
+
+
+@functools.cache
+def _block_item_re(indent: int) -> re.Pattern:
+    """One block-style item at `indent` (its dash's column), each line ended by a newline."""
+    key = " " * (indent + 2)
+    pair = "|".join(rf"\n{i}- {_NUM}\n{i}- {_NUM}" for i in (key, key + "  "))
+    field = rf"[a-z]+:(?: {_VALUE}|{pair})\n"
+    return re.compile(rf" {{{indent}}}- {field}(?:{key}{field})*")
 
 
 def _same_as_first(first: str, block: str, n: int):
@@ -156,6 +239,12 @@ def _same_as_first(first: str, block: str, n: int):
             out[key + "_y"] = columns[at + 1]
         at += 2 if pair else 1
     return {"keys": keys, "columns": out}
+
+
+def bound(split_: Split) -> int:
+    """An upper bound of the YAML values of the whole file: the list's (`nodes`), and one per
+    character of the rest but for the list's blanked lines, which hold none."""
+    return nodes(split_) + len(split_.rest) - split_.blanked
 
 
 def nodes(split_: Split) -> int:
@@ -364,7 +453,7 @@ def table(split_: Split, world, paper: bool, max_objects: int):
         color_of=rank[of.reshape(-1)],
         names=names,
         where=_fall_back,
-        lines=tuple(range(split_.first_line + 1, split_.first_line + 1 + n)),
+        lines=split_.starts or tuple(range(split_.first_line + 1, split_.first_line + 1 + n)),
     )
 
 

@@ -15,4 +15,8 @@ PEER_RATIO = {1_000: 10.0, 10_000: 15.0, 100_000: 30.0}
 STEPPED_NS_PER_BODY_STEP = (100_000, 10.0)
 PAPER_STEPS_PER_S = (100_000, 300.0)
 EXACT_EVENTS_PER_S = {"two-body chain": 4_000_000, "standard-10000": 500_000}
-LOAD = {"YAML list, fast lane": (2.0, 300), "CSV table": (0.3, None)}
+LOAD = {
+    "YAML list, fast lane": (1.0, 300),
+    "YAML block list, fast lane": (3.0, 300),
+    "CSV table": (0.3, None),
+}

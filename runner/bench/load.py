@@ -2,13 +2,13 @@
 memory it takes, before the first tick.
 
 LOAD_N objects of the standard scene (boxes 10x10 px on a 12 px lattice, velocities to three
-decimals, four colours) are written three ways into a temporary folder: a YAML list with one flow
-mapping per line (the fast lane, runner.yamlfast), a CSV table (`objects: {file: bodies.csv}`,
-runner.table) and, once, the same YAML list read by the general path alone (the fast lane turned
-off). Each is loaded by `runner.scenario.load` in a fresh `python` process that reports the load's
-wall time and its peak resident memory (VmHWM on Linux, else `ru_maxrss`) beside that of the
-same process before loading (imports done); the median of LOAD_REPEATS processes. Rows are one
-figure each.
+decimals, four colours) are written four ways into a temporary folder: a YAML list with one flow
+mapping per line and the same list in block style as `yaml.safe_dump` writes it (both through the
+fast lane, runner.yamlfast), a CSV table (`objects: {file: bodies.csv}`, runner.table) and, once,
+the flow list read by the general path alone (the fast lane turned off). Each is loaded by
+`runner.scenario.load` in a fresh `python` process that reports the load's wall time and its peak
+resident memory (VmHWM on Linux, else `ru_maxrss`) beside that of the same process before loading
+(imports done); the median of LOAD_REPEATS processes. Rows are one figure each.
 """
 
 from __future__ import annotations
@@ -54,7 +54,8 @@ print(json.dumps({"s": spent, "n": s.bodies.n, "before_kb": before, "peak_kb": p
 
 
 def write_scenes(folder: Path, n: int) -> dict[str, Path]:
-    """The scene of n boxes as a YAML list and as a CSV table; {kind: scenario path}."""
+    """The scene of n boxes as a YAML list (flow and block style) and as a CSV table; {kind:
+    scenario path}."""
     rng = np.random.default_rng(1)
     cols = max(1, int(np.sqrt(n * 4 / 3 * 4)))
     rows_ = -(-4 * n // cols)
@@ -71,12 +72,22 @@ def write_scenes(folder: Path, n: int) -> dict[str, Path]:
         for i in range(n)
     ]
     (folder / "listed.yaml").write_text(head + "objects:\n" + "\n".join(listed) + "\n")
+    blocks = [
+        f"- shape: box\n  size:\n  - 10\n  - 10\n  position:\n  - {x[i]}\n  - {y[i]}\n"
+        f"  velocity:\n  - {v[i, 0]}\n  - {v[i, 1]}\n  color: {COLORS[i % 4]}\n"
+        for i in range(n)
+    ]
+    (folder / "block.yaml").write_text(head + "objects:\n" + "".join(blocks))
     table = [f"{i},box,10,10,{x[i]},{y[i]},{v[i, 0]},{v[i, 1]},1,{COLORS[i % 4]}" for i in range(n)]
     (folder / "bodies.csv").write_text(
         "id,shape,w,h,x,y,vx,vy,mass,color\n" + "\n".join(table) + "\n"
     )
     (folder / "table.yaml").write_text(head + "objects: {file: bodies.csv}\n")
-    return {"yaml": folder / "listed.yaml", "csv": folder / "table.yaml"}
+    return {
+        "yaml": folder / "listed.yaml",
+        "block": folder / "block.yaml",
+        "csv": folder / "table.yaml",
+    }
 
 
 def _child(path: Path, lane: str) -> dict:
@@ -97,6 +108,7 @@ def load(quick: bool, echo, n: int | None = None) -> list[dict]:
         paths = write_scenes(Path(tmp), n)
         runs = [
             ("YAML list, fast lane", paths["yaml"], "fast", repeats),
+            ("YAML block list, fast lane", paths["block"], "fast", repeats),
             ("CSV table", paths["csv"], "fast", repeats),
             ("YAML list, general path", paths["yaml"], "general", 1),
         ]

@@ -4,6 +4,8 @@ refused in the same words at the same place, by the general path."""
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -233,3 +235,92 @@ def test_one_form_with_a_line_apart_reads_as_the_general_path(small_lane, change
         assert str(info.value) == str(err)
     else:
         same(loads(source), expected)
+
+
+def block(items: list[str], indent: int = 2, pairs: str = "lines") -> list[str]:
+    """The flow lines `items` written in block style, as `yaml.safe_dump` and generators write
+    them: the dash at `indent`, each key on its own line, an [x, y] pair as two `- number` lines
+    at the key's indent ("lines"), two spaces deeper ("deeper"), or inline ("inline")."""
+    out = []
+    pad = " " * indent
+    for item in items:
+        body = item.strip()[3:-1]
+        fields = re.findall(r"([a-z]+): (\[[^\]]*\]|[^,]+)", body)
+        for k, (key, value) in enumerate(fields):
+            lead = pad + ("- " if k == 0 else "  ")
+            if value.startswith("[") and pairs != "inline":
+                x, y = (v.strip() for v in value[1:-1].split(","))
+                under = pad + "  " + ("  " if pairs == "deeper" else "")
+                out += [f"{lead}{key}:", f"{under}- {x}", f"{under}- {y}"]
+            else:
+                out.append(f"{lead}{key}: {value}")
+    return out
+
+
+@pytest.mark.parametrize("pairs", ["lines", "deeper", "inline"])
+@pytest.mark.parametrize("indent", [0, 2, 4])
+@pytest.mark.parametrize("model", ["paper", "stepped", "exact"])
+def test_a_block_style_list_gives_the_scenario_of_the_general_path(
+    small_lane, model, indent, pairs
+):
+    items = lines(9, paper=model == "paper")
+    source = text(block(items, indent, pairs), model)
+    same(loads(source), general(source))
+    assert small_lane == [40]  # the lane took the list
+    flow = loads(text(items, model))
+    assert flow.bodies.pos.tobytes() == loads(source).bodies.pos.tobytes()
+
+
+@pytest.mark.parametrize("kind", [0, 2, 3])
+def test_a_block_style_list_of_one_form_is_taken_whole(small_lane, kind):
+    source = text(block(one_form(kind)))
+    assert yamlfast.split(source).same is not None
+    same(loads(source), general(source))
+    assert small_lane == [30]
+
+
+def block_at(k, old, new):
+    """A change of line k of a block-style list."""
+    return lambda ls: ls[:k] + [ls[k].replace(old, new)] + ls[k + 1 :]
+
+
+@pytest.mark.parametrize(
+    "change",
+    [
+        block_at(1, "  size:", "   size:"),  # a key off the item's indent
+        block_at(2, "  - 10", "    - 10"),  # a pair's lines at two indents
+        block_at(0, "shape: box", "shape: box # a comment"),
+        block_at(0, "shape: box", "shape: 'box'"),
+        block_at(1, "size:", "size: &a"),
+        lambda ls: ls[:3] + [""] + ls[3:],  # a blank line inside the list
+        lambda ls: ls[:3] + ["  - 3"] + ls[3:],  # a pair of three
+        lambda ls: ls[:1] + ["  size: 4"] + ls[1:],  # a key twice
+        block_at(4, "position:", "position: "),
+        block_at(0, "shape: box", "shape: box  "),
+        block_at(1, "size:", "size:\n    - [10, 6]"),
+        lambda ls: ls[:6] + [ls[6] + "\n    - 9"] + ls[7:],  # a list under the pair
+    ],
+)
+def test_what_the_block_lane_declines_the_general_path_reads_or_refuses(small_lane, change):
+    items = block(lines(3), 2, "lines")
+    source = text(change(items))
+    try:
+        expected = general(source)
+    except ScenarioError as err:
+        with pytest.raises(ScenarioError) as info:
+            loads(source)
+        assert str(info.value) == str(err)
+    else:
+        same(loads(source), expected)
+    assert small_lane == []  # declined (or found at fault) before the lane gave any objects
+
+
+def test_a_block_style_object_is_refused_at_its_own_line(small_lane):
+    items = lines(6)
+    items.append("  - {shape: box, size: [400, 1], position: [0, 299], velocity: [3, 0]}")
+    source = text(block(items), "exact")
+    with pytest.raises(ScenarioError) as info:
+        loads(source)
+    with pytest.raises(ScenarioError) as again:
+        general(source)
+    assert str(info.value) == str(again.value) and "no room" in str(info.value)

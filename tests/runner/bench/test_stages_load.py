@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collide2d.engine import threads
+from collide2d.runner import yamlfast
 from collide2d.runner.bench import load, peers, stages
 from collide2d.runner.scenario import load as load_scenario
 
@@ -29,16 +30,19 @@ def test_quick_stages_part_times_each_stage_on_one_thread_and_all():
     assert threads.threads() == before  # the thread count is put back
 
 
-def test_quick_load_part_loads_the_same_objects_three_ways(tmp_path):
+def test_quick_load_part_loads_the_same_objects_four_ways(tmp_path):
     rows = load.load(True, quiet, n=300)
     assert [r["scene"].split(": ")[1] for r in rows] == [
         "YAML list, fast lane",
+        "YAML block list, fast lane",
         "CSV table",
         "YAML list, general path",
     ]
     assert all(r["n"] == 300 and r["run_time_s"] > 0 and "peak memory" in r["note"] for r in rows)
-    paths = load.write_scenes(tmp_path, 300)
-    a, b = load_scenario(paths["yaml"]), load_scenario(paths["csv"])
-    assert a.bodies.pos.tobytes() == b.bodies.pos.tobytes()
-    assert a.bodies.vel.tobytes() == b.bodies.vel.tobytes()
-    assert a.palette.tobytes() == b.palette.tobytes()
+    paths = load.write_scenes(tmp_path, 1000)
+    assert all(yamlfast.split(paths[k].read_text()) is not None for k in ("yaml", "block"))
+    a, b, c = (load_scenario(paths[k]) for k in ("yaml", "csv", "block"))
+    for other in (b, c):
+        assert a.bodies.pos.tobytes() == other.bodies.pos.tobytes()
+        assert a.bodies.vel.tobytes() == other.bodies.vel.tobytes()
+        assert a.palette.tobytes() == other.palette.tobytes()
