@@ -12,7 +12,8 @@ line ends. What cannot be extended so is refused (`FILE:LINE:COL: error: ...`, e
 that is not valid TOML, one with a byte order mark, UTF-16 or not UTF-8, and a `tool` that is an
 inline table, an array of tables or a value. A file reached through a symbolic link (of the file
 or of a folder on its way) that leads outside the project folder is refused too (`FILE: error:
-...`); one that stays inside is written at the link's target, the link kept. Every refusal comes
+...`); one that stays inside is written at the link's target, the link kept; so is a folder, FIFO
+or device in place of a file, without opening it. Every refusal comes
 before anything is written, and the files are written all or nothing (`runner.filebatch`): when one
 cannot be written (a full disk), none is changed and the error names it (exit 2).
 """
@@ -23,6 +24,7 @@ import argparse
 import codecs
 import os
 import re
+import stat
 from importlib import resources
 from pathlib import Path
 
@@ -129,8 +131,11 @@ def init(root: Path) -> list[str]:
 
 
 def _read(path: Path) -> bytes | None:
-    """The bytes of the file `path`, None when there is none (or only a link to nothing)."""
+    """The bytes of the file `path`, None when there is none (or only a link to nothing); a
+    folder, FIFO or device there is refused, never opened (a FIFO would wait for a writer)."""
     try:
+        if not stat.S_ISREG(os.stat(path).st_mode):
+            raise InitRefused(str(path), "is not a regular file; init changes nothing in it")
         return path.read_bytes()
     except FileNotFoundError:
         return None

@@ -275,3 +275,21 @@ def test_init_is_all_or_nothing_when_a_file_cannot_be_written(tmp_path, fails):
     assert result.returncode == 2, result.stderr
     assert result.stderr.startswith(f"collide2d: error: {tmp_path / fails}: File too large")
     assert {p: p.read_bytes() for p in tmp_path.iterdir()} == before  # no temporaries either
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs FIFOs")
+@pytest.mark.parametrize("name", ["pyproject.toml", ".gitignore"])
+def test_init_refuses_a_fifo_in_place_of_a_file_at_once(tmp_path, name):
+    os.mkfifo(tmp_path / name)  # opened, it would wait for a writer forever
+    result = subprocess.run(
+        [sys.executable, "-m", "collide2d", "init", str(tmp_path)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert result.returncode == 2
+    assert (
+        result.stderr
+        == f"{tmp_path / name}: error: is not a regular file; init changes nothing in it\n"
+    )
+    assert sorted(p.name for p in tmp_path.iterdir()) == [name]
