@@ -10,12 +10,12 @@ A pyproject.toml is read as TOML readers read it (its bytes as UTF-8, line ends 
 extended only when the result says exactly what the file said plus the table, in the file's own
 line ends. What cannot be extended so is refused (`FILE:LINE:COL: error: ...`, exit 2): a file
 that is not valid TOML, one with a byte order mark, UTF-16 or not UTF-8, and a `tool` that is an
-inline table, an array of tables or a value. A file reached through a symbolic link (of the file
-or of a folder on its way) that leads outside the project folder is refused too (`FILE: error:
-...`); one that stays inside is written at the link's target, the link kept; so is a folder, FIFO
-or device in place of a file, without opening it. Every refusal comes
-before anything is written, and the files are written all or nothing (`runner.filebatch`): when one
-cannot be written (a full disk), none is changed and the error names it (exit 2).
+inline table, an array of tables or a value. Refused too (`FILE: error: ...`): a file reached
+through a symbolic link (of the file or of a folder on its way) that leads outside the project
+folder (one that stays inside is written at the link's target, the link kept), and a folder, FIFO
+or device in place of a file (never opened). Every refusal comes before anything is written, and
+the files are written all or nothing (`runner.filebatch`): when one cannot be written (a full
+disk), none is changed and the error names it (exit 2).
 """
 
 from __future__ import annotations
