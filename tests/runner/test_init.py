@@ -293,3 +293,18 @@ def test_init_refuses_a_fifo_in_place_of_a_file_at_once(tmp_path, name):
         == f"{tmp_path / name}: error: is not a regular file; init changes nothing in it\n"
     )
     assert sorted(p.name for p in tmp_path.iterdir()) == [name]
+
+
+def test_init_extends_a_gitignore_in_its_own_bytes_and_line_ends(tmp_path, capsys):
+    """A .gitignore is bytes to git: one in Latin-1 with CRLF line ends gets `out/` in CRLF, its
+    bytes kept; one in UTF-16, which bytes cannot extend, is refused before anything is written."""
+    old = b"# caf\xe9\r\n*.pyc"
+    (tmp_path / ".gitignore").write_bytes(old)
+    assert main(["init", str(tmp_path)]) == 0
+    assert (tmp_path / ".gitignore").read_bytes() == old + b"\r\nout/\r\n"
+    utf16 = tmp_path / "u"
+    utf16.mkdir()
+    (utf16 / ".gitignore").write_bytes("*.pyc\n".encode("utf-16"))
+    assert main(["init", str(utf16)]) == 2
+    assert "UTF-16" in capsys.readouterr().err
+    assert sorted(p.name for p in utf16.iterdir()) == [".gitignore"]
