@@ -193,17 +193,24 @@ def _toml():
     return tomllib
 
 
-def _table(pyproject: Path) -> dict | None:
+def parse(text: str, pyproject) -> dict:
+    """The TOML document `text` (the file `pyproject`'s); a ConfigError where it is refused."""
     tomllib = _toml()
     try:
-        data = tomllib.loads(pyproject.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ConfigError(str(pyproject), 1, 1, f"cannot read the file: {exc}") from None
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         at = re.search(r"\(at line (\d+), column (\d+)\)", str(exc))
         line, col = (int(at[1]), int(at[2])) if at else (1, 1)
         text = str(exc).split(" (at line")[0]
         raise ConfigError(str(pyproject), line, col, f"not valid TOML: {text}") from None
+
+
+def _table(pyproject: Path) -> dict | None:
+    try:
+        text = pyproject.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ConfigError(str(pyproject), 1, 1, f"cannot read the file: {exc}") from None
+    data = parse(text, pyproject)
     table = data.get("tool", {}).get("collide2d") if isinstance(data.get("tool"), dict) else None
     if table is None:
         return None

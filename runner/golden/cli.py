@@ -7,10 +7,13 @@ project root (`--root`, default the nearest folder upward with `scenarios/`), `-
 Outputs: console text (stdout: one block per scenario and a closing count;
 stderr: errors and, on a terminal, progress), report folders, golden folders, and the exit status:
 0 fine, 1 a check found a difference (or a golden is missing, damaged or hostile), 2 bad input or
-usage (a scenario refused, a symbolic link in the way), 3 an unexpected error. Each scenario is
-checked or blessed on its own: whatever goes wrong in one is reported (an unexpected error as one
-line naming the scenario, its traceback with `--debug`) and the others still run; the exit status
-is the worst seen (3 over 2 over 1).
+usage (a scenario refused, a symbolic link in the way, a file that cannot be read or written such
+as a report image on a full disk, named), 3 an unexpected error. Each scenario is checked or
+blessed on its own: whatever goes wrong in one is reported (an unexpected error as one line naming
+the scenario, its traceback with `--debug`) and the others still run; the exit status is the worst
+seen (3 over 2 over 1). `check` also goes on past a scenario file it cannot read (one scenario not
+checked, named by its path in the JUnit file and the JSON summaries); `bless` refuses one before
+anything runs.
 
 `register(subparsers)` adds both commands to the `collide2d` parser; each sets `func(args) -> int`.
 The scenario loader and the simulator can be handed in (tests use synthetic ones); by default they
@@ -167,8 +170,9 @@ def main(argv=None, *, load=None, simulate=None) -> int:
 def check_command(args, *, load=default_load, simulate=default_simulate) -> int:
     """`collide2d check`: 0 when every scenario matches its golden, 1 if not, 2 on bad input,
     3 on an unexpected error in any scenario (the others are still checked)."""
+    refused = []  # (path, error) of the scenario files that could not be read
     try:
-        root, scenarios = _prepare(args, load)
+        root, scenarios = _prepare(args, load, refused=refused)
         report_dir = _report_dir(args)
         store = _store(args, root)
         if report_dir is not None:
@@ -176,8 +180,8 @@ def check_command(args, *, load=default_load, simulate=default_simulate) -> int:
                 report.check_target(report_dir, [scn.name for _p, scn in scenarios])
             except GoldenError as exc:
                 raise _Usage(str(exc)) from None
-        # Unused goldens are only known when every scenario is checked.
-        used = None if args.scenarios else [scn.name for _p, scn in scenarios]
+        # Unused goldens are only known when every scenario is read and checked.
+        used = None if args.scenarios or refused else [scn.name for _p, scn in scenarios]
         try:
             out = Output(args)
         except GoldenError as exc:
@@ -190,6 +194,10 @@ def check_command(args, *, load=default_load, simulate=default_simulate) -> int:
     except _Usage as exc:
         return exc.exit()
     outcomes, status, errors = [], EXIT_OK, []
+    for path, exc in refused:  # each one case not checked; the others are still checked
+        status = max(status, _scenario_failed(args, "reading", path, Path(path).stem, exc))
+        said = str(exc) if isinstance(exc, scenario_errors()) else f"{type(exc).__name__}: {exc}"
+        errors.append((shown_path(path), said))
     for i, (path, scn) in enumerate(scenarios, start=1):
         _progress(args, f"[{i}/{len(scenarios)}] checking {scn.name}")
         try:
@@ -199,7 +207,7 @@ def check_command(args, *, load=default_load, simulate=default_simulate) -> int:
                 result = run_scenario(scn, simulate, progress=_show_progress(args))
             outcome = check_run(scn, result, store, path=path, report_dir=report_dir)
         except Exception as exc:  # one scenario never stops the others
-            status = max(status, _scenario_failed(args, "checking", path, scn, exc))
+            status = max(status, _scenario_failed(args, "checking", path, scn.name, exc))
             errors.append((scn.name, f"{type(exc).__name__}: {exc}"))
             continue
         outcomes.append(outcome)
@@ -210,28 +218,48 @@ def check_command(args, *, load=default_load, simulate=default_simulate) -> int:
             f"unused goldens (no scenario uses them): {', '.join(unused)}; "
             "remove them with: collide2d bless --prune"
         )
+    elif refused and not args.scenarios:
+        out.say("unused goldens not listed: a scenario file could not be read")
     if report_dir is not None:
-        out.say(f"report: {shown_path(report.write_index(report_dir, outcomes, unused))}")
+        try:
+            index = report.write_index(report_dir, outcomes, unused, errors)
+            out.say(f"report: {shown_path(index)}")
+        except OSError as exc:
+            status = max(status, _io_error(exc))
     failed = [o for o in outcomes if not o.ok]
     said = f", {len(errors)} not checked (errors above)" if errors else ""
     out.say(f"{len(outcomes) - len(failed)} passed, {len(failed)} failed{said}")
-    out.finish(outcomes, unused, errors)
+    try:
+        out.finish(outcomes, unused, errors)
+    except OSError as exc:
+        status = max(status, _io_error(exc))
     return max(status, EXIT_DIFFERENCE if failed else EXIT_OK)
 
 
-def _scenario_failed(args, doing: str, path, scn, exc: Exception) -> int:
-    """Report what stopped one scenario on stderr; returns its exit status: EXIT_BAD_INPUT for a
-    refusal (a bad scenario or run, a link in the way), EXIT_UNEXPECTED for anything else (one
-    line naming the scenario; the traceback too with --debug)."""
+def _io_error(exc: OSError, name: str = "") -> int:
+    """Print a file that could not be read or written (a full disk), naming it: bad input or
+    surroundings, not a bug; returns EXIT_BAD_INPUT."""
+    where = "".join(f"{w}: " for w in (name, exc.filename) if w)
+    print(f"collide2d: error: {where}{exc.strerror or exc}", file=sys.stderr, flush=True)
+    return EXIT_BAD_INPUT
+
+
+def _scenario_failed(args, doing: str, path, name: str, exc: Exception) -> int:
+    """Report what stopped one scenario (`name`) on stderr; returns its exit status:
+    EXIT_BAD_INPUT for a refusal (a bad scenario or run, a link in the way) or a file that could
+    not be read or written (a full disk), EXIT_UNEXPECTED for anything else (one line naming the
+    scenario; the traceback too with --debug)."""
+    if isinstance(exc, OSError):
+        return _io_error(exc, name)
     if isinstance(exc, _refusals()):
         text = str(exc)
         if isinstance(exc, GoldenError):
-            text = f"collide2d: error: {scn.name}: {text}"
+            text = f"collide2d: error: {name}: {text}"
         print(text, file=sys.stderr, flush=True)
         return EXIT_BAD_INPUT
     detail = " ".join(str(exc).split())[:300]
     print(
-        f"collide2d: unexpected error while {doing} {scn.name} ({shown_path(path)}): "
+        f"collide2d: unexpected error while {doing} {name} ({shown_path(path)}): "
         f"{type(exc).__name__}{': ' + detail if detail else ''}"
         + ("" if getattr(args, "debug", False) else " (run with --debug for the traceback)"),
         file=sys.stderr,
@@ -272,7 +300,7 @@ def bless_command(args, *, load=default_load, simulate=default_simulate) -> int:
             result = run_scenario(scn, simulate, progress=_show_progress(args))
             line = bless_run(scn, result, store).line()
         except Exception as exc:  # one scenario never stops the others
-            status = max(status, _scenario_failed(args, "blessing", path, scn, exc))
+            status = max(status, _scenario_failed(args, "blessing", path, scn.name, exc))
             continue
         print(line, flush=True)
     if args.prune:
@@ -291,9 +319,10 @@ def bless_command(args, *, load=default_load, simulate=default_simulate) -> int:
     return status
 
 
-def _prepare(args, load):
+def _prepare(args, load, refused=None):
     """(root, [(path, Scenario)]) for the command's arguments; _Usage on any bad input, before
-    anything runs."""
+    anything runs. With a list `refused`, a scenario file that cannot be read (refused, or an
+    unexpected error reading it) is left out and added to it as (path, error) instead."""
     from collide2d.runner.options import apply_jit
 
     project = _project(args)
@@ -314,7 +343,7 @@ def _prepare(args, load):
     cap = getattr(args, "max_events_per_tick", None)
     if cap is not None:
         load = partial(load, overrides={"max_events_per_tick": cap})
-    scenarios = _load_all(paths, load)
+    scenarios = _load_all(paths, load, refused)
     for refusal in same_names((path, scn.name) for path, scn in scenarios).values():
         raise _Usage(refusal)
     return root, scenarios
@@ -347,14 +376,19 @@ def _store(args, root) -> GoldenStore:
     return GoldenStore(root, project.value("goldens") if project else GOLDENS_DIR)
 
 
-def _load_all(paths, load):
+def _load_all(paths, load, refused=None):
     errors = scenario_errors()
     out = []
     for path in paths:
         try:
             out.append((path, load(shown_path(path))))
-        except errors as exc:
-            raise _Usage(str(exc), located=True) from None
+        except Exception as exc:
+            if refused is not None:
+                refused.append((path, exc))
+            elif isinstance(exc, errors):
+                raise _Usage(str(exc), located=True) from None
+            else:
+                raise
     return out
 
 

@@ -3,8 +3,9 @@
 `--format text` (the default) prints the console story of each scenario and a closing count;
 `--format json` prints nothing until the end and then one JSON document on stdout, the same
 summary `check --report` keeps in `summary.json` (`report.summary_dict`: counts, the summary line,
-per scenario its status, why it changed, the first differing event, problems and frames).
-`--junit FILE` writes JUnit XML (`junit`), one test case per scenario, whichever format prints.
+per scenario its status, why it changed, the first differing event, problems and frames, and the
+scenarios not checked with their errors). `--junit FILE` writes JUnit XML (`junit`), one test case
+per scenario (an error case for one not checked), whichever format prints.
 """
 
 from __future__ import annotations
@@ -60,12 +61,13 @@ class Output:
             print(text, flush=True)
 
     def finish(self, outcomes, unused, errors) -> None:
-        """errors: (name, message) of the scenarios that could not be checked."""
-        if self.junit:
-            write_junit(self.junit, outcomes, errors)
+        """errors: (name, message) of the scenarios that could not be checked. The JSON summary
+        is printed before the JUnit file is written, so a file that cannot be written (an
+        OSError, raised) leaves the summary whole."""
         if self.json:
-            names = [name for name, _m in errors]
-            doc = report.summary_dict(outcomes, unused, Path.cwd(), names)
+            doc = report.summary_dict(outcomes, unused, Path.cwd(), errors)
             json.dump(doc, sys.stdout, indent=2)
             sys.stdout.write("\n")
             sys.stdout.flush()
+        if self.junit:
+            write_junit(self.junit, outcomes, errors)

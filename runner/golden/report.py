@@ -231,8 +231,10 @@ def _write_run_files(folder: Path, files: dict) -> None:
 
 def summary_dict(outcomes, unused=(), base: Path | None = None, errors=()) -> dict:
     """The summary of a check for tools (summary.json, `check --format json`): the counts, the
-    summary line, one record per scenario (by name) and the unused goldens; `errors` names the
-    scenarios an unexpected error or a refusal kept from being checked."""
+    summary line, one record per scenario (by name) and the unused goldens; `errors`, (name,
+    message) of the scenarios an unexpected error or a refusal kept from being checked (a file
+    that could not be read is named by its path), gives `not_checked` (their names) and `errors`
+    (one record each: name and message)."""
     outcomes = sorted(outcomes, key=lambda o: o.name)
     out = {
         "format": REPORT_FORMAT,
@@ -243,7 +245,9 @@ def summary_dict(outcomes, unused=(), base: Path | None = None, errors=()) -> di
         "unused_goldens": list(unused),
     }
     if errors:
-        out["not_checked"] = list(errors)
+        errors = sorted(errors)
+        out["not_checked"] = [name for name, _message in errors]
+        out["errors"] = [{"name": name, "message": message} for name, message in errors]
     return out
 
 
@@ -256,12 +260,13 @@ def first_divergence(outcome) -> str:
     return outcome.status
 
 
-def write_index(report_dir, outcomes, unused=()) -> Path:
+def write_index(report_dir, outcomes, unused=(), errors=()) -> Path:
     """Write `report_dir/summary.json` and `report_dir/index.html` over `outcomes` (sorted by
-    name) and the unused goldens; returns the index.html path."""
+    name), the unused goldens and the scenarios not checked (`errors`, see `summary_dict`);
+    returns the index.html path."""
     folder = _real_folder(Path(report_dir))
     outcomes = sorted(outcomes, key=lambda o: o.name)
-    summary = summary_dict(outcomes, unused, folder)
+    summary = summary_dict(outcomes, unused, folder, errors)
     _refuse_link(folder / SUMMARY_FILE)
     write_json(folder / SUMMARY_FILE, summary)
     index = folder / INDEX_FILE

@@ -2,10 +2,15 @@
 
 from __future__ import annotations
 
+import errno
 import json
+import os
+import xml.etree.ElementTree as ET
+from pathlib import Path
 
 import pytest
 
+from collide2d.runner import outputs
 from collide2d.runner.golden import cli
 
 from . import synthetic
@@ -158,16 +163,76 @@ def test_bad_input_exits_2(tree, capsys, argv, error):
     assert not (tree / "goldens").exists()
 
 
-def test_a_refused_scenario_exits_2_before_anything_runs(tree, capsys):
+def test_a_refused_scenario_stops_bless_before_anything_runs(tree, capsys):
     _write(tree, "bad", error="unknown key 'tiks' (did you mean 'ticks'?)")
-    for command in ("bless", "check"):
-        assert _run(command) == 2
-        captured = capsys.readouterr()
-        assert captured.err.strip() == (
-            "scenarios/bad.yaml:1:1: error: unknown key 'tiks' (did you mean 'ticks'?)"
-        )
-        assert captured.out == ""
+    assert _run("bless") == 2
+    captured = capsys.readouterr()
+    assert captured.err.strip() == (
+        "scenarios/bad.yaml:1:1: error: unknown key 'tiks' (did you mean 'ticks'?)"
+    )
+    assert captured.out == ""
     assert not (tree / "goldens").exists()
+
+
+def _real_or_synthetic(path, **kwargs):
+    """The real scenario loader for a file that is not a synthetic (JSON) scenario."""
+    if Path(path).read_bytes().startswith(b"{"):
+        return synthetic.load(path, **kwargs)
+    return cli.default_load(path, **kwargs)
+
+
+@pytest.mark.parametrize(
+    ("data", "error"),
+    [
+        (b"version: 1\nticks: [\n", "scenarios/bad.yaml:3:1: error: invalid YAML"),
+        (b"version: 1\ntiks: 3\n", "scenarios/bad.yaml:2:1: error: unknown key 'tiks'"),
+        (b"version: 1\nname: caf\xe9\n", "scenarios/bad.yaml:2:10: error: the file is not UTF-8"),
+        (b"unreadable", "scenarios/bad.yaml:1:1: error: cannot read the file: Permission denied"),
+    ],
+    ids=["yaml", "validation", "encoding", "permissions"],
+)
+def test_check_keeps_checking_past_an_unreadable_scenario_and_files_it_as_one_case(
+    tree, capsys, monkeypatch, data, error
+):
+    """One scenario file that cannot be read is one error case in the JUnit file and the JSON
+    summary (and the report's summary.json); the others are still checked; exit 2."""
+    _write(tree, "other")
+    assert _run("bless") == 0
+    _write(tree, "other", final=[[0.0, 0.0, 0.0, 0.0]])  # differs from its golden
+    bad = tree / "scenarios" / "bad.yaml"
+    bad.write_bytes(data)
+    if data == b"unreadable":
+        import builtins
+
+        real_open = builtins.open
+
+        def refusing_open(file, *args, **kwargs):  # root reads any file: refuse as for a user
+            if Path(file).name == "bad.yaml":
+                raise PermissionError(13, "Permission denied", str(file))
+            return real_open(file, *args, **kwargs)
+
+        monkeypatch.setattr(builtins, "open", refusing_open)
+    capsys.readouterr()
+    argv = ["check", "--junit", "out.xml", "--format", "json", "--report", "rep"]
+    code = cli.main(argv, load=_real_or_synthetic, simulate=synthetic.simulate)
+    monkeypatch.undo()
+    out, err = capsys.readouterr()
+    assert code == 2
+    assert err.startswith(error), err
+    summary = json.loads(out)
+    assert (summary["passed"], summary["failed"]) == (1, 1)  # demo and other were checked
+    assert [s["name"] for s in summary["scenarios"]] == ["demo", "other"]
+    assert summary["not_checked"] == ["scenarios/bad.yaml"]
+    (record,) = summary["errors"]
+    assert record["name"] == "scenarios/bad.yaml" and record["message"].startswith(error)
+    kept = json.loads((tree / "rep" / "summary.json").read_text())
+    assert kept["errors"] == summary["errors"]
+    suite = ET.parse(tree / "out.xml").getroot()
+    assert (suite.get("tests"), suite.get("failures"), suite.get("errors")) == ("3", "1", "1")
+    cases = {c.get("name"): c for c in suite.iter("testcase")}
+    assert cases["demo"].find("failure") is None and cases["demo"].find("error") is None
+    assert cases["other"].find("failure") is not None
+    assert cases["scenarios/bad.yaml"].find("error").get("message").startswith(error)
 
 
 def test_two_scenarios_with_one_name_exit_2(tree, capsys):
@@ -201,3 +266,43 @@ def test_register_adds_both_commands():
     assert (args.scenarios, args.prune, args.quiet) == (["a", "b"], True, True)
     args = parser.parse_args(["check", "--report", "r"])
     assert args.report == "r" and callable(args.func)
+
+
+def test_a_full_disk_during_check_report_is_an_io_error_naming_the_file(tree, capsys, monkeypatch):
+    """ENOSPC while the report is written: exit 2 with the file named, never "a bug" (exit 3);
+    no temporary file is left behind."""
+    assert _run("bless") == 0
+    _write(tree, "demo", pixels=_changed_pixel())
+    (tree / "rep").mkdir()
+
+    class FullDisk:
+        def __init__(self, f):
+            self.f = f
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            self.f.close()
+
+        def write(self, data):
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    real_open = open
+
+    def full_disk_open(file, mode="r", *args, **kwargs):
+        f = real_open(file, mode, *args, **kwargs)
+        return FullDisk(f) if "w" in mode and "rep" in Path(file).parts else f
+
+    monkeypatch.setattr(outputs, "open", full_disk_open, raising=False)
+    capsys.readouterr()
+    assert _run("check", "--report", "rep") == 2
+    out, err = capsys.readouterr()
+    lines = err.splitlines()
+    assert lines[0].startswith("collide2d: error: demo: rep/demo/frame_000004_") and lines[
+        0
+    ].endswith(".png: No space left on device")
+    assert lines[-1] == "collide2d: error: rep/summary.json: No space left on device"
+    assert "unexpected" not in err and "bug" not in err
+    assert out.rstrip().endswith("0 passed, 0 failed, 1 not checked (errors above)")
+    assert [p.name for p in (tree / "rep").rglob("*") if p.is_file()] == []
