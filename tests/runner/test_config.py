@@ -124,10 +124,11 @@ def test_run_and_validate_take_the_tables_limits_and_out_folder(tmp_path, monkey
 def test_the_tables_threads_are_put_in_force_unless_the_command_line_names_some(tmp_path):
     import argparse
 
-    from collide2d.engine import threads
+    from collide2d.engine import jit, threads
     from collide2d.runner.options import apply_threads
 
     found = config.find(project(tmp_path, "[tool.collide2d]\nthreads = 1\n"))
+    jit.numba_module()  # the count is put in force once numba is loaded: load it first
     try:
         apply_threads(argparse.Namespace(threads=None), found)
         assert threads.threads() == 1
