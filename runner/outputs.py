@@ -28,7 +28,7 @@ import numpy as np
 from PIL import GifImagePlugin, Image
 
 from collide2d.engine.events import event_dict, format_event, format_number
-from collide2d.runner import swapdir
+from collide2d.runner import escape, swapdir
 
 # zlib level of every PNG (0-9): fixed so that the same pixels give the same bytes.
 PNG_COMPRESS_LEVEL = 6
@@ -480,7 +480,9 @@ def final_csv_text(pos: np.ndarray, vel: np.ndarray, names=None) -> str:
 
     pos (n, 2) px and vel (n, 2) px/s; numbers as `engine.events.format_number` writes them.
     `names` (per object, None where not given): when any object has a name, a last column `name`
-    holds it (empty for the others; CSV-quoted when it needs to be).
+    holds it (empty for the others; CSV-quoted when it needs to be; `escape.csv_cell`: a name a
+    spreadsheet would run as a formula, such as `=1+1`, gets a leading `'`, and control
+    characters but newline and tab are spelled out).
     """
     pos = np.asarray(pos, dtype=np.float64).reshape(-1, 2)
     vel = np.asarray(vel, dtype=np.float64).reshape(-1, 2)
@@ -495,7 +497,7 @@ def final_csv_text(pos: np.ndarray, vel: np.ndarray, names=None) -> str:
     if names is not None and any(names):
         lines[0] += ",name"
         for i, name in enumerate(names):
-            lines[i + 1] += "," + _csv_cell(name or "")
+            lines[i + 1] += "," + _csv_cell(escape.csv_cell(name or ""))
     return "\n".join(lines) + "\n"
 
 

@@ -29,6 +29,8 @@ from pathlib import Path
 
 import pytest
 
+from collide2d.runner import escape
+
 # Every pytest run of the project loads this plugin: the harness (numpy, Pillow, the engine) is
 # imported inside the hooks and fixtures that use it, so that it costs nothing until they run.
 
@@ -134,7 +136,7 @@ class GoldenItem(pytest.Item):
 
     def repr_failure(self, excinfo):
         if isinstance(excinfo.value, pytest.fail.Exception):
-            return str(excinfo.value)
+            return escape.visible(str(excinfo.value))  # names and golden text, never raw
         return super().repr_failure(excinfo)
 
     def reportinfo(self):
