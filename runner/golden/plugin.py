@@ -136,7 +136,7 @@ class GoldenItem(pytest.Item):
 
     def repr_failure(self, excinfo):
         if isinstance(excinfo.value, pytest.fail.Exception):
-            return escape.visible(str(excinfo.value))  # names and golden text, never raw
+            return str(excinfo.value)
         return super().repr_failure(excinfo)
 
     def reportinfo(self):
@@ -229,7 +229,7 @@ def check_golden(node, path, project, load, simulate, basetemp) -> None:
     try:
         scenario = load(shown_path(path))
     except scenario_errors() as exc:
-        pytest.fail(str(exc), pytrace=False)
+        _fail(str(exc))
     node.user_properties.append((PROP_NAME, scenario.name))
     result = run_scenario(scenario, simulate)
     store = GoldenStore(project.root, project.value("goldens"))
@@ -237,7 +237,7 @@ def check_golden(node, path, project, load, simulate, basetemp) -> None:
         try:
             blessed = bless_run(scenario, result, store)
         except GoldenError as exc:  # a symbolic link in the way
-            pytest.fail(str(exc), pytrace=False)
+            _fail(str(exc))
         node.user_properties.append((PROP_BLESSED, blessed.line()))
         return
     given = config.getoption("golden_report")
@@ -245,9 +245,15 @@ def check_golden(node, path, project, load, simulate, basetemp) -> None:
     try:
         outcome = check_run(scenario, result, store, path=path, report_dir=report_dir)
     except GoldenError as exc:  # the report folder refused (a symbolic link)
-        pytest.fail(str(exc), pytrace=False)
+        _fail(str(exc))
     if not outcome.ok:
-        pytest.fail(outcome.message(), pytrace=False)
+        _fail(outcome.message())
+
+
+def _fail(text: str) -> None:
+    """Fail the golden test with `text`, control characters spelled out (`escape.visible`): a
+    name, a file name or a golden's text never reaches the terminal raw."""
+    pytest.fail(escape.visible(text), pytrace=False)
 
 
 def pytest_terminal_summary(terminalreporter, exitstatus, config) -> None:
