@@ -7,6 +7,13 @@ would pass a limit of SPEC section 8: more frame files than `--max-frames`, more
 format allows. Everything is arithmetic on the rules, so a billion-tick run is judged without a
 list of its frames.
 
+`--max-output-bytes` bounds the event log too, but how many events a run has is known only once
+they happen: the frames' bound is settled before the first tick, and what it leaves of the limit
+(`FramePlan.log_room`) is the most `events.jsonl` may take, counted as it is written
+(`outputs.EventsWriter`); a run whose log would pass it stops there (`runner.run`). So a run's
+frame files and event log together never pass the limit, and whether a run stops depends on the
+scenario alone, not on how well its frames compress.
+
 The byte counts are upper bounds of the files as written, per-file overheads included, for any
 picture (noise too), so a run that passes never writes more:
 - a PNG is its signature, IHDR and IEND chunks, the zlib stream of its filtered rows (raw size plus
@@ -64,13 +71,15 @@ def gif_frame_bytes_bound(width: int, height: int) -> int:
 @dataclass(frozen=True)
 class FramePlan:
     """The frames a run draws: `png` those written as PNG files, `draw` every frame rasterised
-    (the PNG frames, and all of them when there is a GIF); `bytes_bound` the most they take."""
+    (the PNG frames, and all of them when there is a GIF); `bytes_bound` the most they take;
+    `log_room` the bytes `--max-output-bytes` leaves to the event log."""
 
     png: FrameRule
     gif: bool
     draw: FrameRule
     gif_frames: int
     bytes_bound: int
+    log_room: int
 
 
 def plan_frames(scenario: Scenario, *, png: bool, gif: bool, scale: int, limits: Limits):
@@ -119,4 +128,4 @@ def plan_frames(scenario: Scenario, *, png: bool, gif: bool, scale: int, limits:
             "--no-png, --no-gif, a smaller --scale) or raise --max-output-bytes"
         )
     draw = FrameRule.all(ticks) if gif else png_rule
-    return FramePlan(png_rule, gif, draw, gif_frames, total)
+    return FramePlan(png_rule, gif, draw, gif_frames, total, limits.max_output_bytes - total)

@@ -22,6 +22,7 @@ import threading
 import traceback
 from importlib import resources
 
+from collide2d.runner import escape
 from collide2d.runner.exitcodes import (
     EXIT_BAD_INPUT,
     EXIT_INTERRUPTED,
@@ -265,14 +266,19 @@ def main(argv: list[str] | None = None) -> int:
     if command is None and "--version" in argv and "-h" not in argv and "--help" not in argv:
         known, command = True, ""  # the version alone: no command's module is needed
     parser = build_parser(command if known else None)
-    args = parser.parse_args(argv)
+    with escape.visible_streams():  # names and file names never reach a terminal raw
+        args = parser.parse_args(argv)
+        if args.command in COMPILING_COMMANDS:
+            from collide2d.runner import compiling
+
+            quiet = getattr(args, "quiet", False) or not sys.stderr.isatty()
+            compiling.install(None if quiet else compile_notice)
+        return _answered(args)
+
+
+def _answered(args: argparse.Namespace) -> int:
+    """Run the command; its errors are printed and become its exit status."""
     from collide2d.runner.yamlsafe import ScenarioError
-
-    if args.command in COMPILING_COMMANDS:
-        from collide2d.runner import compiling
-
-        quiet = getattr(args, "quiet", False) or not sys.stderr.isatty()
-        compiling.install(None if quiet else compile_notice)
 
     try:
         with _ctrl_c_answered():

@@ -2,7 +2,8 @@
 
 `Limits` is read by the safe YAML reader (`runner.yamlsafe`: file size, YAML values, aliases), by
 the scenario readers (objects, ticks, world sides, frames) and by the run (`runner.budget`: output
-bytes, frame memory). It depends on nothing, so any module may import it.
+bytes, frame memory; `runner.run`: the event log's share of the output bytes). It depends on
+nothing, so any module may import it.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ class Limits:
     max_ticks: int = 10**9
     max_side: int = 16384  # px per world side
     max_alias_nodes: int = 10_000  # YAML nodes reached a second time or more through aliases
-    max_output_bytes: int = 4 * 2**30  # bytes of frame files on disk (PNG and GIF), at most
+    max_output_bytes: int = 4 * 2**30  # bytes of frame files (PNG, GIF) and event log on disk
     max_frame_bytes: int = 2**30  # bytes of one frame in memory: width x height x scale^2 x 3
     max_frames: int = 1_000_000  # frames one `frames` entry may ask for, and a run may write
     max_file_bytes: int = 64 * 2**20  # bytes of a scenario file (it is read whole)

@@ -25,7 +25,7 @@ _LIMIT_OPTIONS = (
     ("--max-yaml-nodes", "max_yaml_nodes", "YAML values in a scenario file"),
 )
 _OUTPUT_OPTIONS = (
-    ("--max-output-bytes", "max_output_bytes", "bytes of frame files (PNG and GIF) on disk"),
+    ("--max-output-bytes", "max_output_bytes", "bytes of frame files and event log on disk"),
     ("--max-frame-bytes", "max_frame_bytes", "bytes of one frame in memory (RGB, scaled)"),
 )
 

@@ -28,7 +28,7 @@ import numpy as np
 from PIL import GifImagePlugin, Image
 
 from collide2d.engine.events import event_dict, format_event, format_number
-from collide2d.runner import swapdir
+from collide2d.runner import escape, swapdir
 
 # zlib level of every PNG (0-9): fixed so that the same pixels give the same bytes.
 PNG_COMPRESS_LEVEL = 6
@@ -439,18 +439,31 @@ class GifWriter(_StreamWriter):
 # Text outputs
 
 
+class LogFull(Exception):
+    """The event log would pass the bytes it may take: `tick` is the tick of the first event
+    that did not fit, `limit` those bytes; nothing past them was written."""
+
+    def __init__(self, path: Path, limit: int, tick: int):
+        super().__init__(f"{path}: the event log would pass {limit:,} bytes at tick {tick:,}")
+        self.path, self.limit, self.tick = path, limit, tick
+
+
 class EventsWriter(_StreamWriter):
     """Streams events.jsonl: one `engine.events.format_event` line per event, in the order given.
 
     `write(events)` appends an EVENT_DTYPE array; `close` renames the file into place, `abort`
     removes it. As a context manager it closes on success and aborts on an exception. `names`
     (per object, None where not given): a named object's name follows its id, as `"name"` in a
-    wall event and `"a_name"` / `"b_name"` in a pair event.
+    wall event and `"a_name"` / `"b_name"` in a pair event. `max_bytes` (None: no bound) is the
+    most the file may hold: a `write` that would pass it raises LogFull before writing any of
+    its lines, so the file never holds more (`bytes` counts what it holds).
     """
 
-    def __init__(self, path: str | os.PathLike, names=None):
+    def __init__(self, path: str | os.PathLike, names=None, max_bytes: int | None = None):
         self._file = _StreamFile(path)
         self.count = 0
+        self.bytes = 0
+        self.max_bytes = max_bytes
         self.names = list(names) if names is not None and any(names) else None
 
     def line(self, rec) -> str:
@@ -470,9 +483,20 @@ class EventsWriter(_StreamWriter):
         # in slices, so that the text of a tick with millions of events is never held whole
         for start in range(0, len(events), EVENTS_PER_WRITE):
             part = events[start : start + EVENTS_PER_WRITE]
-            text = "".join(self.line(rec) + "\n" for rec in part)
-            self._file.write(text.encode("utf-8"))
+            data = "".join(self.line(rec) + "\n" for rec in part).encode("utf-8")
+            if self.max_bytes is not None and self.bytes + len(data) > self.max_bytes:
+                self._full(part)
+            self._file.write(data)
             self.count += len(part)
+            self.bytes += len(data)
+
+    def _full(self, part: np.ndarray) -> None:
+        """Raise LogFull naming the tick of the first event of `part` that does not fit."""
+        size = self.bytes
+        for rec in part:
+            size += len((self.line(rec) + "\n").encode("utf-8"))
+            if size > self.max_bytes:
+                raise LogFull(self.path, self.max_bytes, int(rec["tick"]))
 
 
 def final_csv_text(pos: np.ndarray, vel: np.ndarray, names=None) -> str:
@@ -480,7 +504,9 @@ def final_csv_text(pos: np.ndarray, vel: np.ndarray, names=None) -> str:
 
     pos (n, 2) px and vel (n, 2) px/s; numbers as `engine.events.format_number` writes them.
     `names` (per object, None where not given): when any object has a name, a last column `name`
-    holds it (empty for the others; CSV-quoted when it needs to be).
+    holds it (empty for the others; CSV-quoted when it needs to be; `escape.csv_cell`: a name a
+    spreadsheet would run as a formula, such as `=1+1`, gets a leading `'`, and control
+    characters but newline and tab are spelled out).
     """
     pos = np.asarray(pos, dtype=np.float64).reshape(-1, 2)
     vel = np.asarray(vel, dtype=np.float64).reshape(-1, 2)
@@ -495,7 +521,7 @@ def final_csv_text(pos: np.ndarray, vel: np.ndarray, names=None) -> str:
     if names is not None and any(names):
         lines[0] += ",name"
         for i, name in enumerate(names):
-            lines[i + 1] += "," + _csv_cell(name or "")
+            lines[i + 1] += "," + _csv_cell(escape.csv_cell(name or ""))
     return "\n".join(lines) + "\n"
 
 

@@ -9,7 +9,9 @@ names (`OVERLAYS`):
   two-stroke head;
 - `boxes`: each object's pixel extent, outlined;
 - `contacts`: a ring around each object of a wall or pair event at the frame's tick;
-- `labels`: each object's name above it (Pillow's default font, without smoothing);
+- `labels`: each object's name above it (Pillow's default font, without smoothing), on one line
+  (control characters spelled out, `runner.escape.one_line`) and at most LABEL_MAX_PX wide: a
+  longer name is cut and ends in an ellipsis;
 - `overlap` (`paper` only; other models draw nothing for it): for each pair event at the frame's
   tick, both boxes where the pair rule saw them (`engine.models.paper.Model.advance_to_response`:
   moved, before any pair took its step back) outlined in grey over the background, and their
@@ -33,6 +35,7 @@ from collide2d.engine.draw import dda_line, midpoint_circle
 from collide2d.engine.events import EV_PAIR, EV_WALL
 from collide2d.engine.raster import round_positions
 from collide2d.engine.sprites import sprites
+from collide2d.runner import escape
 from collide2d.runner.outputspec import OVERLAY_NAMES
 from collide2d.runner.scenario import ScenarioError
 
@@ -51,6 +54,9 @@ ARROW_SECONDS = 0.5
 HEAD_PX = 4
 # A contact ring's gap around the object (px).
 RING_GAP_PX = 3
+# The widest a label is drawn (px; and never wider than the frame): a longer name is cut and ends
+# in an ellipsis (about 15 characters of the default font).
+LABEL_MAX_PX = 96
 MAX_PALETTE = 256
 
 
@@ -140,6 +146,7 @@ class Overlay:
         self.ext = extents(scenario.bodies) if self.names else None
         self.staged: Staged | None = None
         self._pending: list = []
+        self._labels: list[str] | None = None
 
     @property
     def wants_events(self) -> bool:
@@ -221,12 +228,43 @@ class Overlay:
                     cy = ipos[i, 1] + (y0 + y1) // 2 - side // 2
                     pen.points(midpoint_circle(side) + (cx, cy), self.index["contacts"])
         if "labels" in self.names:
-            pen.labels(ipos, ext, _names(self.scenario), self.index["labels"])
+            if self._labels is None:  # the same for every frame
+                self._labels = labels(_names(self.scenario), min(LABEL_MAX_PX, idx.shape[1]))
+            pen.labels(ipos, ext, self._labels, self.index["labels"])
         return out
 
 
 def _names(scenario) -> list[str]:
     return [nm if nm else f"#{i}" for i, nm in enumerate(scenario.names)]
+
+
+def labels(names, max_px: int) -> list[str]:
+    """The text drawn for each name: one line, at most `max_px` wide in the default font; a
+    longer name is cut, ending in an ellipsis (`...` in a bitmap font without `…`, which also
+    draws only Latin-1: other characters become `?`)."""
+    font = ImageFont.load_default()
+    draw = ImageDraw.Draw(Image.new("1", (1, 1)))
+    outline = isinstance(font, ImageFont.FreeTypeFont)
+    ellipsis = "…" if outline else "..."
+
+    def width(text: str) -> float:
+        return draw.textlength(text, font=font)
+
+    out = []
+    for name in names:
+        text = escape.one_line(name)
+        if not outline:
+            text = text.encode("latin-1", "replace").decode("latin-1")
+        # a name of more than max_px characters is cut whatever it holds (nearly every glyph
+        # is a pixel wide or more), so that a long name is never measured whole
+        if len(text) > max_px or width(text) > max_px:
+            lo, hi = 0, min(len(text), max_px)  # the longest prefix that fits with the ellipsis
+            while lo < hi:
+                mid = (lo + hi + 1) // 2
+                lo, hi = (mid, hi) if width(text[:mid] + ellipsis) <= max_px else (lo, mid - 1)
+            text = text[:lo] + ellipsis
+        out.append(text)
+    return out
 
 
 def _centre(p, e) -> tuple[int, int]:

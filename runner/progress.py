@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import sys
 
+from collide2d.runner import escape
+
 # Seconds between redraws; runs shorter than SHOW_AFTER_S never show a bar.
 REDRAW_S = 0.2
 SHOW_AFTER_S = 0.5
@@ -23,9 +25,10 @@ class Progress:
 
         self.bar = tqdm(
             total=max(int(total), 1),
-            desc=label,
+            desc=escape.one_line(label),
             unit=unit,
-            file=stream if stream is not None else sys.stderr,
+            # the terminal itself: the bar redraws its line with carriage returns of its own
+            file=escape.raw(stream if stream is not None else sys.stderr),
             dynamic_ncols=True,
             leave=False,
             mininterval=REDRAW_S,

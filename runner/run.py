@@ -5,11 +5,14 @@ at every frame someone needs (and often enough to show progress and stream event
 those frames, and calls back with events and frames as they come. Two front ends sit on it:
 `simulate` keeps everything in memory (goldens, tests), `run_to_dir` streams the files of SPEC
 section 5 into a staging folder that replaces `OUT/NAME/` whole when the run is done, under a lock
-(`runner.rundir`), after `runner.budget` has checked what its frames will cost. Frames are a
-`FrameRule`, so nothing sized by the number of ticks is built. A model that stops a run as a
-runaway (an `engine.errors.Runaway`: the exact model's event cap or an object with no room to move,
-the stepped model's fold limit) raises `RunStopped` with a message for the user. The summary counts
-the wall and pair events whether or not they are logged (the models count them as they happen).
+(`runner.rundir`), after `runner.budget` has checked what its frames will cost; the event log is
+counted as it is written, and a run whose log would pass what the frames leave of
+`--max-output-bytes` stops there with an error, its staging folder removed (the previous run
+stays). Frames are a `FrameRule`, so nothing sized by the number of ticks is built. A model that
+stops a run as a runaway (an `engine.errors.Runaway`: the exact model's event cap or an object
+with no room to move, the stepped model's fold limit) raises `RunStopped` with a message for the
+user. The summary counts the wall and pair events whether or not they are logged (the models
+count them as they happen).
 Each run's kernels run compiled or interpreted (`runner.lanes`, by the size of the run; the
 summary's `kernels` says which). Kernels compiled during a run (a first run, before numba has
 cached them) are timed apart (`runner.compiling`): the summary's `compile_time_s` holds them and
@@ -389,7 +392,9 @@ def _write_files(scenario: Scenario, folder: Path, options: RunOptions, plan) ->
         )
         if gif.note and not options.quiet and sys.stderr.isatty():
             print(f"{scenario.name}: {gif.note}", file=sys.stderr)
-    log = outputs.EventsWriter(folder / "events.jsonl", scenario.names) if options.events else None
+    log = None
+    if options.events:  # within what the frames leave of --max-output-bytes (runner.budget)
+        log = outputs.EventsWriter(folder / "events.jsonl", scenario.names, plan.log_room)
     # the viewer refuses a run too long to view
     recorder = viewer.Recorder(scenario, layer) if options.viewer else None
     digits = max(6, len(str(scenario.ticks)))
@@ -421,9 +426,11 @@ def _write_files(scenario: Scenario, folder: Path, options: RunOptions, plan) ->
             gif.abort()
         for writer in writers:
             writer.close()
-    except BaseException:
+    except BaseException as exc:
         for writer in writers:
             writer.abort()
+        if isinstance(exc, outputs.LogFull):
+            raise _log_full(scenario, exc, plan) from None
         raise
     outputs.write_final_csv(
         folder / "final.csv", model.positions(), model.velocities(), scenario.names
@@ -432,6 +439,21 @@ def _write_files(scenario: Scenario, folder: Path, options: RunOptions, plan) ->
         outputs.atomic_write_bytes(folder / viewer.VIEWER_FILE, recorder.page())
     outputs.write_json(folder / "summary.json", summary)
     return summary
+
+
+def _log_full(scenario: Scenario, full, plan) -> ScenarioError:
+    """The refusal of a run whose event log passed its share of --max-output-bytes."""
+    limit = f"the output limit of {plan.bytes_bound + full.limit:,} bytes"
+    if plan.bytes_bound:
+        limit = f"the {full.limit:,} bytes {limit} leaves it after the frames' {plan.bytes_bound:,}"
+    return ScenarioError(
+        scenario.path or "<scenario>",
+        1,
+        1,
+        f"the run stopped at tick {full.tick:,} of {scenario.ticks:,}: its event log would pass "
+        f"{limit}; no file of it was kept (a previous run stays as it was). Log fewer events "
+        "(--no-events, fewer ticks or objects) or raise --max-output-bytes",
+    )
 
 
 def _tee(write, recorder):

@@ -26,7 +26,6 @@ first tick: its viewer would not open quickly.
 from __future__ import annotations
 
 import base64
-import json
 import zlib
 
 import numpy as np
@@ -34,6 +33,7 @@ import numpy as np
 from collide2d.engine.events import EV_WALL, event_dict
 from collide2d.engine.raster import round_positions
 from collide2d.engine.sprites import sprites
+from collide2d.runner import escape
 from collide2d.runner.scenario import ScenarioError
 
 VIEWER_FILE = "viewer.html"
@@ -155,5 +155,6 @@ class Recorder:
 
 
 def data_json(data: dict) -> str:
-    """JSON of the viewer's data safe inside a <script> element."""
-    return json.dumps(data, separators=(",", ":")).replace("</", "<\\/")
+    """JSON of the viewer's data safe inside a <script> element (`escape.script_json`: no name
+    can end the element or open a comment in it)."""
+    return escape.script_json(data)

@@ -1,5 +1,7 @@
 """The reports of `collide2d bench`: bench.csv (one row per measurement, the columns of `COLUMNS`)
-and bench.md (the headline ratios first, then one table per part).
+and bench.md (the headline ratios first, then one table per part). Cells go through
+`runner.escape`: no text cell of bench.csv runs as a spreadsheet formula, no cell of bench.md
+breaks its table row.
 """
 
 from __future__ import annotations
@@ -8,6 +10,7 @@ import os
 
 import numpy as np
 
+from collide2d.runner import escape
 from collide2d.runner.bench import goals
 from collide2d.runner.bench.error import NUDGE_PX_S
 from collide2d.runner.bench.scenes import (
@@ -92,7 +95,7 @@ def csv_text(rows: list[dict]) -> str:
     writer = csv.writer(buf, lineterminator="\n")
     writer.writerow(COLUMNS)
     for r in rows:
-        writer.writerow([_cell(r.get(c)) for c in COLUMNS])
+        writer.writerow([_cell(escape.csv_cell(r.get(c))) for c in COLUMNS])
     return buf.getvalue()
 
 
@@ -119,8 +122,9 @@ def _range(r) -> str:
 
 
 def _table(header: list[str], lines: list[list]) -> list[str]:
-    out = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    out += ["| " + " | ".join(_fmt(v) for v in line) + " |" for line in lines]
+    cell = escape.markdown_cell
+    out = ["| " + " | ".join(cell(h) for h in header) + " |", "|" + "---|" * len(header)]
+    out += ["| " + " | ".join(cell(_fmt(v)) for v in line) + " |" for line in lines]
     return out
 
 

@@ -4,8 +4,10 @@ One `testsuite` named `collide2d.check` with one `testcase` per scenario (classn
 name the scenario's name). A scenario that differs from its golden (or whose golden is missing or
 unreadable) holds a `failure` whose message is its first divergence (`report.first_divergence`)
 and whose text is the console story, why it changed included; a scenario an unexpected error or
-a refusal kept from being checked holds an `error`. The file is written atomically; the same
-outcomes give the same bytes (no timestamps, no host names).
+a refusal kept from being checked holds an `error`. Every text passes through `escape.visible`, so
+the file is valid XML 1.0 whatever a name, a file name or a golden holds (control characters are
+spelled out: XML forbids them even as character references). The file is written atomically; the
+same outcomes give the same bytes (no timestamps, no host names).
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+from collide2d.runner.escape import visible
 from collide2d.runner.golden.report import STATUS_FAILED, first_divergence
 from collide2d.runner.outputs import atomic_write_bytes
 
@@ -32,16 +35,20 @@ def junit_xml(outcomes, errors=()) -> bytes:
         errors=str(len(errors)),
         skipped="0",
     )
+    v = visible
     for o in outcomes:
-        case = ET.SubElement(suite, "testcase", classname=CLASS_NAME, name=o.name, file=o.scenario)
+        case = ET.SubElement(
+            suite, "testcase", classname=CLASS_NAME, name=v(o.name), file=v(o.scenario)
+        )
         if not o.ok:
             kind = "difference" if o.status == STATUS_FAILED else o.status
-            failure = ET.SubElement(case, "failure", message=first_divergence(o), type=kind)
-            failure.text = o.message()
+            failure = ET.SubElement(case, "failure", message=v(first_divergence(o)), type=v(kind))
+            failure.text = v(o.message())
     for name, message in errors:
-        case = ET.SubElement(suite, "testcase", classname=CLASS_NAME, name=name)
-        err = ET.SubElement(case, "error", message=message.splitlines()[0] if message else "")
-        err.text = message
+        case = ET.SubElement(suite, "testcase", classname=CLASS_NAME, name=v(name))
+        first = message.splitlines()[0] if message else ""
+        err = ET.SubElement(case, "error", message=v(first))
+        err.text = v(message)
     ET.indent(suite)
     return ET.tostring(suite, encoding="utf-8", xml_declaration=True) + b"\n"
 

@@ -32,6 +32,8 @@ from pathlib import Path
 
 import pytest
 
+from collide2d.runner import escape
+
 # Every pytest run of the project loads this plugin: the harness (numpy, Pillow, the engine) is
 # imported inside the hooks and fixtures that use it, so that it costs nothing until they run.
 
@@ -250,10 +252,10 @@ def check_golden(node, path, project, load, simulate, basetemp) -> None:
     try:
         scenario = load(shown_path(path))
     except scenario_errors() as exc:
-        pytest.fail(str(exc), pytrace=False)
+        _fail(str(exc))
     refusal = _same_name(config, project, load, Path(path), scenario.name)
     if refusal is not None:  # as `collide2d check` and `bless` refuse it: no golden is written
-        pytest.fail(refusal, pytrace=False)
+        _fail(refusal)
     node.user_properties.append((PROP_NAME, scenario.name))
     result = run_scenario(scenario, simulate)
     store = GoldenStore(project.root, project.value("goldens"))
@@ -261,7 +263,7 @@ def check_golden(node, path, project, load, simulate, basetemp) -> None:
         try:
             blessed = bless_run(scenario, result, store)
         except GoldenError as exc:  # a symbolic link in the way
-            pytest.fail(str(exc), pytrace=False)
+            _fail(str(exc))
         node.user_properties.append((PROP_BLESSED, blessed.line()))
         return
     given = config.getoption("golden_report")
@@ -269,9 +271,15 @@ def check_golden(node, path, project, load, simulate, basetemp) -> None:
     try:
         outcome = check_run(scenario, result, store, path=path, report_dir=report_dir)
     except GoldenError as exc:  # the report folder refused (a symbolic link)
-        pytest.fail(str(exc), pytrace=False)
+        _fail(str(exc))
     if not outcome.ok:
-        pytest.fail(outcome.message(), pytrace=False)
+        _fail(outcome.message())
+
+
+def _fail(text: str) -> None:
+    """Fail the golden test with `text`, control characters spelled out (`escape.visible`): a
+    name, a file name or a golden's text never reaches the terminal raw."""
+    pytest.fail(escape.visible(text), pytrace=False)
 
 
 # The names of the scenario files of the project's scenarios folder, read once a session.

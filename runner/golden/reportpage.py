@@ -2,7 +2,8 @@
 
 Input: `report.Outcome`s (with their frames and texts) and the report folder. Output: the bytes of
 `index.html`. Every image is inline (PNG data URIs) and the script and styles are inline, so the
-file opens anywhere with no network and no other file.
+file opens anywhere with no network and no other file. Every text from a scenario, a file name or
+a golden goes through `_html`.
 
 What the page shows, top to bottom: a summary line (`1 failed, 18 passed`), a "failures only"
 filter and the keys; then one section per scenario, failures first (each group by name). A failed
@@ -25,6 +26,7 @@ import json
 
 import numpy as np
 
+from collide2d.runner.escape import visible
 from collide2d.runner.golden import compare
 from collide2d.runner.golden import serialize as ser
 from collide2d.runner.outputs import encode_png
@@ -40,6 +42,12 @@ ZOOM_BELOW_PX = 480
 # Event rows shown before and after the first divergence.
 EVENT_CONTEXT = 3
 VIEWS = ("side", "blink", "slider", "diff")
+
+
+def _html(text) -> str:
+    """`text` as page text: HTML-escaped, with control characters and a file name's undecodable
+    bytes spelled out (`escape.visible`), so that any name, file name or golden text shows."""
+    return html.escape(visible(str(text)))
 
 
 def summary_line(outcomes) -> str:
@@ -87,10 +95,10 @@ def page(title: str, outcomes, unused=()) -> bytes:
         "<!DOCTYPE html>",
         '<html lang="en"><head><meta charset="utf-8">',
         '<meta name="viewport" content="width=device-width">',
-        f"<title>{html.escape(title)}</title><style>{_CSS}</style></head><body>",
-        f"<h1>{html.escape(title)}</h1>",
+        f"<title>{_html(title)}</title><style>{_CSS}</style></head><body>",
+        f"<h1>{_html(title)}</h1>",
         f'<p id="summary" class="summary {"bad" if any(not o.ok for o in outcomes) else "good"}">'
-        f"{html.escape(summary_line(outcomes))}</p>",
+        f"{_html(summary_line(outcomes))}</p>",
         '<p class="bar"><label><input type="checkbox" id="only-failures"> failures only '
         "(f)</label> <span class=keys>keys: <kbd>j</kbd>/<kbd>k</kbd> next/previous frame, "
         "<kbd>n</kbd>/<kbd>p</kbd> next/previous failure, <kbd>1</kbd>-<kbd>4</kbd> side by "
@@ -99,14 +107,14 @@ def page(title: str, outcomes, unused=()) -> bytes:
         '<ul id="toc">',
     ]
     for o in outcomes:
-        name = html.escape(o.name)
+        name = _html(o.name)
         parts.append(
             f'<li class="entry" data-status="{o.status}"><a href="#sc-{name}">{name}</a> '
             f'<span class="{o.status}">{o.status}</span></li>'
         )
     parts.append("</ul>")
     if unused:
-        names = ", ".join(html.escape(n) for n in unused)
+        names = ", ".join(_html(n) for n in unused)
         parts.append(
             f"<p>Goldens no scenario uses: {names} "
             "(remove them with <code>collide2d bless --prune</code>).</p>"
@@ -117,28 +125,28 @@ def page(title: str, outcomes, unused=()) -> bytes:
 
 
 def _section(o) -> str:
-    name = html.escape(o.name)
+    name = _html(o.name)
     out = [
         f'<section class="scenario" id="sc-{name}" data-status="{o.status}">',
         f'<h2>{name} <span class="{o.status}">{o.status}</span></h2>',
-        f"<p>Scenario <code>{html.escape(o.scenario)}</code>.</p>",
+        f"<p>Scenario <code>{_html(o.scenario)}</code>.</p>",
     ]
     if o.ok:
         return "\n".join([*out, "</section>"])
     if o.cause is not None:
         out.append(
-            f'<p class="why" data-kind="{html.escape(o.cause.kind)}"><b>Why it changed:</b> '
-            f"{html.escape(o.cause.text)}</p>"
+            f'<p class="why" data-kind="{_html(o.cause.kind)}"><b>Why it changed:</b> '
+            f"{_html(o.cause.text)}</p>"
         )
     texts = [p for p in o.problems if isinstance(p, str)]
     if texts:
-        out.append('<pre class="problems">' + html.escape("\n".join(texts)) + "</pre>")
+        out.append('<pre class="problems">' + _html("\n".join(texts)) + "</pre>")
     table = _event_table(o)
     if table:
         out.append(table)
     for fr in o.frames:
         out.append(_frame_block(o.name, fr))
-    out.append(f"<p>To accept this run: <code>{html.escape(o.bless)}</code></p>")
+    out.append(f"<p>To accept this run: <code>{_html(o.bless)}</code></p>")
     out.append("</section>")
     return "\n".join(out)
 
@@ -182,13 +190,13 @@ def _event_cell(ev) -> str:
         return "<i>(none)</i>"
     extra = {k: v for k, v in ev.items() if k not in ("tick", "type", "a", "b", "id")}
     tail = " ".join(f"{k}={json.dumps(v)}" for k, v in extra.items())
-    return f"{html.escape(compare.event_label(ev))} <small>{html.escape(tail)}</small>"
+    return f"{_html(compare.event_label(ev))} <small>{_html(tail)}</small>"
 
 
 def _frame_block(name: str, fr) -> str:
-    key = html.escape(f"{name}-{fr.frame}")
+    key = _html(f"{name}-{fr.frame}")
     head = f'<div class="frame" id="f-{key}" data-view="side" tabindex="-1">'
-    msg = f"<p class=msg>{html.escape(fr.message)}</p>"
+    msg = f"<p class=msg>{_html(fr.message)}</p>"
     exp, act, d = fr.expected, fr.actual, fr.diff
     if d is None or d.size_mismatch or d.bbox is None:
         figures = [
@@ -234,7 +242,7 @@ def _frame_block(name: str, fr) -> str:
         + '<div class="panel slider"><input type="range" min="0" max="100" value="50" '
         + f'style="width:{cw}px" aria-label="slider"></div>'
         + f'<div class="panel diff"><img {size} src="{crops["diff"]}" alt="diff"></div>'
-        + f"<p class=caption>{html.escape(crop_caption)}</p></div>"
+        + f"<p class=caption>{_html(crop_caption)}</p></div>"
         + '<div class="fulls">'
         + _figure(act, "this run, full frame", box)
         + "</div></div>"
@@ -254,7 +262,7 @@ def _figure(rgb, caption: str, box=None) -> str:
     return (
         f'<figure><div class="full" style="width:{w * zoom}px;height:{h * zoom}px">'
         f'<img src="{_uri(rgb)}" width="{w * zoom}" height="{h * zoom}" alt="{caption}">'
-        f"{mark}</div><figcaption>{html.escape(caption)} ({w}x{h})</figcaption></figure>"
+        f"{mark}</div><figcaption>{_html(caption)} ({w}x{h})</figcaption></figure>"
     )
 
 

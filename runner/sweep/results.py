@@ -10,8 +10,10 @@ benchmark's one definition (`runner.bench.error.position_error`).
 
 `write(folder, ...)` writes `results.csv` (the parameter columns, then `FIGURES`; `run_time_s`, the
 wall time, is the last column and the only one that changes between two sweeps), `results.md` (one
-table per scenario), `sweep.json` (runs asked, done, complete or not) and, with the `plot` extra and
-position errors, `runtime_vs_error.png` (the benchmark's plot). Every file is replaced atomically.
+table per scenario), both safe to open whatever a value holds (`runner.escape`: no text cell runs
+as a spreadsheet formula, no cell breaks its markdown row), `sweep.json` (runs asked, done,
+complete or not) and, with the `plot` extra and position errors, `runtime_vs_error.png` (the
+benchmark's plot). Every file is replaced atomically.
 """
 
 from __future__ import annotations
@@ -21,7 +23,7 @@ import io
 import json
 from pathlib import Path
 
-from collide2d.runner import outputs
+from collide2d.runner import escape, outputs
 from collide2d.runner.bench.error import mark_pareto, position_error
 
 FIGURES = (
@@ -91,7 +93,7 @@ def csv_text(columns: list[str], table: list[dict]) -> str:
     header = list(columns) + list(FIGURES)
     writer.writerow(header)
     for row in table:
-        writer.writerow([_text(row[c]) for c in header])
+        writer.writerow([_text(escape.csv_cell(row[c])) for c in header])
     return buf.getvalue()
 
 
@@ -107,17 +109,18 @@ def markdown(columns: list[str], table: list[dict], total: int, complete: bool) 
     shown = [c for c in columns if c != "scenario"] + [c for c in FIGURES if c != "note"]
     for scenario in dict.fromkeys(r["scenario"] for r in table):
         mine = [r for r in table if r["scenario"] == scenario]
-        lines += ["", f"## {scenario}", ""]
-        lines.append("| " + " | ".join(shown) + " |")
+        lines += ["", f"## {escape.one_line(scenario)}", ""]
+        lines.append("| " + " | ".join(escape.markdown_cell(c) for c in shown) + " |")
         lines.append("|" + "---|" * len(shown))
         for r in mine:
-            lines.append("| " + " | ".join(_text(r[c], 4) for c in shown) + " |")
+            cells = (escape.markdown_cell(_text(r[c], 4)) for c in shown)
+            lines.append("| " + " | ".join(cells) + " |")
         notes = [r for r in mine if r["note"]]
         if notes:
             lines.append("")
             for r in notes:
                 said = ", ".join(f"{c}={r[c]}" for c in columns if c != "scenario" and r[c])
-                lines.append(f"- {said}: {r['note']}")
+                lines.append(escape.one_line(f"- {said}: {r['note']}"))
     return "\n".join(lines) + "\n"
 
 

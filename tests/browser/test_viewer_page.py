@@ -140,3 +140,24 @@ def test_paper_overlap_before_the_undo_is_shown_at_its_tick(clean_page, tmp_path
     assert (xs.min(), xs.max(), ys.min(), ys.max()) == (104, 119, 110, 110)
     clean_page.locator("#ov-overlap").uncheck()
     assert not (shot(canvas) == (255, 0, 0)).all(axis=2).any()
+
+
+def test_a_name_that_opens_a_comment_or_a_script_leaves_the_viewer_working(clean_page, tmp_path):
+    """Found by hardening: an object named `<!--<script>` kept the viewer from starting."""
+    names = ["<!--<script>", "</script><script>document.body.dataset.pwned=1</script>"]
+    objects = "".join(
+        f"  - {{shape: box, size: 4, position: [{10 * i + 2}, 4], velocity: [5, 0], "
+        f"name: '{name}'}}\n"
+        for i, name in enumerate(names)
+    )
+    path = tmp_path / "names.yaml"
+    path.write_text(f"version: 1\nworld: {{width: 40, height: 20}}\nticks: 5\nobjects:\n{objects}")
+    argv = ["run", str(path), "--out", str(tmp_path / "out"), "--viewer", "--no-gif", "--quiet"]
+    assert cli.main(argv) == 0
+    _open(clean_page, (tmp_path / "out" / "names" / "viewer.html").as_uri())
+    assert clean_page.locator("#status").text_content() == "6 frames"
+    assert clean_page.locator("body").get_attribute("data-pwned") is None
+    assert (
+        clean_page.evaluate("JSON.parse(document.getElementById('data').textContent).names")
+        == names
+    )

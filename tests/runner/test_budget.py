@@ -106,6 +106,7 @@ def test_output_bytes_on_disk_stay_within_the_limit_that_lets_a_run_through(
         sc, png="--png" in flags, gif=True, scale=scale, limits=Limits(max_output_bytes=2**62)
     )
     out = tmp_path / "out"
+    flags = [*flags, "--no-events"]  # the frames alone: the event log takes the rest of a limit
     limit = ["--max-output-bytes", str(plan.bytes_bound - 1)]
     assert main(["run", str(path), "--out", str(out), "--quiet", *flags, *limit]) == 2
     assert "past the output limit" in capsys.readouterr().err and not out.exists()
@@ -144,3 +145,44 @@ def test_max_frames_counts_the_frames_a_gif_shows(tmp_path, capsys):
     assert main(["run", str(path), "--out", str(out), "--quiet", "--max-frames", "4"]) == 2
     assert "5 GIF frames, past the limit of 4" in capsys.readouterr().err
     assert main(["run", str(path), "--out", str(out), "--quiet", "--max-frames", "5"]) == 0
+
+
+DENSE = """version: 1
+name: dense
+world: {width: 24, height: 24, fps: 60}
+ticks: 600
+generate:
+  - {count: 60, shape: box, size: 1, speed: 40, seed: 3}
+output: {frames: last, gif: false, events: true}
+"""
+
+
+def test_the_event_log_counts_in_max_output_bytes(tmp_path, capsys):
+    """Found by hardening: a 1 MB scenario (many objects in a tight box) wrote 300 MB of events
+    a second whatever --max-output-bytes said. The log takes what the frames' bound leaves: a
+    limit that holds the frames and the whole log lets the run through, one byte less stops it
+    and keeps the previous run as it was."""
+    path = tmp_path / "dense.yaml"
+    path.write_text(DENSE)
+    frames = budget.plan_frames(
+        load(path), png=True, gif=False, scale=1, limits=Limits(max_output_bytes=2**62)
+    ).bytes_bound
+    out = tmp_path / "out"
+    argv = ["run", str(path), "--out", str(out), "--quiet", "--png", "--max-output-bytes"]
+    assert main([*argv, str(2**62)]) == 0
+    log = (out / "dense" / "events.jsonl").read_bytes()
+    assert len(log) > 100_000  # a log far larger than the frames
+
+    assert main([*argv, str(frames + len(log))]) == 0
+    assert (out / "dense" / "events.jsonl").read_bytes() == log
+    before = {p: p.read_bytes() for p in (out / "dense").rglob("*") if p.is_file()}
+    capsys.readouterr()
+
+    assert main([*argv, str(frames + len(log) - 1)]) == 2
+    err = capsys.readouterr().err
+    assert f"{path}:1:1: error: the run stopped at tick " in err
+    assert f"its event log would pass the {len(log) - 1:,} bytes" in err
+    assert "--max-output-bytes" in err
+    after = {p: p.read_bytes() for p in (out / "dense").rglob("*") if p.is_file()}
+    assert after == before  # the previous run, whole
+    assert sorted(p.name for p in out.iterdir()) == ["dense"]  # no staging folder, no lock left

@@ -21,7 +21,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from PIL import Image, ImageSequence
 
-from collide2d.engine.events import AXIS_X, EV_PAIR, EV_WALL, SIDE_LEFT, empty_events
+from collide2d.engine.events import (
+    AXIS_X,
+    EV_PAIR,
+    EV_WALL,
+    SIDE_LEFT,
+    empty_events,
+    format_event,
+)
 from collide2d.runner import outputs
 
 PALETTE = np.array(
@@ -380,6 +387,25 @@ def test_events_writer_abort_keeps_old_log(tmp_path):
         raise RuntimeError
     assert path.read_text() == "old\n"
     assert listing(tmp_path) == ["events.jsonl"]
+
+
+def test_events_writer_never_passes_its_bound(tmp_path):
+    path = tmp_path / "events.jsonl"
+    path.write_text("old\n")
+    ev = pair_and_wall_events()
+    whole = sum(len(format_event(r)) + 1 for r in ev)
+    with outputs.EventsWriter(path, max_bytes=whole) as log:
+        log.write(ev)
+    assert log.bytes == whole == len(path.read_bytes())
+    path.write_text("old\n")
+    log = outputs.EventsWriter(path, max_bytes=whole - 1)
+    with pytest.raises(outputs.LogFull) as caught, log:
+        log.write(ev[:1])
+        log.write(ev[1:])
+    assert (caught.value.tick, caught.value.limit) == (9, whole - 1)  # the wall event's tick
+    assert log.bytes < whole - 1 and log.count == 1
+    assert path.read_text() == "old\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["events.jsonl"]
 
 
 def test_empty_events_log_is_an_empty_file(tmp_path):

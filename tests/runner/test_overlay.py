@@ -12,7 +12,7 @@ from PIL import Image
 
 from collide2d.engine import models
 from collide2d.runner import cli
-from collide2d.runner.overlay import COLORS, Overlay, Staged
+from collide2d.runner.overlay import COLORS, LABEL_MAX_PX, Overlay, Staged, labels
 from collide2d.runner.run import drive, simulate
 from collide2d.runner.scenario import ScenarioError, load, loads
 
@@ -87,6 +87,26 @@ def test_overlays_draw_in_their_colours_over_a_copy():
         rgb[129, 150:156] == COLORS["boxes"]
     ).all()
     assert (rgb[100:130, 150] == COLORS["boxes"]).all()
+
+
+def test_a_long_name_is_cut_with_an_ellipsis_instead_of_overflowing():
+    """Found by hardening: a 5,000-character name ran its label off the frame."""
+    long, short = "W" * 5000, "ab"
+    scn = loads(
+        "version: 1\nworld: {width: 400, height: 40}\nticks: 1\nobjects:\n"
+        f"  - {{shape: box, size: 2, position: [10, 30], name: {long}}}\n"
+        f"  - {{shape: box, size: 2, position: [300, 30], name: {short}}}\n"
+        '  - {shape: box, size: 2, position: [350, 30], name: "x\\e[2J\\ny"}\n'
+    )
+    layer = Overlay(scn, ("labels",))
+    seen = {}
+    drive(scn, frames=(0,), on_frame=lambda k, idx: seen.setdefault(k, idx.copy()), overlay=layer)
+    cols = np.nonzero((seen[0] == len(scn.palette)).any(axis=0))[0]
+    left = cols[cols < 250]  # the long name's label
+    assert 10 <= left.min() and left.max() < 10 + LABEL_MAX_PX
+    cut, kept, one_line = labels(scn.names, LABEL_MAX_PX)
+    assert cut.endswith(("…", "...")) and long.startswith(cut.rstrip(".…"))
+    assert len(cut) > 5 and kept == short and one_line == "x\\x1b[2J\\ny"
 
 
 def test_contacts_ring_the_objects_of_an_event_at_the_frame():

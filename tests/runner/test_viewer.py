@@ -121,6 +121,27 @@ def test_output_viewer_in_the_scenario_and_the_flag(tmp_path):
     assert not (tmp_path / "out" / "v" / "viewer.html").exists()
 
 
+def test_no_name_can_end_or_comment_out_the_viewers_data(tmp_path):
+    """Found by hardening: an object named `<!--<script>` kept the viewer from starting (the
+    browser read the rest of the page as the data's script). The data holds no `<`, `>` or `&`
+    as such, and reads back the very names."""
+    names = ["<!--<script>", "</script><script>alert(1)</script>", "a & b", "]]> -->", "</SCRIPT "]
+    objects = "".join(
+        f"  - {{shape: box, size: 2, position: [{4 * i}, 4], name: {json.dumps(name)}}}\n"
+        for i, name in enumerate(names)
+    )
+    path = tmp_path / "v.yaml"
+    path.write_text(f"version: 1\nworld: {{width: 40, height: 20}}\nticks: 3\nobjects:\n{objects}")
+    out = tmp_path / "out"
+    assert cli.main(["run", str(path), "--out", str(out), "--quiet", "--viewer", "--no-gif"]) == 0
+    page = (out / "v" / "viewer.html").read_text()
+    head = '<script id="data" type="application/json">'
+    data = page[page.index(head) + len(head) :]
+    data = data[: data.index("</script>")]
+    assert not set("<>&") & set(data)
+    assert json.loads(data)["names"] == names
+
+
 def test_ten_thousand_frames_of_fifty_objects_stay_small(tmp_path):
     argv = [
         "run",

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import hashlib
 import json
 from pathlib import Path
 
@@ -88,6 +89,24 @@ def test_a_difference_fails_with_the_check_message_and_a_report(project):
     )
     summary = json.loads((rep / "b" / "summary.json").read_text())
     assert summary["frames"][0]["n_diff"] == 1
+
+
+def test_a_golden_text_reaches_the_terminal_spelled_out(project):
+    """Found by hardening: a control character in a golden's text went raw into pytest's report
+    (an escape sequence there clears the terminal)."""
+    project.runpytest("--update-goldens").assert_outcomes(passed=2)
+    events = project.path / "goldens" / "b" / "events.jsonl"
+    rows = [json.loads(line) for line in events.read_text().splitlines()]
+    rows[0]["type"] = "pa\x1b[2Jir"
+    events.write_text("".join(json.dumps(r) + "\n" for r in rows))
+    manifest = project.path / "goldens" / "b" / "manifest.json"
+    data = json.loads(manifest.read_text())
+    data["events"]["sha256"] = hashlib.sha256(events.read_bytes()).hexdigest()
+    manifest.write_text(json.dumps(data, indent=2) + "\n")
+    result = project.runpytest()
+    result.assert_outcomes(passed=1, failed=1)
+    out = result.stdout.str()
+    assert "pa\\x1b[2Jir" in out and "\x1b[2J" not in out
 
 
 def test_update_goldens_is_refused_in_ci(project, monkeypatch):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import base64
 import json
+import os
 import re
 
 import numpy as np
@@ -163,6 +164,18 @@ def test_html_escapes_what_it_shows(tmp_path):
     out.problems[0] = "events: <b>&"
     page = report.write_scenario(tmp_path, out).read_text()
     assert "<b>&" not in page and "&lt;b&gt;&amp;" in page
+
+
+def test_a_file_name_of_any_bytes_shows_on_the_page(tmp_path):
+    """Found by hardening: a scenario file name holding a byte that is not UTF-8 (or a control
+    character) made writing the report page a crash, exit 3."""
+    scenario = os.fsdecode(b"scenarios/d\x1b[2J\xffemo.yaml")
+    out = _failed_outcome()
+    out.scenario, out.bless = scenario, f"collide2d bless {scenario}"
+    out.problems[0] = "events: type differs (golden pa\x1b[2Jir\x00)"
+    page = report.write_scenario(tmp_path, out).read_text()
+    assert "<code>scenarios/d\\x1b[2J\\xffemo.yaml</code>" in page
+    assert "golden pa\\x1b[2Jir\\x00" in page and "\x1b" not in page
 
 
 def test_message_lists_problems_paths_and_command(tmp_path, monkeypatch):

@@ -5,10 +5,11 @@ on a project tree of synthetic scenarios."""
 from __future__ import annotations
 
 import json
+import os
 import xml.etree.ElementTree as ET
 
 from collide2d import __version__
-from collide2d.runner.golden import cli, why
+from collide2d.runner.golden import cli, junit, why
 
 from . import synthetic
 
@@ -103,6 +104,29 @@ def test_junit_has_one_case_per_scenario_and_the_first_divergence(tree, capsys):
     first = (tree / "out.xml").read_bytes()
     assert _run("check", "--junit", "out.xml") == 1
     assert (tree / "out.xml").read_bytes() == first  # same outcomes, same bytes
+
+
+def test_junit_is_valid_xml_whatever_a_name_file_name_or_golden_holds(tree, capsys):
+    """Found by hardening: a control character in a golden's text (or a name, or a file name)
+    went into the JUnit file as such, which XML 1.0 forbids: CI could not read the file."""
+    import hashlib
+
+    assert _run("bless") == 0
+    events = tree / "goldens" / "demo" / "events.jsonl"
+    rows = [json.loads(line) for line in events.read_text().splitlines()]
+    rows[0]["type"] = "pa\x1b[2Jir\x00"
+    events.write_text("".join(json.dumps(r) + "\n" for r in rows))
+    digest = hashlib.sha256(events.read_bytes()).hexdigest()
+    _edit_manifest(tree, "demo", events={"file": "events.jsonl", "count": 2, "sha256": digest})
+    assert _run("check", "--junit", "out.xml") == 1
+    failure = ET.parse(tree / "out.xml").getroot().find("testcase/failure")
+    assert "pa\\x1b[2Jir\\x00" in failure.get("message") and "\\x1b" in failure.text
+
+    bad = os.fsdecode(b"scenarios/b\x01d\xff.yaml")  # a byte that is not UTF-8, too
+    suite = ET.fromstring(junit.junit_xml([], [(bad, f"{bad}:1:1: error: \x1b[2J\x0c")]))
+    error = suite.find("testcase/error")
+    assert suite.find("testcase").get("name") == "scenarios/b\\x01d\\xff.yaml"
+    assert error.text == "scenarios/b\\x01d\\xff.yaml:1:1: error: \\x1b[2J\\x0c"
 
 
 def test_junit_refuses_a_link(tree, capsys):
