@@ -202,7 +202,7 @@ class Scenario:
     lines: tuple[int, ...]  # per object, the 1-based YAML line it came from
     output: Output
     golden: Golden
-    text_sha256: str  # of the file's bytes
+    text_sha256: str  # of the file's bytes; with a table, of both (`with_table`)
     # the exact model's cap: --max-events-per-tick, else the model option, else the default
     max_events_per_tick: int = DEFAULT_MAX_EVENTS_PER_TICK
 
@@ -238,6 +238,13 @@ def loads(
     ys.check_length(len(text), path, limits)  # characters: never more than the UTF-8 bytes
     digest = hashlib.sha256(text.encode("utf-8", "surrogatepass")).hexdigest()
     return _Reader(path, None, overrides, limits, defaults).scenario(text, digest)
+
+
+def with_table(text_sha256: str, table_sha256: str) -> str:
+    """The hash of a scenario whose objects come from a table: the file's and the table's hashes
+    hashed together, so that goldens and reports see an edit of the table as an edit of the
+    scenario. A scenario without a table keeps the hash of its file's bytes alone."""
+    return hashlib.sha256(f"{text_sha256} {table_sha256}".encode("ascii")).hexdigest()
 
 
 class _Reader(Nodes):
@@ -317,6 +324,8 @@ class _Reader(Nodes):
         bodies, names, lines, palette = assemble.bodies(
             self, listed, blocks, world, background, geometry, table
         )
+        if table is not None and table.sha256 is not None:
+            digest = with_table(digest, table.sha256)
         if model == "exact":
             self.room(world, bodies, geometry, names, listed, lines, table)
         return Scenario(
