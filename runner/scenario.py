@@ -396,13 +396,15 @@ class _Reader(Nodes):
                 side[key] = default
                 continue
             node = m[key][1]
-            v = self.integer(node, f"world.{key}", lo=1, of=" of pixels", unit=" px")
-            if v > self.limits.max_side:
+            # no bound but the side's own, so that the message names the one that holds
+            v = self.integer(node, f"world.{key}", lo=1, hi=math.inf, of=" of pixels", unit=" px")
+            bound = min(self.limits.max_side, MAX_INTEGER)
+            if v > bound:
+                shown = str(v) if len(str(v)) <= 24 else node.value  # 1e308, not its 309 digits
                 raise self.error(
                     node,
-                    f"world.{key} {v} is past the limit of "
-                    f"{self.limits.max_side} px per side; raise it with "
-                    "--max-side",
+                    f"world.{key} {shown} is past the limit of {bound} px per side; raise it "
+                    "with --max-side",
                 )
             side[key] = v
         fps_node = m["fps"][1] if "fps" in m else None
