@@ -13,7 +13,9 @@ short in silence (`runner.table` refuses it). A header with no rows is a table o
 numpy refuses a row, the cell is found again with Python's csv module (its field size limit
 raised to the text's length for that reading, so a long cell is read like any other): a row of the
 wrong length, or a number numpy does not read (`NUMBER_RE`: decimal, exponent, `inf`, `nan`; not
-`1_000`, not `0x10`, not full-width digits).
+`1_000`, not `0x10`, not full-width digits). A quote that opens a field and is never closed would
+take the rest of the file into that field, rows and all: it is refused where it opens (looked for
+only when fewer rows were read than the text has lines, or when numpy refused the text).
 
 `.npy`: the header is read from the bytes first; a one-dimensional structured array of numbers
 and text (no objects, so no pickles), whose rows at their item size must fill the rest of the file
@@ -144,14 +146,21 @@ def read_csv(raw: bytes, shown: str, limits: Limits):
         )
     except ValueError:
         raise _first_bad_cell(text, header, place) from None
+    if data.shape[0] < rows:  # blank lines, or a record over several lines: is a quote left open?
+        open_at = _records(text)[1]
+        if open_at is not None:
+            raise _unclosed(text, shown, open_at)
     return data, place
 
 
-def _records(text: str) -> list[tuple[int, int, list[str]]]:
-    """(data row from 0, line from 1, fields) of each CSV record after the header, blank lines
-    skipped as numpy.loadtxt skips them; a cell of any length is read (the csv module's field
-    limit raised to the text's length while it reads)."""
+def _records(text: str) -> tuple[list[tuple[int, int, list[str]]], int | None]:
+    """(data row from 0, its first line from 1, fields) of each CSV record after the header, blank
+    lines skipped as numpy.loadtxt skips them, and the line where the last record starts when a
+    quoted field of it is never closed (it runs to the end of the text, as numpy reads it too),
+    else None. A cell of any length is read: the csv module's field limit is raised to the text's
+    length while it reads."""
     out = []
+    last = None
     with _CSV_LIMIT:
         old = csv.field_size_limit()
         csv.field_size_limit(max(old, len(text) + 1))
@@ -159,33 +168,58 @@ def _records(text: str) -> list[tuple[int, int, list[str]]]:
             reader = csv.reader(io.StringIO(text))
             next(reader, None)
             k = -1
-            try:
-                for record in reader:
-                    if not record or all(not f.strip() for f in record) and len(record) <= 1:
-                        continue
+            start = reader.line_num + 1
+            for record in reader:
+                if record and not (all(not f.strip() for f in record) and len(record) <= 1):
                     k += 1
-                    out.append((k, reader.line_num, record))
-            except csv.Error:  # an unclosed quote: what was read so far stands
-                pass
+                    out.append((k, start, record))
+                    last = start
+                start = reader.line_num + 1
         finally:
             csv.field_size_limit(old)
-    return out
+    if last is None:
+        return out, None
+    tail = text.split("\n", last - 1)[-1]  # the last record, from its first line to the end
+    return out, (last if _open_quote(tail) else None)
+
+
+def _open_quote(raw: str) -> int:
+    """Character column (from 1) of a quote that opens a field of the CSV text `raw` and is never
+    closed, or 0."""
+    quoted, at, start = False, 0, True
+    i = 0
+    while i < len(raw):
+        ch = raw[i]
+        if quoted:
+            if ch == '"' and raw[i + 1 : i + 2] == '"':
+                i += 1  # "" is one quote
+            elif ch == '"':
+                quoted = False
+        elif ch == '"' and start:
+            quoted, at = True, i + 1
+        start = not quoted and ch in ",\n"
+        i += 1
+    return at if quoted else 0
 
 
 def _csv_cell(text: str, row: int, col: int) -> tuple[int, int]:
     """(line, character column) of field `col` of data row `row` (blank lines skipped, as
     numpy.loadtxt skips them), both from 1."""
-    lines = text.split("\n")
-    for k, line, record in _records(text):
+    for k, line, _record in _records(text)[0]:
         if k == row:
-            first = line - record_lines(record) + 1  # a quoted newline: the record's first line
-            return first, _field_start(lines[first - 1] if first - 1 < len(lines) else "", col)
+            return line, _field_start(text.split("\n", line)[line - 1], col)
     return 1, 1
 
 
-def record_lines(record: list[str]) -> int:
-    """Lines a CSV record spans (a quoted field may hold newlines)."""
-    return 1 + sum(f.count("\n") for f in record)
+def _unclosed(text: str, shown: str, line: int) -> ScenarioError:
+    """The error of a quoted field opened in the record starting at `line` and never closed."""
+    tail = text.split("\n", line - 1)[-1]
+    at = _open_quote(tail)
+    line += tail.count("\n", 0, at - 1)
+    col = at - (tail.rfind("\n", 0, at - 1) + 1)
+    return ScenarioError(
+        shown, line, col, 'a quoted field opens here and is never closed (a " is missing)'
+    )
 
 
 def _field_start(raw: str, col: int) -> int:
@@ -204,8 +238,10 @@ def _field_start(raw: str, col: int) -> int:
 def _first_bad_cell(text: str, header: list[str], place: Place) -> ScenarioError:
     """The error numpy met, found again cell by cell: a row of the wrong length or a number that
     is not one."""
-    for k, line, record in _records(text):
-        line = line - record_lines(record) + 1
+    records, open_at = _records(text)
+    if open_at is not None:  # the last record runs to the end inside a quote
+        records = records[:-1]
+    for k, line, record in records:
         if len(record) != len(header):
             return ScenarioError(
                 place.shown,
@@ -216,6 +252,8 @@ def _first_bad_cell(text: str, header: list[str], place: Place) -> ScenarioError
         for c, name in enumerate(header):
             if name in NUMBERS and not NUMBER_RE.fullmatch(record[c].strip()):
                 return place(k, name, f"must be a number, not {_cut(record[c].strip())!r}")
+    if open_at is not None:
+        return _unclosed(text, place.shown, open_at)
     return ScenarioError(place.shown, 1, 1, "the table cannot be read as CSV")
 
 
@@ -262,8 +300,9 @@ def read_npy(raw: bytes, shown: str, limits: Limits):
             shown,
             1,
             1,
-            f"not a whole .npy file: its header claims {shape[0]:,} rows of {dtype.itemsize:,} "
-            f"bytes ({need:,} bytes), the file holds {len(raw) - start:,} bytes after the header",
+            f"not a whole .npy file: its header claims {shape[0]:,} row(s) of "
+            f"{dtype.itemsize:,} bytes ({need:,} bytes), the file holds {len(raw) - start:,} "
+            "bytes after the header",
         )
     data = np.frombuffer(raw, dtype=dtype, count=shape[0], offset=start)
     return data, Place(shown, header, None)

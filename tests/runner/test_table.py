@@ -373,7 +373,7 @@ def test_an_npy_header_claiming_more_rows_than_the_file_holds_is_refused_unalloc
     finally:
         tracemalloc.stop()
     assert status == 2
-    assert "t.npy:1:1: error: not a whole .npy file: its header claims 100,000 rows" in err
+    assert "t.npy:1:1: error: not a whole .npy file: its header claims 100,000 row(s)" in err
     assert peak < 20 * 2**20, peak
 
 
@@ -405,3 +405,23 @@ def test_a_table_or_scenario_that_is_not_a_regular_file_is_refused_at_once(tmp_p
             f"{where}: error: cannot read the {'table' if said else 'file'}: it is a FIFO "
             "(named pipe), not a regular file\n"
         )
+
+
+@pytest.mark.parametrize(
+    "rows, line, col",
+    [
+        (['0,box,2,2,0,0,"abc', "1,box,2,2,10,0,x"], 2, 15),  # read whole, a row taken for a name
+        (["0,box,2,2,0,0,x", '1,box,2,2,10,"0,y', "2,box,2,2,20,0,z"], 3, 14),
+    ],
+)
+def test_a_quote_never_closed_is_refused_where_it_opens(tmp_path, capsys, rows, line, col):
+    text = "\n".join(["id,shape,w,h,x,y,name", *rows]) + "\n"
+    status, err = run_validate(tmp_path, capsys, text.encode())
+    assert (status, err) == (
+        2,
+        f"{tmp_path / 'bodies.csv'}:{line}:{col}: error: a quoted field opens here and is never "
+        'closed (a " is missing)\n',
+    )
+    closed = text.replace('"abc', '"abc"').replace('"0,y', '"0",y')  # closed: read as written
+    status, err = run_validate(tmp_path, capsys, closed.encode())
+    assert (status, err) == (0, "")
