@@ -44,14 +44,16 @@ def read_regular(path, limit: int, shown: str, what: str = "file") -> bytes:
     except OSError as exc:
         raise ScenarioError(shown, 1, 1, f"cannot read the {what}: {exc.strerror or exc}") from None
     try:
-        mode = os.fstat(fd).st_mode
+        st = os.fstat(fd)
+        mode = st.st_mode
         if not stat.S_ISREG(mode):
             raise ScenarioError(
                 shown, 1, 1, f"cannot read the {what}: it is {kind_of(mode)}, not a regular file"
             )
         chunks: list[bytes] = []
         size = 0
-        while chunk := os.read(fd, READ_CHUNK_BYTES):  # in pieces: a growing file stops here
+        want = min(st.st_size, limit) + 1  # the whole file at once, and one byte to see it grew
+        while chunk := os.read(fd, want):  # then in pieces: a growing file stops at the limit
             size += len(chunk)
             if size > limit:
                 raise ScenarioError(
@@ -62,6 +64,7 @@ def read_regular(path, limit: int, shown: str, what: str = "file") -> bytes:
                     "raise it with --max-file-bytes",
                 )
             chunks.append(chunk)
+            want = READ_CHUNK_BYTES
     except OSError as exc:
         raise ScenarioError(shown, 1, 1, f"cannot read the {what}: {exc.strerror or exc}") from None
     finally:
