@@ -15,8 +15,8 @@ object's position.
 An object's name follows one rule wherever it is written (a list here, a table in `runner.table`,
 the fast lane in `runner.yamlfast`, a generate block's `name`): `object_names`. Surrounding
 whitespace is not part of it, a name left empty is no name, and a name holds at most
-MAX_OBJECT_NAME_CHARS characters; that no two objects share one is checked once all are known
-(`runner.assemble.check_names`).
+MAX_OBJECT_NAME_CHARS characters of text; that no two objects share one is checked once all are
+known (`runner.assemble.check_names`).
 """
 
 from __future__ import annotations
@@ -129,23 +129,36 @@ def polygon_problem(points: np.ndarray) -> str | None:
     return None
 
 
-class NameTooLong(ValueError):
-    """A name past MAX_OBJECT_NAME_CHARS characters; `index` is its place among those given."""
+class NameRefused(ValueError):
+    """A name the rule refuses, with the reason; `index` is its place among those given."""
 
-    def __init__(self, index: int, length: int):
-        super().__init__(f"a name holds at most {MAX_OBJECT_NAME_CHARS} characters, not {length:,}")
+    def __init__(self, index: int, reason: str):
+        super().__init__(reason)
         self.index = index
 
 
 def object_names(texts) -> list[str | None]:
     """The names that objects written with `texts` get (a list's `name`, a table's column, the
     fast lane's names), under the one rule: the text without surrounding whitespace, None when
-    nothing is left; NameTooLong at the first longer than MAX_OBJECT_NAME_CHARS characters."""
+    nothing is left; NameRefused at the first longer than MAX_OBJECT_NAME_CHARS characters or
+    holding what is not text (a lone surrogate, which a .npy string may hold: no output could
+    write it)."""
     names = [t.strip() or None for t in texts]
     if max(map(len, texts), default=0) > MAX_OBJECT_NAME_CHARS:  # else none can be too long
         for i, name in enumerate(names):
             if name is not None and len(name) > MAX_OBJECT_NAME_CHARS:
-                raise NameTooLong(i, len(name))
+                raise NameRefused(
+                    i, f"a name holds at most {MAX_OBJECT_NAME_CHARS} characters, not {len(name):,}"
+                )
+    try:
+        "".join(filter(None, names)).encode("utf-8")
+    except UnicodeEncodeError:
+        for i, name in enumerate(names):
+            try:
+                (name or "").encode("utf-8")
+            except UnicodeEncodeError as exc:
+                code = ord(name[exc.start])
+                raise NameRefused(i, f"a name is text, not a lone surrogate U+{code:04X}") from None
     return names
 
 
@@ -263,7 +276,7 @@ class ObjectReader(Nodes):
         if "name" in m:
             try:
                 (name,) = object_names([self.string(m["name"][1], f"{what}.name")])
-            except NameTooLong as exc:
+            except NameRefused as exc:
                 raise self.error(m["name"][1], f"{what}.name: {exc}") from None
         return color, color_node, mass, static, fill, name
 

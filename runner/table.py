@@ -297,7 +297,7 @@ def _names(data, refuse) -> tuple:
     """Each row's name under the one rule for object names (runner.objects.object_names), a cell
     past TEXT_CHARS as written refused first (a CSV's is read one character longer, never cut
     short unseen); a number in a .npy name column is its text."""
-    from collide2d.runner.objects import NameTooLong, object_names
+    from collide2d.runner.objects import NameRefused, object_names
 
     n = data.shape[0]
     if "name" not in data.dtype.names:
@@ -315,7 +315,7 @@ def _names(data, refuse) -> tuple:
         return (None,) * n
     try:
         return tuple(object_names(texts))
-    except NameTooLong as exc:
+    except NameRefused as exc:
         said = str(exc)
         refuse(np.arange(n) == exc.index, "name", lambda r: said)
         return (None,) * n

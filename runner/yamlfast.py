@@ -250,7 +250,7 @@ def table(split_: Split, world, paper: bool, max_objects: int):
         MAX_MASS,
         MAX_SPEED,
         MIN_MASS,
-        NameTooLong,
+        NameRefused,
         object_names,
     )
     from collide2d.runner.table import Table
@@ -359,7 +359,7 @@ def table(split_: Split, world, paper: bool, max_objects: int):
     try:  # each name under the one rule for names: the lane takes those it leaves as written
         if object_names(list(distinct)) != list(distinct):
             raise FallBack
-    except NameTooLong:
+    except NameRefused:
         raise FallBack from None
     # inside the world and apart, as runner.assemble checks listed objects
     if np.any((pos < 0) | (pos + size > np.array([world.width, world.height]))):

@@ -425,3 +425,19 @@ def test_a_quote_never_closed_is_refused_where_it_opens(tmp_path, capsys, rows, 
     closed = text.replace('"abc', '"abc"').replace('"0,y', '"0",y')  # closed: read as written
     status, err = run_validate(tmp_path, capsys, closed.encode())
     assert (status, err) == (0, "")
+
+
+def test_a_name_that_no_output_could_write_is_refused_at_its_cell(tmp_path, capsys):
+    """A .npy string may hold a lone surrogate, which no UTF-8 output can write (exit 3 at the
+    first write before)."""
+    numbers = [(c, "f8") for c in ("id", "w", "h", "x", "y")]
+    rec = np.zeros(2, dtype=numbers + [("shape", "U3"), ("name", "U2")])
+    rec["name"] = ["ok", "\ud800"]
+    rec["id"], rec["x"], rec["w"], rec["h"], rec["shape"] = [0, 1], [0, 10], 2, 2, "box"
+    np.save(tmp_path / "t.npy", rec)
+    status, err = run_validate(tmp_path, capsys, (tmp_path / "t.npy").read_bytes(), "t.npy")
+    assert (status, err) == (
+        2,
+        f"{tmp_path / 't.npy'}:2:7: error: row 2, column name: a name is text, not a lone "
+        "surrogate U+D800\n",
+    )
