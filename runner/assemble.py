@@ -228,22 +228,28 @@ def _shape_overlap(listed: list[Listed], pos, size) -> tuple[int, int] | None:
 
 
 def check_names(reader: Nodes, names, listed, blocks, lines) -> None:
-    """No two objects share a name (a generate block's `name` names its objects NAME-0, ...)."""
+    """No two objects share a name (a generate block's `name` names its objects NAME-0, ...); a
+    repeat is refused at the later object: its node, its table cell, or its block's line."""
+    table = listed.table if isinstance(listed, _TableRows) else None
     seen: dict[str, int] = {}
     for i, name in enumerate(names):
         if name is None:
             continue
         if name in seen:
             j = seen[name]
-            node = listed[i].node if i < len(listed) else None
-            where = f"objects[{i}]" if i < len(listed) else "a generated object"
-            message = (
-                f"{where} is named {name!r}, like object {j} (line {lines[j]}); "
-                "names must differ, they name the objects in events.jsonl and final.csv"
+            first = f"row {j + 1} of the table" if table is not None and j < table.n else None
+            first = first or f"line {lines[j]}"
+            said = (
+                f"like object {j} ({first}); names must differ, they name the objects in "
+                "events.jsonl and final.csv"
             )
-            if node is None:
-                raise ScenarioError(reader.path, lines[i], 1, message)
-            raise reader.error(node, message)
+            if table is not None and i < table.n:
+                raise table.error(i, "name", f"{name!r} is taken, {said}")
+            if i < len(listed):
+                raise reader.error(listed[i].node, f"objects[{i}] is named {name!r}, {said}")
+            raise ScenarioError(
+                reader.path, lines[i], 1, f"a generated object is named {name!r}, {said}"
+            )
         seen[name] = i
 
 

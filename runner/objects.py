@@ -11,6 +11,12 @@ velocity component of a moving object is a rate the model can take at the world'
 Masses lie in [MIN_MASS, MAX_MASS] and velocity components in [-MAX_SPEED, MAX_SPEED] (see the
 "Numbers" paragraph of `runner.scenario`); polygon points lie within MAX_POINT_OFFSET px of the
 object's position.
+
+An object's name follows one rule wherever it is written (a list here, a table in `runner.table`,
+the fast lane in `runner.yamlfast`, a generate block's `name`): `object_names`. Surrounding
+whitespace is not part of it, a name left empty is no name, and a name holds at most
+MAX_OBJECT_NAME_CHARS characters of text; that no two objects share one is checked once all are
+known (`runner.assemble.check_names`).
 """
 
 from __future__ import annotations
@@ -35,6 +41,7 @@ MAX_MASS = 1e15  # mass units, the heaviest movable object (`static: true` is he
 MAX_SEED = 2**64 - 1  # the largest generate seed
 MAX_SPEED = 1e9  # px/s, largest velocity component (a larger one crosses any world in a tick)
 MAX_POINT_OFFSET = 2**24  # px, largest |coordinate| of a polygon point relative to its position
+MAX_OBJECT_NAME_CHARS = 100  # characters in an object's name (it labels the object in every output)
 SHAPES = ("box", "circle", "polygon")
 BLOCK_SHAPES = ("box", "circle")
 _KIND_OF_SHAPE = {"box": KIND_BOX, "circle": KIND_CIRCLE, "polygon": KIND_POLYGON}
@@ -120,6 +127,39 @@ def polygon_problem(points: np.ndarray) -> str | None:
     if abs(turning) > 3.0 * math.pi:
         return "it is not convex: it winds around more than once"
     return None
+
+
+class NameRefused(ValueError):
+    """A name the rule refuses, with the reason; `index` is its place among those given."""
+
+    def __init__(self, index: int, reason: str):
+        super().__init__(reason)
+        self.index = index
+
+
+def object_names(texts) -> list[str | None]:
+    """The names that objects written with `texts` get (a list's `name`, a table's column, the
+    fast lane's names), under the one rule: the text without surrounding whitespace, None when
+    nothing is left; NameRefused at the first longer than MAX_OBJECT_NAME_CHARS characters or
+    holding what is not text (a lone surrogate, which a .npy string may hold: no output could
+    write it)."""
+    names = [t.strip() or None for t in texts]
+    if max(map(len, texts), default=0) > MAX_OBJECT_NAME_CHARS:  # else none can be too long
+        for i, name in enumerate(names):
+            if name is not None and len(name) > MAX_OBJECT_NAME_CHARS:
+                raise NameRefused(
+                    i, f"a name holds at most {MAX_OBJECT_NAME_CHARS} characters, not {len(name):,}"
+                )
+    try:
+        "".join(filter(None, names)).encode("utf-8")
+    except UnicodeEncodeError:
+        for i, name in enumerate(names):
+            try:
+                (name or "").encode("utf-8")
+            except UnicodeEncodeError as exc:
+                code = ord(name[exc.start])
+                raise NameRefused(i, f"a name is text, not a lone surrogate U+{code:04X}") from None
+    return names
 
 
 @dataclass
@@ -232,7 +272,12 @@ class ObjectReader(Nodes):
                     m["mass"][0], f"{what} is static, so its mass is infinite; remove 'mass'"
                 )
         fill = self.boolean(m["fill"][1], f"{what}.fill") if "fill" in m else False
-        name = self.string(m["name"][1], f"{what}.name") if "name" in m else None
+        name = None
+        if "name" in m:
+            try:
+                (name,) = object_names([self.string(m["name"][1], f"{what}.name")])
+            except NameRefused as exc:
+                raise self.error(m["name"][1], f"{what}.name: {exc}") from None
         return color, color_node, mass, static, fill, name
 
     def objects(self, top: dict) -> list[Listed]:

@@ -79,6 +79,7 @@ from collide2d.runner.objects import (
     DEFAULT_COLOR,
     DEFAULT_MASS,
     MAX_MASS,
+    MAX_OBJECT_NAME_CHARS,
     MAX_POINT_OFFSET,
     MAX_SEED,
     MAX_SPEED,
@@ -123,6 +124,7 @@ __all__ = [
     "MAX_INTEGER",
     "MAX_MASS",
     "MAX_NAME_LENGTH",
+    "MAX_OBJECT_NAME_CHARS",
     "MAX_POINT_OFFSET",
     "MAX_SEED",
     "MAX_SPEED",
@@ -206,7 +208,7 @@ class Scenario:
     lines: tuple[int, ...]  # per object, the 1-based YAML line it came from
     output: Output
     golden: Golden
-    text_sha256: str  # of the file's bytes
+    text_sha256: str  # of the file's bytes; with a table, of both (`with_table`)
     # the exact model's cap: --max-events-per-tick, else the model option, else the default
     max_events_per_tick: int = DEFAULT_MAX_EVENTS_PER_TICK
 
@@ -242,6 +244,13 @@ def loads(
     ys.check_length(len(text), path, limits)  # characters: never more than the UTF-8 bytes
     digest = hashlib.sha256(text.encode("utf-8", "surrogatepass")).hexdigest()
     return _Reader(path, None, overrides, limits, defaults).scenario(text, digest)
+
+
+def with_table(text_sha256: str, table_sha256: str) -> str:
+    """The hash of a scenario whose objects come from a table: the file's and the table's hashes
+    hashed together, so that goldens and reports see an edit of the table as an edit of the
+    scenario. A scenario without a table keeps the hash of its file's bytes alone."""
+    return hashlib.sha256(f"{text_sha256} {table_sha256}".encode("ascii")).hexdigest()
 
 
 class _Reader(Nodes):
@@ -321,6 +330,8 @@ class _Reader(Nodes):
         bodies, names, lines, palette = assemble.bodies(
             self, listed, blocks, world, background, geometry, table
         )
+        if table is not None and table.sha256 is not None:
+            digest = with_table(digest, table.sha256)
         if model == "exact":
             self.room(world, bodies, geometry, names, listed, lines, table)
         return Scenario(
@@ -391,13 +402,15 @@ class _Reader(Nodes):
                 side[key] = default
                 continue
             node = m[key][1]
-            v = self.integer(node, f"world.{key}", lo=1, of=" of pixels", unit=" px")
-            if v > self.limits.max_side:
+            # no bound but the side's own, so that the message names the one that holds
+            v = self.integer(node, f"world.{key}", lo=1, hi=math.inf, of=" of pixels", unit=" px")
+            bound = min(self.limits.max_side, MAX_INTEGER)
+            if v > bound:
+                shown = str(v) if len(str(v)) <= 24 else node.value  # 1e308, not its 309 digits
                 raise self.error(
                     node,
-                    f"world.{key} {v} is past the limit of "
-                    f"{self.limits.max_side} px per side; raise it with "
-                    "--max-side",
+                    f"world.{key} {shown} is past the limit of {bound} px per side; raise it "
+                    "with --max-side",
                 )
             side[key] = v
         fps_node = m["fps"][1] if "fps" in m else None

@@ -25,6 +25,7 @@ from collide2d.runner.scenario import (
     MAX_FPS,
     MAX_MASS,
     MAX_NAME_LENGTH,
+    MAX_OBJECT_NAME_CHARS,
     MAX_SEED,
     MAX_SPEED,
     MAX_SUBSTEPS,
@@ -56,7 +57,11 @@ def json_schema() -> dict:
         },
         "static": {"type": "boolean", "description": "infinite mass, never moves"},
         "fill": {"type": "boolean", "description": "paint the inside too; default false"},
-        "name": {"type": "string", "description": "a label in logs and reports"},
+        "name": {
+            "type": "string",
+            "maxLength": MAX_OBJECT_NAME_CHARS,
+            "description": "a label in logs and reports; no two objects share one",
+        },
     }
     size = {
         "anyOf": [whole_px, {"type": "array", "items": whole_px, "minItems": 2, "maxItems": 2}],

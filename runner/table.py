@@ -12,28 +12,32 @@ parsed. Columns, by name (any order; only id, shape, w, h, x, y are required):
     vx, vy px/s (default 0)
     mass   MIN_MASS ... MAX_MASS (default 1; empty for a static object)
     color  a CSS name or #rrggbb (default white)
-    name   text (default none)
+    name   text, MAX_OBJECT_NAME_CHARS at most (default none)
     static true | false (default false)
     fill   true | false (default false)
 
-A CSV file has a header row of column names, then one row per object, fields separated by commas
-(a field holding a comma is quoted with "); blank lines are skipped. It is read by
-`numpy.loadtxt` into one structured array in a single pass. A `.npy` file holds a structured array
-whose field names are the columns (numbers as any numeric type, text as unicode or bytes); its
-header is read first, so its row count and size are checked before the data is read, and it is
-loaded without pickles.
+The file is read once (`runner.readfile`: a regular file within `--max-file-bytes`) and its bytes
+go to `runner.tableread`, which makes one structured array of them: a CSV file (a header row of
+column names, then one row per object, fields separated by commas, a field holding a comma quoted
+with ", blank lines skipped, lines ending in LF, CRLF or CR) by `numpy.loadtxt` in a single pass, a
+`.npy` file (a structured array whose field names are the columns, numbers as any numeric type, text
+as unicode or bytes) over the same bytes once its header's claim has been held against the file's
+size. The table's SHA-256 is kept (`Table.sha256`): it counts in the scenario's hash, so goldens and
+reports see an edited table as an edited scenario.
 
 Every check runs over whole columns at once (numpy), and the first failing cell, in row order and
 then column order, is reported as `FILE:ROW:COLUMN: error: ...`: the CSV's line and the character
 column where the field starts (for `.npy` the row counted from 1 and the field's number). Finding
-that place reads the CSV again with Python's csv module, on the error path only.
+that place reads the CSV again with Python's csv module, on the error path only. A text cell longer
+than its column's bound (TEXT_CHARS) is refused, never cut short; names follow the one rule for
+object names (`runner.objects.object_names`), and two rows of one name are refused at the second
+(`runner.assemble.check_names`).
 """
 
 from __future__ import annotations
 
-import csv
-import difflib
-import io
+import dataclasses
+import hashlib
 import math
 import os
 from dataclasses import dataclass
@@ -44,15 +48,12 @@ from collide2d.engine import motion
 from collide2d.engine.world import KIND_BOX, KIND_CIRCLE
 from collide2d.runner import colors
 from collide2d.runner.limits import Limits
-from collide2d.runner.yamlsafe import ScenarioError
+from collide2d.runner.readfile import read_regular
+from collide2d.runner.tableread import COLUMNS, NUMBERS, REQUIRED, TEXT_CHARS, read_csv, read_npy
 
-COLUMNS = ("id", "shape", "w", "h", "x", "y", "vx", "vy", "mass", "color", "name", "static", "fill")
-REQUIRED = ("id", "shape", "w", "h", "x", "y")
-NUMBERS = ("id", "w", "h", "x", "y", "vx", "vy")
+__all__ = ["COLUMNS", "NUMBERS", "REQUIRED", "TEXT_CHARS", "Table", "read_table", "table_of"]
+
 SUFFIXES = (".csv", ".npy")
-# Longest text a cell may hold, per text column (characters); wider columns would cost memory for
-# every row.
-TEXT_CHARS = {"shape": 16, "color": 40, "name": 100, "static": 8, "fill": 8, "mass": 100}
 TRUE_WORDS = ("true", "yes", "on", "1")
 FALSE_WORDS = ("false", "no", "off", "0", "")
 
@@ -73,14 +74,16 @@ class Table:
     colors: list
     color_of: np.ndarray
     names: tuple
-    where: object  # where(row, column) -> ScenarioError maker, see _Place
+    where: object  # where(row, column) -> ScenarioError maker, see runner.tableread.Place
     lines: tuple | None = None  # each object's line in the scenario, when it has its own
+    sha256: str | None = None  # of the table file's bytes (None: the rows are the scenario's text)
 
     @property
     def n(self) -> int:
         return int(self.kind.shape[0])
 
-    def error(self, row: int, column: str, message: str) -> ScenarioError:
+    def error(self, row: int, column: str, message: str):
+        """The ScenarioError at the cell of `row` (from 0) and `column`."""
         return self.where(row, column, message)
 
 
@@ -108,217 +111,26 @@ def read_table(
 ) -> Table:
     """Read and check the table at `opened` (named `shown` in messages) for a world of that size,
     under the paper model's rules when `paper`; a located ScenarioError when anything is wrong."""
-    try:
-        size = os.stat(opened).st_size
-    except OSError as exc:
-        raise ScenarioError(shown, 1, 1, f"cannot read the table: {exc.strerror or exc}") from None
-    if size > limits.max_file_bytes:
-        raise ScenarioError(
-            shown,
-            1,
-            1,
-            f"the table is larger than the limit of {limits.max_file_bytes:,} bytes; "
-            "raise it with --max-file-bytes",
-        )
+    raw = read_regular(opened, limits.max_file_bytes, shown, "table")
     if opened.lower().endswith(".npy"):
-        data, place = _read_npy(opened, shown, limits)
+        data, place = read_npy(raw, shown, limits)
     else:
-        data, place = _read_csv(opened, shown, limits)
-    return _check(data, place, width, height, fps, paper)
-
-
-# --- reading ----------------------------------------------------------------------------------
-
-
-class _Place:
-    """Where a cell is, for messages: the CSV's line and character column (found by reading the
-    text again, only when an error needs it) or the .npy's row and field number."""
-
-    def __init__(self, shown: str, header: list[str], text: str | None):
-        self.shown = shown
-        self.header = header
-        self.text = text
-
-    def __call__(self, row: int, column: str, message: str) -> ScenarioError:
-        col = self.header.index(column) if column in self.header else 0
-        message = f"row {row + 1}, column {column}: {message}" if column else message
-        if self.text is None:  # .npy: row counted from 1, the field's number
-            return ScenarioError(self.shown, row + 1, col + 1, message)
-        line, char = _csv_cell(self.text, row, col)
-        return ScenarioError(self.shown, line, char, message)
-
-
-def _data_records(text: str):
-    """(data row from 0, line from 1, fields) of each CSV record after the header, blank lines
-    skipped as numpy.loadtxt skips them."""
-    reader = csv.reader(io.StringIO(text))
-    next(reader, None)
-    k = -1
-    for record in reader:
-        if not record or all(not f.strip() for f in record) and len(record) <= 1:
-            continue
-        k += 1
-        yield k, reader.line_num, record
-
-
-def _csv_cell(text: str, row: int, col: int) -> tuple[int, int]:
-    """(line, character column) of field `col` of data row `row` (blank lines skipped, as
-    numpy.loadtxt skips them), both from 1."""
-    for k, line, _record in _data_records(text):
-        if k == row:
-            raw = text.splitlines()[line - 1] if line - 1 < len(text.splitlines()) else ""
-            return line, _field_start(raw, col)
-    return 1, 1
-
-
-def _field_start(raw: str, col: int) -> int:
-    """Character column (from 1) where field `col` of the CSV line `raw` starts."""
-    field, quoted = 0, False
-    for i, ch in enumerate(raw):
-        if field == col:
-            return i + 1
-        if ch == '"':
-            quoted = not quoted
-        elif ch == "," and not quoted:
-            field += 1
-    return len(raw) + 1
-
-
-def _header_error(shown: str, header: list[str]) -> None:
-    """Unknown, repeated and missing columns, at the header line."""
-    seen = set()
-    at = 1
-    for name in header:
-        if name not in COLUMNS:
-            near = difflib.get_close_matches(name, COLUMNS, n=1)
-            hint = f"did you mean '{near[0]}'?" if near else "expected " + ", ".join(COLUMNS)
-            raise ScenarioError(shown, 1, at, f"unknown column {name!r}; {hint}")
-        if name in seen:
-            raise ScenarioError(shown, 1, at, f"column {name!r} appears twice")
-        seen.add(name)
-        at += len(name) + 1
-    missing = [c for c in REQUIRED if c not in seen]
-    if missing:
-        raise ScenarioError(
-            shown,
-            1,
-            1,
-            f"the table lacks the column(s) {', '.join(missing)} (header: id, shape, "
-            "w, h, x, y and optionally vx, vy, mass, color, name, static, fill)",
-        )
-
-
-def _read_csv(opened: str, shown: str, limits: Limits):
-    try:
-        with open(opened, "rb") as f:
-            raw = f.read(limits.max_file_bytes + 1)
-    except OSError as exc:
-        raise ScenarioError(shown, 1, 1, f"cannot read the table: {exc.strerror or exc}") from None
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        line = raw.count(b"\n", 0, exc.start) + 1
-        raise ScenarioError(shown, line, 1, "the table is not UTF-8 text") from None
-    del raw
-    rows = text.count("\n") + (0 if text.endswith("\n") else 1) - 1
-    if rows > limits.max_objects:
-        raise ScenarioError(
-            shown,
-            1,
-            1,
-            f"the table has {rows} rows, past the limit of {limits.max_objects} objects; "
-            "raise it with --max-objects",
-        )
-    first = text.split("\n", 1)[0].rstrip("\r")
-    header = [h.strip() for h in next(csv.reader([first]), [])]
-    if not first.strip():
-        raise ScenarioError(shown, 1, 1, "the table is empty; its first line names the columns")
-    _header_error(shown, header)
-    place = _Place(shown, header, text)
-    dtype = [(c, "f8") if c in NUMBERS else (c, f"U{TEXT_CHARS[c] + 1}") for c in header]
-    try:
-        data = np.loadtxt(
-            io.StringIO(text),
-            dtype=dtype,
-            delimiter=",",
-            skiprows=1,
-            comments=None,
-            quotechar='"',
-            ndmin=1,
-        )
-    except ValueError:
-        raise _first_bad_cell(text, header, place) from None
-    return data, place
-
-
-def _first_bad_cell(text: str, header: list[str], place: _Place) -> ScenarioError:
-    """The error numpy met, found again cell by cell: a row of the wrong length or a number that
-    is not one."""
-    for k, line, record in _data_records(text):
-        if len(record) != len(header):
-            return ScenarioError(
-                place.shown,
-                line,
-                1,
-                f"row {k + 1} has {len(record)} fields; the header names {len(header)}",
-            )
-        for c, name in enumerate(header):
-            if name in NUMBERS:
-                try:
-                    float(record[c])
-                except ValueError:
-                    return place(k, name, f"must be a number, not {record[c].strip()!r}")
-    return ScenarioError(place.shown, 1, 1, "the table cannot be read as CSV")
-
-
-def _read_npy(opened: str, shown: str, limits: Limits):
-    try:
-        with open(opened, "rb") as f:
-            version = np.lib.format.read_magic(f)
-            if version == (1, 0):
-                shape, fortran, dtype = np.lib.format.read_array_header_1_0(f)
-            else:
-                shape, fortran, dtype = np.lib.format.read_array_header_2_0(f)
-    except (OSError, ValueError) as exc:
-        raise ScenarioError(shown, 1, 1, f"not a .npy file numpy can read ({exc})") from None
-    if dtype.names is None or len(shape) != 1:
-        raise ScenarioError(
-            shown,
-            1,
-            1,
-            "a .npy table holds a one-dimensional structured array whose field "
-            "names are the columns",
-        )
-    if shape[0] > limits.max_objects:
-        raise ScenarioError(
-            shown,
-            1,
-            1,
-            f"the table has {shape[0]} rows, past the limit of {limits.max_objects} objects; "
-            "raise it with --max-objects",
-        )
-    header = list(dtype.names)
-    _header_error(shown, header)
-    for c in header:
-        kind = dtype[c].kind
-        if c in NUMBERS and kind not in "iuf":
-            raise ScenarioError(shown, 1, header.index(c) + 1, f"column {c} must hold numbers")
-        if c not in NUMBERS and kind not in "iufbUS":
-            raise ScenarioError(shown, 1, header.index(c) + 1, f"column {c} must hold text")
-    try:
-        data = np.load(opened, allow_pickle=False)
-    except (OSError, ValueError) as exc:
-        raise ScenarioError(shown, 1, 1, f"not a .npy file numpy can read ({exc})") from None
-    return data, _Place(shown, header, None)
+        data, place = read_csv(raw, shown, limits)
+    table = _check(data, place, width, height, fps, paper)
+    return dataclasses.replace(table, sha256=hashlib.sha256(raw).hexdigest())
 
 
 # --- checking, column by column -----------------------------------------------------------------
 
 
-def _words(data, name: str, default: str, lower: bool = True) -> tuple[np.ndarray, np.ndarray]:
+def _words(
+    data, name: str, default: str, refuse, lower: bool = True
+) -> tuple[np.ndarray, np.ndarray]:
     """A text column as (its distinct values in order of first use, stripped (and lower-cased),
     as an array of str; each row's index into them); [default] for every row when the column is
-    absent. Stripping and comparing run over the distinct values only."""
+    absent. A value past the column's TEXT_CHARS as written is refused (a CSV's is read one
+    character longer, so it is seen, never cut short). Stripping, comparing and measuring run
+    over the distinct values only."""
     n = data.shape[0]
     if name not in data.dtype.names:
         return np.array([default]), np.zeros(n, np.int64)
@@ -331,13 +143,18 @@ def _words(data, name: str, default: str, lower: bool = True) -> tuple[np.ndarra
         inverse = np.array(
             [first_seen.setdefault(v, len(first_seen)) for v in column.tolist()], np.int64
         )
+    inverse = inverse.reshape(-1)
+    most = TEXT_CHARS[name]
     words = []
-    for u in first_seen:
+    for k, u in enumerate(first_seen):
         if isinstance(u, bytes):
             u = u.decode("utf-8", "replace")
-        u = str(u).strip()
+        u = str(u)
+        if column.dtype.kind in "US" and len(u) > most:
+            refuse(inverse == k, name, lambda r: f"the cell holds more than {most} characters")
+        u = u.strip()
         words.append(u.lower() if lower else u)
-    return np.array(words + [""])[:-1], inverse.reshape(-1)
+    return np.array(words + [""])[:-1], inverse
 
 
 FEW_DISTINCT = 16  # a text column with more distinct values is taken apart by a dict
@@ -366,21 +183,23 @@ def _first(bad: np.ndarray) -> int | None:
     return int(np.argmax(bad)) if bad.any() else None
 
 
-def _check(data, place: _Place, width: int, height: int, fps: int, paper: bool) -> Table:
+def _check(data, place, width: int, height: int, fps: int, paper: bool) -> Table:
     n = data.shape[0]
     names = data.dtype.names
-    problems: list[tuple[int, int, str, str]] = []  # (row, column index, column, message)
+    # (row, column index, order found, column, message): the first cell in row and column order,
+    # and of two problems in one cell the one found first
+    problems: list[tuple[int, int, int, str, str]] = []
 
     def refuse(bad, column, message_of) -> None:
         r = _first(bad)
         if r is not None:
-            problems.append((r, names.index(column), column, message_of(r)))
+            problems.append((r, names.index(column), len(problems), column, message_of(r)))
 
     def number(column, default=0.0) -> np.ndarray:
         if column not in names:
             return np.full(n, default)
         v = data[column].astype(np.float64)
-        refuse(~np.isfinite(v), column, lambda r: f"must be a finite number, not {float(v[r])!r}")
+        refuse(~np.isfinite(v), column, lambda r: f"must be a finite number, not {_shown(v[r])}")
         return np.where(np.isfinite(v), v, default) + 0.0  # -0.0 is 0.0
 
     def whole(v, column, lo, unit):
@@ -396,7 +215,7 @@ def _check(data, place: _Place, width: int, height: int, fps: int, paper: bool) 
         "id",
         lambda r: f"must be {r} (ids run 0, 1, 2, ... in row order), not {_shown(ids[r])}",
     )
-    words, of = _words(data, "shape", "box")
+    words, of = _words(data, "shape", "box", refuse)
     kind = np.where(words == "circle", KIND_CIRCLE, KIND_BOX).astype(np.int8)[of]
     known = ((words == "box") | (words == "circle"))[of]
     refuse(~known, "shape", lambda r: f"must be box or circle, not {str(words[of[r]])!r}")
@@ -449,16 +268,10 @@ def _check(data, place: _Place, width: int, height: int, fps: int, paper: bool) 
                     break
     mass = _mass(data, static, refuse)
     rgb, color_of = _colors(data, refuse)
+    names_out = _names(data, refuse)
     if problems:
-        r, _, column, message = min(problems)
+        r, _, _, column, message = min(problems)
         raise place(r, column, message)
-    names_out = (None,) * n
-    if "name" in names:
-        col = data["name"].tolist()
-        names_out = tuple(
-            (v.decode("utf-8", "replace") if isinstance(v, bytes) else str(v)).strip() or None
-            for v in col
-        )
     return Table(
         path=place.shown,
         kind=kind,
@@ -480,13 +293,41 @@ def _shown(v) -> str:
     return str(int(v)) if math.isfinite(v) and v.is_integer() and abs(v) < 1e15 else repr(v)
 
 
+def _names(data, refuse) -> tuple:
+    """Each row's name under the one rule for object names (runner.objects.object_names), a cell
+    past TEXT_CHARS as written refused first (a CSV's is read one character longer, never cut
+    short unseen); a number in a .npy name column is its text."""
+    from collide2d.runner.objects import NameRefused, object_names
+
+    n = data.shape[0]
+    if "name" not in data.dtype.names:
+        return (None,) * n
+    column = data["name"]
+    texts = column.tolist()
+    if column.dtype.kind == "S":
+        texts = [v.decode("utf-8", "replace") for v in texts]
+    elif column.dtype.kind != "U":
+        texts = [str(v) for v in texts]
+    most = TEXT_CHARS["name"]
+    if max(map(len, texts), default=0) > most:
+        long = np.fromiter(map(len, texts), np.int64, n) > most
+        refuse(long, "name", lambda r: f"the cell holds more than {most} characters")
+        return (None,) * n
+    try:
+        return tuple(object_names(texts))
+    except NameRefused as exc:
+        said = str(exc)
+        refuse(np.arange(n) == exc.index, "name", lambda r: said)
+        return (None,) * n
+
+
 def _flag(data, column: str, refuse) -> np.ndarray:
     n = data.shape[0]
     if column in data.dtype.names and data[column].dtype.kind in "biuf":
         v = data[column].astype(np.float64)
-        refuse((v != 0) & (v != 1), column, lambda r: f"must be true or false, not {v[r]!r}")
+        refuse((v != 0) & (v != 1), column, lambda r: f"must be true or false, not {_shown(v[r])}")
         return v != 0
-    words, of = _words(data, column, "false")
+    words, of = _words(data, column, "false", refuse)
     yes = np.isin(words, TRUE_WORDS)
     known = (yes | np.isin(words, FALSE_WORDS))[of]
     refuse(~known, column, lambda r: f"must be true or false, not {str(words[of[r]])!r}")
@@ -504,7 +345,7 @@ def _mass(data, static, refuse) -> np.ndarray:
         given = np.ones(n, bool)
         mass = col.astype(np.float64)
     else:
-        words, of = _words(data, "mass", "")
+        words, of = _words(data, "mass", "", refuse)
         values = np.full(words.shape[0], np.nan)
         bad_word = np.zeros(words.shape[0], bool)
         for k, w in enumerate(words.tolist()):  # the distinct values only
@@ -524,7 +365,7 @@ def _mass(data, static, refuse) -> np.ndarray:
     refuse(
         given & ~static & ~((mass >= MIN_MASS) & (mass <= MAX_MASS)),
         "mass",
-        lambda r: f"must be from {MIN_MASS:g} to {MAX_MASS:g}, not {mass[r]!r}",
+        lambda r: f"must be from {MIN_MASS:g} to {MAX_MASS:g}, not {_shown(mass[r])}",
     )
     return np.where(given, mass, DEFAULT_MASS)
 
@@ -534,9 +375,11 @@ def _colors(data, refuse) -> tuple[list, np.ndarray]:
     from collide2d.runner.objects import DEFAULT_COLOR
 
     n = data.shape[0]
+    if n == 0:
+        return [], np.zeros(0, np.int64)
     if "color" not in data.dtype.names:
         return [DEFAULT_COLOR], np.zeros(n, np.int64)
-    words, of = _words(data, "color", "", lower=False)  # in order of first use
+    words, of = _words(data, "color", "", refuse, lower=False)  # in order of first use
     rgb = []
     for u, word in enumerate(words.tolist()):
         try:

@@ -32,8 +32,9 @@ its usual message. So the lane changes how long a file takes, never what it mean
 to the general path: other block forms (values on lines of their own, other indents), multi-line
 flow mappings, quoted or tagged values, anchors and aliases, comments or blank lines inside the
 list, polygons, numbers with leading zeros (YAML 1.1 octal), exponents, underscores, or other YAML
-1.1 forms, words YAML reads as booleans or null where a text is asked for, and lists shorter than
-FAST_MIN_OBJECTS.
+1.1 forms, words YAML reads as booleans or null where a text is asked for, two objects of one name,
+and lists shorter than FAST_MIN_OBJECTS. Names pass the one rule for object names
+(`runner.objects.object_names`) as the general path's do.
 """
 
 from __future__ import annotations
@@ -332,7 +333,15 @@ def _number(values: list[str]) -> np.ndarray:
 def table(split_: Split, world, paper: bool, max_objects: int):
     """The objects of the list as a runner.table.Table, every check of the general path run by
     column; FallBack when anything would make the general path refuse or read it otherwise."""
-    from collide2d.runner.objects import DEFAULT_COLOR, DEFAULT_MASS, MAX_MASS, MAX_SPEED, MIN_MASS
+    from collide2d.runner.objects import (
+        DEFAULT_COLOR,
+        DEFAULT_MASS,
+        MAX_MASS,
+        MAX_SPEED,
+        MIN_MASS,
+        NameRefused,
+        object_names,
+    )
     from collide2d.runner.table import Table
 
     n = split_.n
@@ -430,9 +439,17 @@ def table(split_: Split, world, paper: bool, max_objects: int):
         for i, text in zip(np.flatnonzero(name.one).tolist(), name.ones, strict=True):
             listed[i] = text
         names = tuple(listed)
-    for text in set(name.ones):
+    distinct = set(name.ones)
+    if len(distinct) != len(name.ones):
+        raise FallBack  # two objects of one name: the general path refuses the second
+    for text in distinct:
         if text in _NOT_TEXT or text[:1].isdigit() or text[0] == "-":
             raise FallBack
+    try:  # each name under the one rule for names: the lane takes those it leaves as written
+        if object_names(list(distinct)) != list(distinct):
+            raise FallBack
+    except NameRefused:
+        raise FallBack from None
     # inside the world and apart, as runner.assemble checks listed objects
     if np.any((pos < 0) | (pos + size > np.array([world.width, world.height]))):
         raise FallBack

@@ -34,7 +34,6 @@ from collide2d.runner.limits import Limits
 MAX_YAML_DEPTH = 64  # nesting levels of YAML collections
 MAX_SHOWN_CHARS = 40  # characters of a text quoted in a message
 MAX_NUMBER_CHARS = 100  # characters of one number as written (signs, underscores, colons included)
-READ_CHUNK_BYTES = 2**16  # a scenario file is read in pieces of this many bytes
 CORE_TAG = "tag:yaml.org,2002:"
 
 _FLOAT12_RE = re.compile(r"[-+]?(\.[0-9]+|[0-9]+(\.[0-9]*)?)[eE][-+]?[0-9]+\Z")
@@ -106,20 +105,13 @@ class ScenarioErrors(ScenarioError):
 
 
 def read_file(path, limits: Limits) -> tuple[str, str]:
-    """(text, SHA-256 of the bytes) of the file at `path`, read in pieces within
-    `limits.max_file_bytes`; a located ScenarioError when it cannot be read or is not UTF-8."""
+    """(text, SHA-256 of the bytes) of the file at `path`: a regular file of at most
+    `limits.max_file_bytes` (runner.readfile); a located ScenarioError when it cannot be read or
+    is not UTF-8."""
+    from collide2d.runner.readfile import read_regular  # it raises this module's ScenarioError
+
     shown = os.fspath(path)
-    chunks: list[bytes] = []
-    size = 0
-    try:
-        with open(path, "rb") as f:
-            while chunk := f.read(READ_CHUNK_BYTES):  # in pieces: an endless file stops here
-                size += len(chunk)
-                check_length(size, shown, limits)
-                chunks.append(chunk)
-    except OSError as exc:
-        raise ScenarioError(shown, 1, 1, f"cannot read the file: {exc.strerror or exc}") from None
-    data = b"".join(chunks)
+    data = read_regular(path, limits.max_file_bytes, shown)
     return decode(data, shown), hashlib.sha256(data).hexdigest()
 
 

@@ -4,9 +4,10 @@
 (`DIR/NAME/run/`: manifest, events, final state, frames; see `report`). This command writes those
 files as the scenario's golden. Each is read back as a golden is (`store`: every file checked
 against the manifest's hashes, hostile content refused, no symbolic link followed), and it is
-refused when the scenario file was edited after the report was written (the manifest's scenario
-hash differs): the report would no longer show what the scenario gives. With no NAME, every
-scenario the report holds a run of and lists as failed (its `summary.json`) is blessed.
+refused when the scenario file, or the table its objects come from, was edited after the report was
+written (the manifest's scenario hash differs): the report would no longer show what the scenario
+gives. With no NAME, every scenario the report holds a run of and lists as failed (its
+`summary.json`) is blessed.
 """
 
 from __future__ import annotations
@@ -110,8 +111,8 @@ def _bless_one(report_dir: Path, scn, store: GoldenStore) -> str:
     then, now = golden.manifest.get("scenario_sha256"), getattr(scn, "text_sha256", None)
     if then is None or then != now:
         raise GoldenError(
-            "the scenario was edited after the report was written (its text hash differs); "
-            "run `collide2d check --report` again"
+            "the scenario was edited after the report was written (the hash of its text and any "
+            "table differs); run `collide2d check --report` again"
         )
     existed = store.folder(scn.name).exists()
     changed = store.write(scn.name, golden.files)

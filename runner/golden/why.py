@@ -1,10 +1,11 @@
 """Why a golden check failed: the scenario edited since bless, or the same scenario run by another
 collide2d.
 
-A golden's manifest keeps the SHA-256 of the scenario file's text and the collide2d version that
-blessed it (`serialize.manifest`). `cause(scenario, manifest)` compares them with the scenario
-checked now and this collide2d, and returns a `Cause`: a `kind` for tools and a sentence for the
-reviewer, shown at the top of the report, in the console text and in the JSON and JUnit outputs.
+A golden's manifest keeps the SHA-256 of the scenario (its file's bytes, and its table's when its
+objects come from one: `runner.scenario.with_table`) and the collide2d version that blessed it
+(`serialize.manifest`). `cause(scenario, manifest)` compares them with the scenario checked now and
+this collide2d, and returns a `Cause`: a `kind` for tools and a sentence for the reviewer, shown at
+the top of the report, in the console text and in the JSON and JUnit outputs.
 """
 
 from __future__ import annotations
@@ -49,7 +50,7 @@ def cause(scenario, manifest: dict, version: str = __version__) -> Cause:
         same = then_version == version
         return Cause(
             SCENARIO_EDITED,
-            f"the scenario was edited since bless (text SHA-256 {then_hash[:12]}… then, "
+            f"the scenario was edited since bless (SHA-256 {then_hash[:12]}… then, "
             f"{now_hash[:12]}… now)" + ("" if same else f"; also {engine}"),
         )
     if then_version != version:

@@ -3,7 +3,8 @@
 An `Axis` is one swept key with its values: a run setting (`model`, `fps`, `ticks`, `substeps`,
 `geometry`) or a dotted scenario key (`world.width`, `generate.0.count`: mapping keys and list
 indices from the top of the file). `parse_set` reads `--set KEY=V1,V2,...` (values are YAML, split
-on the commas outside brackets, so `--set generate.0.size=[10,10],[20,20]` works), `parse_seeds`
+on the commas outside brackets and quotes, so `--set generate.0.size=[10,10],[20,20]` and
+`--set objects.0.name="a, b",c` work), `parse_seeds`
 reads `--seeds 1-100` (also `7` and `1-5,9`). `expand` makes the runs: the product of every axis
 and seed for each scenario, each run's scenario loaded and checked in full before anything runs
 (a located `ScenarioError` naming the run's values when one is refused). A setting the run's model
@@ -66,16 +67,35 @@ class Run:
 
 
 def split_values(text: str) -> list[str]:
-    """`a,[1,2],b` -> ["a", "[1,2]", "b"]: commas inside brackets or braces stay."""
+    """`a,[1,2],'b, c'` -> ["a", "[1,2]", "'b, c'"]: commas inside brackets, braces or a quoted
+    YAML text stay. A quote opens a quoted text where YAML would read one (at the start of a value
+    or after `[`, `{`, `,` or `:`), so an apostrophe inside a word (`it's`) is just a character;
+    `''` inside single quotes and a backslash inside double quotes escape as in YAML."""
     out, depth, start = [], 0, 0
-    for i, ch in enumerate(text):
-        if ch in "[{":
+    quote, last, i = "", "", 0  # the open quote; the value's last character outside spaces
+    while i < len(text):
+        ch = text[i]
+        if quote:
+            if quote == '"' and ch == "\\":
+                i += 1  # the escaped character
+            elif quote == "'" and ch == "'" and text[i + 1 : i + 2] == "'":
+                i += 1  # '' is one quote
+            elif ch == quote:
+                quote = ""
+        elif ch in "'\"" and last in ("", "[", "{", ",", ":"):
+            quote = ch
+        elif ch in "[{":
             depth += 1
         elif ch in "]}":
             depth -= 1
         elif ch == "," and depth == 0:
             out.append(text[start:i])
-            start = i + 1
+            start, last = i + 1, ""
+            i += 1
+            continue
+        if not ch.isspace():
+            last = ch
+        i += 1
     out.append(text[start:])
     return [v.strip() for v in out]
 

@@ -172,14 +172,15 @@ def test_sizes_are_refused_at_once_with_little_memory(tmp_path, capsys, body, ex
 
 
 @pytest.mark.skipif(not Path("/dev/zero").exists(), reason="needs /dev/zero")
-def test_an_endless_file_is_read_no_further_than_the_size_limit(capsys):
-    """Found by hardening: `validate /dev/zero` read until memory ran out."""
+def test_an_endless_file_is_refused_before_it_is_read(capsys):
+    """Found by hardening: `validate /dev/zero` read until memory ran out; a device is not a
+    regular file, so it is refused before a byte is read."""
     status, seconds, peak = refuse_cheaply(["validate", "/dev/zero", "--max-file-bytes", "100000"])
     assert status == 2 and seconds < REFUSAL_SECONDS and peak < REFUSAL_PEAK_BYTES
     err = capsys.readouterr().err
-    assert err.startswith("/dev/zero:1:1: error: the file is larger than the limit of 100,000 ")
-    assert main(["validate", "/dev/zero"]) == 2  # the default limit holds too
-    assert "--max-file-bytes" in capsys.readouterr().err
+    assert err.startswith("/dev/zero:1:1: error: cannot read the file: it is a character device")
+    assert main(["validate", "/dev/zero"]) == 2  # whatever the limit
+    assert "not a regular file" in capsys.readouterr().err
 
 
 def test_yaml_values_are_counted_before_any_is_built(tmp_path, capsys):

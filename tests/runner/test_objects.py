@@ -246,3 +246,77 @@ def test_generated_objects_avoid_listed_ones():
     )
     b = loads(text).bodies
     assert not any_overlap(b.pos, b.size)
+
+
+# ----------------------------------------------------------------------------- names
+
+
+def _names_in_each_lane(tmp_path, monkeypatch, written: str) -> dict:
+    """{lane: the first object's name, or the refusal's message} for an object named `written`
+    in a YAML list (general path), a long list (the fast lane, when the name is a plain word), a
+    CSV table and a .npy table; a second object is named "other"."""
+    from collide2d.runner import yamlfast
+    from collide2d.runner.scenario import ScenarioError, load
+
+    monkeypatch.setattr(yamlfast, "FAST_MIN_OBJECTS", 2)
+    quoted = "'" + written.replace("'", "''") + "'"
+    head = "version: 1\nworld: {width: 100, height: 80, fps: 10}\nmodel: stepped\n"
+    texts = {
+        "list": head + f"objects:\n  - {{shape: box, size: 2, position: [0, 0], name: {quoted}}}\n"
+        "  - {shape: box, size: 2, position: [10, 0], name: other}\n",
+        "csv": head + "objects: {file: t.csv}\n",
+        "npy": head + "objects: {file: t.npy}\n",
+    }
+    if written.isidentifier():
+        texts["fast lane"] = texts["list"].replace(quoted, written)
+    (tmp_path / "t.csv").write_text(
+        'id,shape,w,h,x,y,name\n0,box,2,2,0,0,"' + written.replace('"', '""') + '"\n'
+        "1,box,2,2,10,0,other\n"
+    )
+    rec = np.zeros(
+        2,
+        dtype=[(c, "f8") for c in ("id", "w", "h", "x", "y")]
+        + [("shape", "U3"), ("name", f"U{max(len(written), 5) + 1}")],
+    )
+    rec["id"], rec["x"], rec["w"], rec["h"], rec["shape"] = [0, 1], [0, 10], 2, 2, "box"
+    rec["name"] = [written, "other"]
+    np.save(tmp_path / "t.npy", rec)
+    taken = []
+    real = yamlfast.table
+    monkeypatch.setattr(yamlfast, "table", lambda *a, **k: taken.append(1) or real(*a, **k))
+    out = {}
+    for lane, text in texts.items():
+        (tmp_path / "s.yaml").write_text(text)
+        try:
+            out[lane] = load(tmp_path / "s.yaml").names[0]
+        except ScenarioError as err:
+            out[lane] = err.message.split(": ")[-1]  # the reason, wherever it is said
+    # the lane read the names it takes (a word of 100 characters at most; longer, the general
+    # path reads the file)
+    assert bool(taken) == ("fast lane" in texts and len(written) <= 100)
+    return out
+
+
+@pytest.mark.parametrize(
+    "written, name",
+    [
+        ("wall", "wall"),
+        ("  wall ", "wall"),  # surrounding whitespace is not part of a name
+        ("", None),  # an empty name is no name
+        (" ", None),
+        ("x" * 100, "x" * 100),
+        ("x" * 101, "a name holds at most 100 characters, not 101"),
+        (" " + "y" * 100, "y" * 100),
+    ],
+)
+def test_an_object_name_follows_one_rule_in_lists_tables_and_the_fast_lane(
+    tmp_path, monkeypatch, written, name
+):
+    lanes = _names_in_each_lane(tmp_path, monkeypatch, written)
+    if written == "x" * 101:  # a CSV cell is bounded as written, before its name is taken
+        assert lanes.pop("csv") == "the cell holds more than 100 characters"
+        assert lanes.pop("npy") == "the cell holds more than 100 characters"
+    if written == " " + "y" * 100:  # likewise: 101 characters as written
+        assert lanes.pop("csv") == "the cell holds more than 100 characters"
+        assert lanes.pop("npy") == "the cell holds more than 100 characters"
+    assert set(lanes.values()) == {name}, lanes

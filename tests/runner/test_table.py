@@ -5,6 +5,9 @@ checked before the table is parsed."""
 from __future__ import annotations
 
 import os
+import threading
+import time
+import tracemalloc
 
 import numpy as np
 import pytest
@@ -227,3 +230,214 @@ def test_colours_keep_the_order_of_first_use(tmp_path, distinct):
     first_use = list(dict.fromkeys(order))
     expected = [[int(c[i : i + 2], 16) for i in (1, 3, 5)] for c in first_use]
     assert scene.palette[1 : 1 + len(expected)].tolist() == expected  # row 0: background
+
+
+# --- hostile tables: a located error or a correct read, never exit 3, never a cut cell ---------
+
+
+def run_validate(tmp_path, capsys, content: bytes, name="bodies.csv"):
+    """(exit status, stderr) of `collide2d validate` on a scene whose table holds `content`."""
+    (tmp_path / name).write_bytes(content)
+    path = tmp_path / "scene.yaml"
+    path.write_text(HEAD.replace("MODEL", "stepped") + f"objects: {{file: {name}}}\n")
+    capsys.readouterr()
+    status = main(["validate", str(path)])
+    return status, capsys.readouterr().err
+
+
+def test_a_table_with_a_header_alone_is_a_scene_of_no_objects(tmp_path, capsys):
+    csv_status, err = run_validate(tmp_path, capsys, ROWS[0].encode() + b"\n")
+    assert (csv_status, err) == (0, "")
+    empty = np.zeros(0, dtype=[(c, "f8") for c in ("id", "w", "h", "x", "y")] + [("shape", "U3")])
+    np.save(tmp_path / "none.npy", empty)
+    status, err = run_validate(tmp_path, capsys, (tmp_path / "none.npy").read_bytes(), "t.npy")
+    assert (status, err) == (0, "")
+    assert load(tmp_path / "scene.yaml").bodies.n == 0
+
+
+def test_lines_ending_in_cr_alone_read_as_lines(tmp_path):
+    lf = load(write(tmp_path))
+    (tmp_path / "bodies.csv").write_bytes(("\r".join(ROWS) + "\r").encode())
+    cr = load(tmp_path / "scene.yaml")
+    same_bodies(cr.bodies, lf.bodies)
+    assert cr.names == lf.names
+    bad = ROWS[:4] + ["3,box,10,10,150,80,abc,-10,0.5,red,,false,false"]
+    (tmp_path / "bodies.csv").write_bytes(("\r".join(bad) + "\r").encode())
+    with pytest.raises(ScenarioError) as info:
+        load(tmp_path / "scene.yaml")
+    assert (info.value.line, info.value.col) == (5, 20)  # the line an editor shows
+
+
+@pytest.mark.parametrize(
+    "cell, line, fragment",
+    [
+        ("x" * 101, 2, "column name: the cell holds more than 100 characters"),
+        ("x" * 200_000, 2, "column name: the cell holds more than 100 characters"),  # past csv's
+        ('"' + "x" * 200_000 + '"', 2, "column name: the cell holds more than 100 characters"),
+        ("  " + "x" * 100, 2, "column name: the cell holds more than 100 characters"),
+    ],
+)
+def test_a_text_cell_past_its_bound_is_refused_not_cut(tmp_path, capsys, cell, line, fragment):
+    rows = ["id,shape,w,h,x,y,name", f"0,box,2,2,0,0,{cell}", "1,box,2,2,10,0,zz"]
+    status, err = run_validate(tmp_path, capsys, ("\n".join(rows) + "\n").encode())
+    assert status == 2
+    assert err == f"{tmp_path / 'bodies.csv'}:{line}:15: error: row 1, {fragment}\n"
+
+
+def test_a_long_cell_does_not_hide_a_bad_cell_after_it(tmp_path, capsys):
+    """The bad cell is found again with the csv module, whose field limit (131,072 characters)
+    a long quoted name passes."""
+    rows = [
+        "id,shape,w,h,x,y,color",
+        f'0,box,2,2,0,0,"{"white" + " " * 200_000}"',
+        "1,box,2,2,10,0,white",
+        "2,box,2,2,1_0,0,white",
+    ]
+    status, err = run_validate(tmp_path, capsys, ("\n".join(rows) + "\n").encode())
+    assert (status, err) == (
+        2,
+        f"{tmp_path / 'bodies.csv'}:4:11: error: row 3, column x: must be a number, not '1_0'\n",
+    )
+
+
+@pytest.mark.parametrize("number", ["1_0", "１０", "0x10", "1d5", "nan(1)", "- 1", "1e", "."])
+def test_a_number_numpy_does_not_read_is_refused_at_its_cell(tmp_path, capsys, number):
+    rows = ["id,shape,w,h,x,y", "0,box,2,2,0,0", f"1,box,2,2,{number},0"]
+    status, err = run_validate(tmp_path, capsys, ("\n".join(rows) + "\n").encode())
+    assert status == 2
+    assert err == (
+        f"{tmp_path / 'bodies.csv'}:3:11: error: row 2, column x: must be a number, not "
+        f"{number!r}\n"
+    )
+
+
+def test_two_rows_of_one_name_are_refused_at_the_second(tmp_path, capsys):
+    rows = ["id,shape,w,h,x,y,name", "0,box,2,2,0,0,a", "1,box,2,2,10,0,b", "2,box,2,2,20,0, a"]
+    status, err = run_validate(tmp_path, capsys, ("\n".join(rows) + "\n").encode())
+    assert status == 2
+    assert err == (
+        f"{tmp_path / 'bodies.csv'}:4:16: error: row 3, column name: 'a' is taken, like object 0 "
+        "(row 1 of the table); names must differ, they name the objects in events.jsonl and "
+        "final.csv\n"
+    )
+    rec = np.zeros(
+        2, dtype=[(c, "f8") for c in ("id", "w", "h", "x", "y")] + [("shape", "U3"), ("name", "S4")]
+    )
+    rec["id"], rec["x"], rec["w"], rec["h"], rec["shape"], rec["name"] = (
+        [0, 1],
+        [0, 10],
+        2,
+        2,
+        "box",
+        b"b",
+    )
+    np.save(tmp_path / "dup.npy", rec)
+    status, err = run_validate(tmp_path, capsys, (tmp_path / "dup.npy").read_bytes(), "t.npy")
+    assert status == 2 and "t.npy:2:7: error: row 2, column name: 'b' is taken" in err
+
+
+def test_values_in_messages_read_as_written(tmp_path, capsys):
+    for column, value, said in (
+        ("mass", -1.5, "must be from 1e-15 to 1e+15, not -1.5"),
+        ("static", np.nan, "must be true or false, not nan"),
+        ("fill", 2.0, "must be true or false, not 2"),
+    ):
+        numbers = ("id", "w", "h", "x", "y", column)
+        rec = np.zeros(1, dtype=[(c, "f8") for c in numbers] + [("shape", "U3")])
+        rec["w"], rec["h"], rec["shape"], rec[column] = 2, 2, "box", value
+        np.save(tmp_path / "t.npy", rec)
+        status, err = run_validate(tmp_path, capsys, (tmp_path / "t.npy").read_bytes(), "t.npy")
+        assert (status, err) == (
+            2,
+            f"{tmp_path / 't.npy'}:1:6: error: row 1, column {column}: {said}\n",
+        )
+
+
+def test_an_npy_header_claiming_more_rows_than_the_file_holds_is_refused_unallocated(
+    tmp_path, capsys
+):
+    """The header's claim (100,000 rows of 804 bytes, 80 MB) is held against the file's size
+    before any array is made."""
+    rec = np.zeros(
+        1,
+        dtype=[(c, "f8") for c in ("id", "w", "h", "x", "y")] + [("shape", "U3"), ("name", "U187")],
+    )
+    np.save(tmp_path / "t.npy", rec)
+    raw = (tmp_path / "t.npy").read_bytes()
+    raw = raw.replace(b"(1,)", b"(100000,)", 1)
+    run_validate(tmp_path, capsys, raw, "t.npy")  # kernels and modules loaded once
+    tracemalloc.start()
+    try:
+        status, err = run_validate(tmp_path, capsys, raw, "t.npy")
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert status == 2
+    assert "t.npy:1:1: error: not a whole .npy file: its header claims 100,000 row(s)" in err
+    assert peak < 20 * 2**20, peak
+
+
+def test_a_table_or_scenario_that_is_not_a_regular_file_is_refused_at_once(tmp_path, capsys):
+    """A FIFO is refused before it is opened for a blocking read (a writer opening it after a
+    while lets a waiting reader go, so this test cannot hang)."""
+    fifo = tmp_path / "bodies.csv"
+    os.mkfifo(fifo)
+    scene = tmp_path / "scene.yaml"
+    scene.write_text(HEAD.replace("MODEL", "stepped") + "objects: {file: bodies.csv}\n")
+    os.mkfifo(tmp_path / "piped.yaml")
+
+    def release(path):
+        time.sleep(5)
+        try:
+            os.close(os.open(path, os.O_WRONLY | os.O_NONBLOCK))
+        except OSError:
+            pass  # no reader waits: nothing to release
+
+    for path, said in ((scene, f"{fifo}:1:1"), (tmp_path / "piped.yaml", None)):
+        waiting = fifo if said else tmp_path / "piped.yaml"
+        threading.Thread(target=release, args=(waiting,), daemon=True).start()
+        capsys.readouterr()
+        began = time.monotonic()
+        assert main(["validate", str(path)]) == 2
+        assert time.monotonic() - began < 3
+        where = said or f"{path}:1:1"
+        assert capsys.readouterr().err == (
+            f"{where}: error: cannot read the {'table' if said else 'file'}: it is a FIFO "
+            "(named pipe), not a regular file\n"
+        )
+
+
+@pytest.mark.parametrize(
+    "rows, line, col",
+    [
+        (['0,box,2,2,0,0,"abc', "1,box,2,2,10,0,x"], 2, 15),  # read whole, a row taken for a name
+        (["0,box,2,2,0,0,x", '1,box,2,2,10,"0,y', "2,box,2,2,20,0,z"], 3, 14),
+    ],
+)
+def test_a_quote_never_closed_is_refused_where_it_opens(tmp_path, capsys, rows, line, col):
+    text = "\n".join(["id,shape,w,h,x,y,name", *rows]) + "\n"
+    status, err = run_validate(tmp_path, capsys, text.encode())
+    assert (status, err) == (
+        2,
+        f"{tmp_path / 'bodies.csv'}:{line}:{col}: error: a quoted field opens here and is never "
+        'closed (a " is missing)\n',
+    )
+    closed = text.replace('"abc', '"abc"').replace('"0,y', '"0",y')  # closed: read as written
+    status, err = run_validate(tmp_path, capsys, closed.encode())
+    assert (status, err) == (0, "")
+
+
+def test_a_name_that_no_output_could_write_is_refused_at_its_cell(tmp_path, capsys):
+    """A .npy string may hold a lone surrogate, which no UTF-8 output can write (exit 3 at the
+    first write before)."""
+    numbers = [(c, "f8") for c in ("id", "w", "h", "x", "y")]
+    rec = np.zeros(2, dtype=numbers + [("shape", "U3"), ("name", "U2")])
+    rec["name"] = ["ok", "\ud800"]
+    rec["id"], rec["x"], rec["w"], rec["h"], rec["shape"] = [0, 1], [0, 10], 2, 2, "box"
+    np.save(tmp_path / "t.npy", rec)
+    status, err = run_validate(tmp_path, capsys, (tmp_path / "t.npy").read_bytes(), "t.npy")
+    assert (status, err) == (
+        2,
+        f"{tmp_path / 't.npy'}:2:7: error: row 2, column name: a name is text, not a lone "
+        "surrogate U+D800\n",
+    )

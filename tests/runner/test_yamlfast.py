@@ -136,6 +136,7 @@ def at(k, old, new):
         at(0, "position: [", "position: [399"),
         at(1, "Red", "'Red'"),
         at(3, "static: false", "static: true"),
+        at(3, "name: b-3", "name: wall_2"),  # two objects of one name
     ],
 )
 def test_what_the_lane_declines_the_general_path_reads_or_refuses(small_lane, change):

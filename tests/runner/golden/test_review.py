@@ -198,3 +198,44 @@ def test_bless_from_report_skips_runs_an_older_report_left(tree, capsys):
     assert _run("bless", "--from-report", "rep") == 0
     out = capsys.readouterr().out
     assert out.startswith("updated   demo:") and "other" not in out
+
+
+TABLE_SCENE = """version: 1
+name: tab
+world: {width: 40, height: 30, fps: 10}
+model: paper
+ticks: 6
+objects: {file: tab.csv}
+"""
+
+
+def test_a_table_is_part_of_the_scenario_goldens_and_reports_keep(tmp_path, monkeypatch, capsys):
+    """An edited table reads as an edited scenario in `check`, and `bless --from-report` refuses
+    a table changed since the report (and takes it back once it is as the report saw it)."""
+    (tmp_path / "scenarios").mkdir()
+    (tmp_path / "scenarios" / "tab.yaml").write_text(TABLE_SCENE)
+    table = tmp_path / "scenarios" / "tab.csv"
+
+    def rows(vx):
+        table.write_text(f"id,shape,w,h,x,y,vx\n0,box,4,4,2,2,{vx}\n1,box,4,4,30,20,0\n")
+
+    monkeypatch.chdir(tmp_path)
+    rows(10)
+    assert cli.main(["bless"]) == 0
+    manifest = tmp_path / "goldens" / "tab" / "manifest.json"
+    blessed = manifest.read_bytes()
+    rows(20)
+    capsys.readouterr()
+    assert cli.main(["check", "--format", "json"]) == 1
+    (scn,) = json.loads(capsys.readouterr().out)["scenarios"]
+    assert scn["cause"]["kind"] == why.SCENARIO_EDITED
+    assert scn["cause"]["text"].startswith("the scenario was edited since bless")
+    assert cli.main(["check", "--report", "rep"]) == 1
+    rows(30)  # changed again after the report
+    capsys.readouterr()
+    assert cli.main(["bless", "--from-report", "rep"]) == 2
+    assert "edited after the report was written" in capsys.readouterr().err
+    assert manifest.read_bytes() == blessed
+    rows(20)  # as the report saw it
+    assert cli.main(["bless", "--from-report", "rep"]) == 0
+    assert cli.main(["check"]) == 0

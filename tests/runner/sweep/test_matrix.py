@@ -23,6 +23,28 @@ def test_set_values_split_on_commas_outside_brackets():
     assert [type(n).__name__ for n in axis.nodes] == ["SequenceNode", "ScalarNode", "SequenceNode"]
 
 
+def test_a_comma_inside_a_quoted_value_stays_in_the_value():
+    axis = parse_set("""objects.0.name='a, b',"c, \\"d\\", e",it's,'x''y, z',[' ]', 2],f""")
+    assert axis.texts == ("'a, b'", '"c, \\"d\\", e"', "it's", "'x''y, z'", "[' ]', 2]", "f")
+    values = [
+        n.value if hasattr(n.value, "upper") else [v.value for v in n.value] for n in axis.nodes
+    ]
+    assert values == ["a, b", 'c, "d", e', "it's", "x'y, z", [" ]", "2"], "f"]
+
+
+def test_a_side_past_its_bound_names_the_bound_whatever_the_number():
+    for value, shown in (
+        ("1e308", "1e308"),
+        ("100000", "100000"),
+        ("2e19", "20000000000000000000"),
+    ):
+        with pytest.raises(ScenarioError) as err:
+            expand([FIFTY], [parse_set(f"world.width={value}")], None)
+        assert err.value.message.endswith(
+            f"world.width {shown} is past the limit of 16384 px per side; raise it with --max-side"
+        )
+
+
 @pytest.mark.parametrize(
     "option, said",
     [

@@ -1,0 +1,308 @@
+"""A table's bytes to one structured array: the CSV and `.npy` readers of `runner.table`.
+
+Both take the file's bytes, read once (`runner.readfile`), and give a numpy structured array whose
+field names are the columns, with a `Place` that turns (row, column) into the cell's place for a
+message. Nothing is parsed before the header has been checked and the row count held against
+`--max-objects`.
+
+CSV: UTF-8 text (an initial byte-order mark dropped); lines end in LF, CRLF or CR alone (all read
+as LF first, so the row count and every line number mean what an editor shows). The header names
+the columns; the rows are read by `numpy.loadtxt` in one pass, numbers as float64 and each text
+column as text of its TEXT_CHARS width and one character more, so a longer cell is seen, never cut
+short in silence (`runner.table` refuses it). A header with no rows is a table of no objects. When
+numpy refuses a row, the cell is found again with Python's csv module (its field size limit
+raised to the text's length for that reading, so a long cell is read like any other): a row of the
+wrong length, or a number numpy does not read (`NUMBER_RE`: decimal, exponent, `inf`, `nan`; not
+`1_000`, not `0x10`, not full-width digits). A quote that opens a field and is never closed would
+take the rest of the file into that field, rows and all: it is refused where it opens (looked for
+only when fewer rows were read than the text has lines, or when numpy refused the text).
+
+`.npy`: the header is read from the bytes first; a one-dimensional structured array of numbers
+and text (no objects, so no pickles), whose rows at their item size must fill the rest of the file
+exactly, before the array is made over those same bytes (no copy, nothing allocated from what the
+header claims).
+"""
+
+from __future__ import annotations
+
+import csv
+import difflib
+import io
+import re
+import threading
+
+import numpy as np
+
+from collide2d.runner.limits import Limits
+from collide2d.runner.objects import MAX_OBJECT_NAME_CHARS
+from collide2d.runner.yamlsafe import ScenarioError
+
+COLUMNS = ("id", "shape", "w", "h", "x", "y", "vx", "vy", "mass", "color", "name", "static", "fill")
+REQUIRED = ("id", "shape", "w", "h", "x", "y")
+NUMBERS = ("id", "w", "h", "x", "y", "vx", "vy")
+# Longest text a cell may hold, per text column (characters, as written); wider columns would cost
+# memory for every row. A name's bound is the one every object name has (runner.objects).
+TEXT_CHARS = {
+    "shape": 16,
+    "color": 40,
+    "name": MAX_OBJECT_NAME_CHARS,
+    "static": 8,
+    "fill": 8,
+    "mass": 100,
+}
+# A number as numpy.loadtxt reads one (surrounding whitespace aside).
+NUMBER_RE = re.compile(
+    r"[+-]?(?:(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|inf|infinity|nan)",
+    re.IGNORECASE | re.ASCII,
+)
+_CSV_LIMIT = threading.Lock()  # the csv module's field size limit is one for the whole process
+
+
+class Place:
+    """Where a cell is, for messages: the CSV's line and character column (found by reading the
+    text again, only when an error needs it) or the .npy's row and field number."""
+
+    def __init__(self, shown: str, header: list[str], text: str | None):
+        self.shown = shown
+        self.header = header
+        self.text = text
+
+    def __call__(self, row: int, column: str, message: str) -> ScenarioError:
+        col = self.header.index(column) if column in self.header else 0
+        message = f"row {row + 1}, column {column}: {message}" if column else message
+        if self.text is None:  # .npy: row counted from 1, the field's number
+            return ScenarioError(self.shown, row + 1, col + 1, message)
+        line, char = _csv_cell(self.text, row, col)
+        return ScenarioError(self.shown, line, char, message)
+
+
+def header_error(shown: str, header: list[str]) -> None:
+    """Unknown, repeated and missing columns, at the header line."""
+    seen = set()
+    at = 1
+    for name in header:
+        if name not in COLUMNS:
+            near = difflib.get_close_matches(name, COLUMNS, n=1)
+            hint = f"did you mean '{near[0]}'?" if near else "expected " + ", ".join(COLUMNS)
+            raise ScenarioError(shown, 1, at, f"unknown column {name!r}; {hint}")
+        if name in seen:
+            raise ScenarioError(shown, 1, at, f"column {name!r} appears twice")
+        seen.add(name)
+        at += len(name) + 1
+    missing = [c for c in REQUIRED if c not in seen]
+    if missing:
+        raise ScenarioError(
+            shown,
+            1,
+            1,
+            f"the table lacks the column(s) {', '.join(missing)} (header: id, shape, "
+            "w, h, x, y and optionally vx, vy, mass, color, name, static, fill)",
+        )
+
+
+def _too_many(shown: str, rows: int, limits: Limits) -> None:
+    if rows > limits.max_objects:
+        raise ScenarioError(
+            shown,
+            1,
+            1,
+            f"the table has {rows} rows, past the limit of {limits.max_objects} objects; "
+            "raise it with --max-objects",
+        )
+
+
+# --- CSV ----------------------------------------------------------------------------------------
+
+
+def read_csv(raw: bytes, shown: str, limits: Limits):
+    """(structured array, Place) of the CSV table `raw`."""
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = raw.count(b"\n", 0, exc.start) + 1
+        raise ScenarioError(shown, line, 1, "the table is not UTF-8 text") from None
+    if "\r" in text:
+        text = text.replace("\r\n", "\n").replace("\r", "\n")
+    rows = text.count("\n") + (0 if text.endswith("\n") else 1) - 1
+    _too_many(shown, rows, limits)
+    first, _, body = text.partition("\n")
+    if not first.strip():
+        raise ScenarioError(shown, 1, 1, "the table is empty; its first line names the columns")
+    header = [h.strip() for h in next(csv.reader([first]), [])]
+    header_error(shown, header)
+    place = Place(shown, header, text)
+    dtype = [(c, "f8") if c in NUMBERS else (c, f"U{TEXT_CHARS[c] + 1}") for c in header]
+    if not body.strip():  # a header alone: no objects (numpy would warn of no data)
+        return np.zeros(0, dtype), place
+    try:
+        data = np.loadtxt(
+            io.StringIO(text),
+            dtype=dtype,
+            delimiter=",",
+            skiprows=1,
+            comments=None,
+            quotechar='"',
+            ndmin=1,
+        )
+    except ValueError:
+        raise _first_bad_cell(text, header, place) from None
+    if data.shape[0] < rows:  # blank lines, or a record over several lines: is a quote left open?
+        open_at = _records(text)[1]
+        if open_at is not None:
+            raise _unclosed(text, shown, open_at)
+    return data, place
+
+
+def _records(text: str) -> tuple[list[tuple[int, int, list[str]]], int | None]:
+    """(data row from 0, its first line from 1, fields) of each CSV record after the header, blank
+    lines skipped as numpy.loadtxt skips them, and the line where the last record starts when a
+    quoted field of it is never closed (it runs to the end of the text, as numpy reads it too),
+    else None. A cell of any length is read: the csv module's field limit is raised to the text's
+    length while it reads."""
+    out = []
+    last = None
+    with _CSV_LIMIT:
+        old = csv.field_size_limit()
+        csv.field_size_limit(max(old, len(text) + 1))
+        try:
+            reader = csv.reader(io.StringIO(text))
+            next(reader, None)
+            k = -1
+            start = reader.line_num + 1
+            for record in reader:
+                if record and not (all(not f.strip() for f in record) and len(record) <= 1):
+                    k += 1
+                    out.append((k, start, record))
+                    last = start
+                start = reader.line_num + 1
+        finally:
+            csv.field_size_limit(old)
+    if last is None:
+        return out, None
+    tail = text.split("\n", last - 1)[-1]  # the last record, from its first line to the end
+    return out, (last if _open_quote(tail) else None)
+
+
+def _open_quote(raw: str) -> int:
+    """Character column (from 1) of a quote that opens a field of the CSV text `raw` and is never
+    closed, or 0."""
+    quoted, at, start = False, 0, True
+    i = 0
+    while i < len(raw):
+        ch = raw[i]
+        if quoted:
+            if ch == '"' and raw[i + 1 : i + 2] == '"':
+                i += 1  # "" is one quote
+            elif ch == '"':
+                quoted = False
+        elif ch == '"' and start:
+            quoted, at = True, i + 1
+        start = not quoted and ch in ",\n"
+        i += 1
+    return at if quoted else 0
+
+
+def _csv_cell(text: str, row: int, col: int) -> tuple[int, int]:
+    """(line, character column) of field `col` of data row `row` (blank lines skipped, as
+    numpy.loadtxt skips them), both from 1."""
+    for k, line, _record in _records(text)[0]:
+        if k == row:
+            return line, _field_start(text.split("\n", line)[line - 1], col)
+    return 1, 1
+
+
+def _unclosed(text: str, shown: str, line: int) -> ScenarioError:
+    """The error of a quoted field opened in the record starting at `line` and never closed."""
+    tail = text.split("\n", line - 1)[-1]
+    at = _open_quote(tail)
+    line += tail.count("\n", 0, at - 1)
+    col = at - (tail.rfind("\n", 0, at - 1) + 1)
+    return ScenarioError(
+        shown, line, col, 'a quoted field opens here and is never closed (a " is missing)'
+    )
+
+
+def _field_start(raw: str, col: int) -> int:
+    """Character column (from 1) where field `col` of the CSV line `raw` starts."""
+    field, quoted = 0, False
+    for i, ch in enumerate(raw):
+        if field == col:
+            return i + 1
+        if ch == '"':
+            quoted = not quoted
+        elif ch == "," and not quoted:
+            field += 1
+    return len(raw) + 1
+
+
+def _first_bad_cell(text: str, header: list[str], place: Place) -> ScenarioError:
+    """The error numpy met, found again cell by cell: a row of the wrong length or a number that
+    is not one."""
+    records, open_at = _records(text)
+    if open_at is not None:  # the last record runs to the end inside a quote
+        records = records[:-1]
+    for k, line, record in records:
+        if len(record) != len(header):
+            return ScenarioError(
+                place.shown,
+                line,
+                1,
+                f"row {k + 1} has {len(record)} fields; the header names {len(header)}",
+            )
+        for c, name in enumerate(header):
+            if name in NUMBERS and not NUMBER_RE.fullmatch(record[c].strip()):
+                return place(k, name, f"must be a number, not {_cut(record[c].strip())!r}")
+    if open_at is not None:
+        return _unclosed(text, place.shown, open_at)
+    return ScenarioError(place.shown, 1, 1, "the table cannot be read as CSV")
+
+
+def _cut(text: str, chars: int = 40) -> str:
+    """`text`, or its first `chars` characters and an ellipsis."""
+    return text if len(text) <= chars else text[:chars] + "…"
+
+
+# --- .npy ---------------------------------------------------------------------------------------
+
+
+def read_npy(raw: bytes, shown: str, limits: Limits):
+    """(structured array, Place) of the .npy table `raw`: the array is made over these bytes."""
+    f = io.BytesIO(raw)
+    try:
+        version = np.lib.format.read_magic(f)
+        if version == (1, 0):
+            shape, _fortran, dtype = np.lib.format.read_array_header_1_0(f)
+        else:
+            shape, _fortran, dtype = np.lib.format.read_array_header_2_0(f)
+    except (ValueError, EOFError) as exc:
+        raise ScenarioError(shown, 1, 1, f"not a .npy file numpy can read ({exc})") from None
+    if dtype.names is None or len(shape) != 1:
+        raise ScenarioError(
+            shown,
+            1,
+            1,
+            "a .npy table holds a one-dimensional structured array whose field "
+            "names are the columns",
+        )
+    _too_many(shown, shape[0], limits)
+    header = list(dtype.names)
+    header_error(shown, header)
+    for c in header:
+        kind = dtype[c].kind
+        if c in NUMBERS and kind not in "iuf":
+            raise ScenarioError(shown, 1, header.index(c) + 1, f"column {c} must hold numbers")
+        if c not in NUMBERS and kind not in "iufbUS":
+            raise ScenarioError(shown, 1, header.index(c) + 1, f"column {c} must hold text")
+    start = f.tell()
+    need = shape[0] * dtype.itemsize
+    if len(raw) - start != need:
+        raise ScenarioError(
+            shown,
+            1,
+            1,
+            f"not a whole .npy file: its header claims {shape[0]:,} row(s) of "
+            f"{dtype.itemsize:,} bytes ({need:,} bytes), the file holds {len(raw) - start:,} "
+            "bytes after the header",
+        )
+    data = np.frombuffer(raw, dtype=dtype, count=shape[0], offset=start)
+    return data, Place(shown, header, None)
