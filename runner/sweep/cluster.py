@@ -33,6 +33,7 @@ INSTALL = 'pip install "collide2d[dask]"'
 # Seconds a scheduler has to answer: a live one answers in milliseconds, and a typo should not
 # keep the command waiting (Dask's own default is 30 s).
 CONNECT_TIMEOUT_S = 3
+MESSAGES_KEPT = 16  # messages a connection keeps for debugging (see `connect`)
 SCHEMES = ("tcp", "tls", "ws", "wss", "ucx")  # Dask's network protocols
 _ADDRESS = re.compile(
     r"(?:(?P<scheme>[a-z]+)://)?"
@@ -92,8 +93,18 @@ def connect(workers: int | None = None, scheduler: str | None = None):
     """A Client on the cluster at `scheduler`, or on an embedded LocalCluster of `workers`
     processes (default: one per core)."""
     require_dask()
+    import dask
     from distributed import Client, LocalCluster
 
+    # Dask keeps the last messages of each connection for debugging, tasks and their arguments
+    # (a run's scenario) with them: a thousand by default, so memory would grow with the tasks
+    with dask.config.set({"distributed.admin.low-level-log-length": MESSAGES_KEPT}):
+        with _connected(Client, LocalCluster, workers, scheduler) as client:
+            yield client
+
+
+@contextlib.contextmanager
+def _connected(Client, LocalCluster, workers, scheduler):
     # Ctrl-C raises KeyboardInterrupt here, as `collide2d run` stops on it: also when the process
     # started with SIGINT ignored, as a shell starts a job in the background (`collide2d sweep
     # ... &`; Python would leave it ignored, and a `kill -INT` would go unanswered)

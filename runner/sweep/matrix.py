@@ -257,8 +257,14 @@ def seed_key(seed: int) -> tuple:
     return (0, float(seed), str(seed))
 
 
-def _file_model(path: str, limits: Limits) -> str:
-    return load(path, limits=limits).model
+def _file_model(path: str, seed: int | None, limits: Limits) -> str:
+    """The model of the file itself (as loaded with the sweep's first seed, if any: the file's
+    own seed need not place its objects)."""
+    said = f"in the sweep run seed={seed}" if seed is not None else path
+    try:
+        return load(path, limits=limits, edit=_edit({}, seed, said)).model
+    except ScenarioError as exc:
+        raise ScenarioError(exc.path, exc.line, exc.col, f"{said}: {exc.message}") from None
 
 
 def check_axes(scenarios: list[str], axes: list[Axis], seeds) -> int:
@@ -286,10 +292,10 @@ def check_axes(scenarios: list[str], axes: list[Axis], seeds) -> int:
     return count
 
 
-def choices(path: str, axes: list[Axis], limits: Limits):
+def choices(path: str, axes: list[Axis], seed: int | None, limits: Limits):
     """Each combination of the axes' values for the scenario at `path`: {key: (node, text)},
     without the settings its model does not take (see the module docstring)."""
-    base_model = _file_model(path, limits)
+    base_model = _file_model(path, seed, limits)
     for combo in itertools.product(*(range(len(a.texts)) for a in axes)):
         chosen = {a.key: (a.nodes[i], a.texts[i]) for a, i in zip(axes, combo, strict=True)}
         model = ys.value(chosen["model"][0]) if "model" in chosen else base_model

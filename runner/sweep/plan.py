@@ -130,8 +130,8 @@ def check(
     try:
         with lanes.loads(count):
             for path in scenarios:
-                for chosen, model in matrix.choices(path, axes, limits):
-                    first = seeds[0] if seeds else None
+                first = seeds[0] if seeds else None
+                for chosen, model in matrix.choices(path, axes, first, limits):
                     combo, scenario = matrix.combo_of(path, chosen, model, dotted, first, limits)
                     name = scenario.name
                     if name in names and names[name] != path:
