@@ -4,9 +4,11 @@ An `Axis` is one swept key with its values: a run setting (`model`, `fps`, `tick
 `geometry`) or a dotted scenario key (`world.width`, `generate.0.count`: mapping keys and list
 indices from the top of the file). `parse_set` reads `--set KEY=V1,V2,...` (values are YAML, split
 on the commas outside brackets, so `--set generate.0.size=[10,10],[20,20]` works), `parse_seeds`
-reads `--seeds 1-100` (also `7` and `1-5,9`). `expand` makes the runs: the product of every axis
-and seed for each scenario, each run's scenario loaded and checked in full before anything runs
-(a located `ScenarioError` naming the run's values when one is refused). A setting the run's model
+reads `--seeds 1-100` (also `7` and `1-5,9`). The runs are the product of every axis and seed for
+each scenario: `choices` gives each combination of the axes' values, `combo_of` loads it in full
+as a `Combo` (the runs of every seed share it; `runner.sweep.plan` checks the seeds), and
+`load_run` loads one run (a located `ScenarioError` naming the run's values when one is
+refused). A setting the run's model
 does not take (`substeps` off `stepped`; `substeps` and `geometry` under `paper`) is left out and
 the runs it would have told apart count once. A seed goes to every `generate` block of the file.
 
