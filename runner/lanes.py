@@ -25,7 +25,8 @@ boxes, 100 ticks, every frame drawn for the GIF) takes 0.19 s; a gas of 300 boxe
 2.6 s (36,000 object-ticks), where numba loads its cached kernels in about 0.5 s.
 
 Loading a scenario runs kernels too (the start-overlap check, `generate` blocks, the starting
-room check): interpreted up to LOAD_INTERPRETED_MAX_OBJECTS objects (`objects(n)`).
+room check): interpreted up to LOAD_INTERPRETED_MAX_OBJECTS objects (`objects(n)`), counting the
+objects of every load of a `loads(k)` block (a sweep's check draws one scene for each seed).
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ import contextlib
 import math
 import os
 import time
+from contextvars import ContextVar
 
 import numpy as np
 
@@ -57,6 +59,7 @@ INTERPRETED_LEFT_S = 3.0
 INTERPRETED_CHUNK_TICKS = 8
 
 _mode: str | None = None  # set by the command line; None: the environment's, else auto
+_loads: ContextVar[int] = ContextVar("collide2d_loads", default=1)
 
 
 def check_mode(mode: str) -> str:
@@ -162,7 +165,18 @@ def objects(n: int):
     chosen = mode()
     if chosen != "auto":
         return jit.lane(chosen == "on")
-    return jit.lane(n > LOAD_INTERPRETED_MAX_OBJECTS)
+    return jit.lane(n * _loads.get() > LOAD_INTERPRETED_MAX_OBJECTS)
+
+
+@contextlib.contextmanager
+def loads(k: int):
+    """A `with` block of about `k` loads of one scene: each load's kernels take the lane of
+    all their objects together (`objects`)."""
+    token = _loads.set(max(1, int(k)))
+    try:
+        yield
+    finally:
+        _loads.reset(token)
 
 
 def name(compiled: bool) -> str:

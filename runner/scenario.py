@@ -211,6 +211,9 @@ class Scenario:
     text_sha256: str  # of the file's bytes; with a table, of both (`with_table`)
     # the exact model's cap: --max-events-per-tick, else the model option, else the default
     max_events_per_tick: int = DEFAULT_MAX_EVENTS_PER_TICK
+    # each generate block as drawn (runner.generate.BlockSpec), its objects the last of `bodies`:
+    # what a sweep draws again for another seed (runner.sweep.reseed)
+    generated: tuple = ()
 
 
 def load(
@@ -352,6 +355,7 @@ class _Reader(Nodes):
             golden=golden,
             text_sha256=digest,
             max_events_per_tick=cap,
+            generated=tuple(b.spec for b in blocks),
         )
 
     def description(self, top: dict) -> str:

@@ -4,8 +4,8 @@
 runs each scenario itself, as always). Otherwise it runs `run(scenario)` for every scenario on the
 cluster (`runner.sweep.cluster`) and returns, in the scenarios' order, one callable per scenario
 that gives its run's result or raises what the run raised; the check then compares each with its
-golden locally, exactly as it compares a local run, so its output is the same. Dask missing is
-bad input (`usage`, the check's exception for it).
+golden locally, exactly as it compares a local run, so its output is the same. Dask missing, or
+a scheduler that does not answer, is bad input (`usage`, the check's exception for it).
 """
 
 from __future__ import annotations
@@ -33,16 +33,19 @@ def cluster_runs(args, scenarios, run, usage):
         raise usage(str(exc)) from None
     got: dict[int, tuple] = {}
     items = [scn for _path, scn in scenarios]
-    with cluster.connect(workers, scheduler) as client:
-        progress = cluster.progress_for(len(items), "check", args.quiet)
-        complete = cluster.run_all(
-            client,
-            run,
-            items,
-            lambda i, value, error: got.__setitem__(i, (value, error)),
-            progress=progress,
-            label="collide2d-check",
-        )
+    try:
+        with cluster.connect(workers, scheduler) as client:
+            progress = cluster.progress_for(len(items), "check", args.quiet)
+            complete = cluster.run_all(
+                client,
+                run,
+                items,
+                lambda i, value, error: got.__setitem__(i, (value, error)),
+                progress=progress,
+                label="collide2d-check",
+            )
+    except cluster.SchedulerUnreachable as exc:
+        raise usage(str(exc)) from None
     if not complete:
         raise KeyboardInterrupt
     return [_outcome(*got[i]) for i in range(len(items))]

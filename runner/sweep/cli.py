@@ -1,11 +1,12 @@
 """The `sweep` subcommand: its arguments, and the run that builds the matrix, runs it, writes it.
 
 `register` adds the subcommand without loading Dask; `cmd_sweep` reads the matrix (scenario files
-and `--set`/`--seeds`, or one sweep file), loads and checks every run before anything runs, runs
-them on the cluster (`--scheduler`, else an embedded LocalCluster of `--workers` processes) and
-writes OUT/sweep/. Exit status: 0 done, 2 bad input (nothing written) or Dask not installed,
-3 when a run failed unexpectedly (its row says so), 130 when cancelled by Ctrl-C (the rows done
-are written, marked incomplete).
+and `--set`/`--seeds`, or one sweep file), checks every run before anything runs (`plan.check`),
+runs them on the cluster (`--scheduler`, else an embedded LocalCluster of `--workers` processes)
+and writes OUT/sweep/ whole (`folder`; OUT is `--out`, else the project's `out` setting, else
+`out`). Exit status: 0 done, 2 bad input (nothing written), Dask not installed, a scheduler that
+does not answer or OUT/sweep taken by another sweep, 3 when a run failed unexpectedly (its row says
+so), 130 when cancelled by Ctrl-C (the rows done are written, marked incomplete).
 """
 
 from __future__ import annotations
@@ -51,8 +52,11 @@ def add_cluster_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="N",
         help="run on an embedded Dask cluster of N processes (default: one per core)",
     )
+    from collide2d.runner.sweep.cluster import scheduler_address
+
     where.add_argument(
         "--scheduler",
+        type=scheduler_address,
         metavar="ADDRESS",
         help="run on the Dask cluster whose scheduler is at ADDRESS (tcp://HOST:PORT), started "
         "with `dask scheduler` and `dask worker`",
@@ -85,7 +89,11 @@ def register(subparsers) -> None:
     )
     p.add_argument("--seeds", metavar="A-B", help="sweep every generate block's seed over A..B")
     add_cluster_arguments(p)
-    p.add_argument("--out", default="out", metavar="DIR", help="output folder (default: out)")
+    p.add_argument(
+        "--out",
+        metavar="DIR",
+        help="output folder (default: the project's [tool.collide2d] out, else out)",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress, no summary")
     add_limit_arguments(p)
     p.set_defaults(func=cmd_sweep)
@@ -114,43 +122,52 @@ def matrix_from_args(args):
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
-    from collide2d.runner.sweep import cluster, driver, matrix, results
+    from collide2d.runner import config
+    from collide2d.runner.sweep import cluster, driver, folder, matrix, plan, results
+
+    project = config.find()
+    out_root = args.out or (project.folder("out") if project.file else "out")
+
+    def checking(total: int):
+        return cluster.progress_for(total, "checking", args.quiet)
 
     try:
         cluster.require_dask("collide2d sweep")
         paths, axes, seeds, limits = matrix_from_args(args)
-        runs = matrix.expand(paths, axes, seeds, limits)
-    except (cluster.DaskMissing, matrix.SweepError) as exc:
+        folder.check_replaceable(out_root)
+        runs = plan.check(paths, axes, seeds, limits, progress=checking)
+        with (
+            cluster.connect(args.workers, args.scheduler) as client,
+            folder.staged(out_root) as stage,
+        ):
+            if not args.quiet:
+                where = args.scheduler or f"{args.workers or os.cpu_count()} local workers"
+                print(f"sweep: {len(runs)} runs on {where}", file=sys.stderr, flush=True)
+            progress = cluster.progress_for(len(runs), "sweep", args.quiet)
+            table, complete = driver.run_sweep(client, runs, progress=progress)
+            written = results.write(stage, table, complete)
+    except (
+        cluster.DaskMissing,
+        cluster.SchedulerUnreachable,
+        matrix.SweepError,
+        folder.FolderRefused,
+    ) as exc:
         print(f"collide2d: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
-    target = Path(args.out) / REPORT_DIR
-    if target.is_symlink():
-        print(
-            f"collide2d: error: {target} is a symbolic link; name another folder", file=sys.stderr
-        )
-        return EXIT_BAD_INPUT
-    columns = matrix.columns(axes, seeds)
-    with cluster.connect(args.workers, args.scheduler) as client:
-        if not args.quiet:
-            where = args.scheduler or f"{args.workers or os.cpu_count()} local workers"
-            print(f"sweep: {len(runs)} runs on {where}", file=sys.stderr, flush=True)
-        progress = cluster.progress_for(len(runs), "sweep", args.quiet)
-        figures, positions, complete = driver.run_sweep(client, runs, progress=progress)
-    table = results.rows(runs, figures, positions)
-    written = results.write(target, columns, table, len(runs), complete)
-    failed = [r for r in table if r["status"] == "error"]
+    target = Path(out_root) / folder.NAME
     if not complete:
         print(
-            f"sweep: cancelled; {len(table)} of {len(runs)} runs written, marked incomplete -> "
+            f"sweep: cancelled; {table.done} of {len(runs)} runs written, marked incomplete -> "
             f"{target}",
             file=sys.stderr,
         )
         return EXIT_CANCELLED
+    failed = [r for r in table.rows() if r["status"] == "error"]
     for row in failed:
         print(f"collide2d: run failed: {row['scenario']}: {row['note']}", file=sys.stderr)
     if not args.quiet:
-        stopped = sum(r["status"] == "stopped" for r in table)
+        stopped = table.count("stopped")
         said = f", {stopped} stopped by their model" if stopped else ""
         said += f", {len(failed)} failed" if failed else ""
-        print(f"sweep: {len(table)} runs{said} -> {target} ({', '.join(written)})")
+        print(f"sweep: {table.done} runs{said} -> {target} ({', '.join(written)})")
     return EXIT_UNEXPECTED if failed else EXIT_OK

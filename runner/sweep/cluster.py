@@ -3,21 +3,25 @@
 `connect(workers, scheduler)` is a context manager giving a `distributed.Client`: with a scheduler
 address (`tcp://HOST:PORT`, a cluster started with `dask scheduler` and `dask worker`) it joins
 that cluster; else it starts an embedded `LocalCluster` of `workers` processes (default one per
-core) with one thread each, and closes it on the way out. `run_all(client, fn, items, ...)`
-submits `fn(item)` for every item and hands each result (or the exception it raised) to
-`on_result(i, value, error)` as runs finish, in any order. A task whose worker dies is run again
-elsewhere by the scheduler (up to its `allowed-failures`), so every item gets one result; on
-Ctrl-C (SIGINT, answered inside `connect` even by a process started with it ignored) the tasks
-still pending are cancelled and `run_all` returns False.
+core) with one thread each, and closes it on the way out. A scheduler that does not answer
+within CONNECT_TIMEOUT_S is `SchedulerUnreachable`, naming its address (`scheduler_address`, the
+type of `--scheduler`, refuses an address that is not one). `run_all(client, fn, items, ...)`
+submits `fn(item)` for every item, a window of tasks at a time, and hands each result (or the
+exception it raised) to `on_result(i, value, error)` as runs finish, in any order. A task whose
+worker dies is run again elsewhere by the scheduler (up to its `allowed-failures`), so every item
+gets one result; on Ctrl-C (SIGINT, answered inside `connect` even by a process started with it
+ignored) the tasks still pending are cancelled and `run_all` returns False.
 
 Dask is the optional `dask` extra: `require_dask` raises `DaskMissing` with the install command.
 """
 
 from __future__ import annotations
 
+import argparse
 import contextlib
 import logging
 import os
+import re
 import signal
 import sys
 import threading
@@ -26,11 +30,39 @@ import uuid
 from collide2d.runner.progress import Progress
 
 INSTALL = 'pip install "collide2d[dask]"'
-CONNECT_TIMEOUT_S = 30
+# Seconds a scheduler has to answer: a live one answers in milliseconds, and a typo should not
+# keep the command waiting (Dask's own default is 30 s).
+CONNECT_TIMEOUT_S = 3
+MESSAGES_KEPT = 16  # messages a connection keeps for debugging (see `connect`)
+SCHEMES = ("tcp", "tls", "ws", "wss", "ucx")  # Dask's network protocols
+_ADDRESS = re.compile(
+    r"(?:(?P<scheme>[a-z]+)://)?"
+    r"(?P<host>\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9_.-]+)"  # a name, an IPv4 or a bracketed IPv6 address
+    r":(?P<port>[0-9]{1,5})"
+)
 
 
 class DaskMissing(Exception):
     """dask.distributed is not installed; str is the message with the install command."""
+
+
+class SchedulerUnreachable(Exception):
+    """No Dask scheduler answered at the address given; str names it and says why."""
+
+
+def scheduler_address(text: str) -> str:
+    """argparse type of --scheduler: a Dask scheduler's address, `tcp://HOST:PORT` (or another
+    of Dask's protocols, SCHEMES; `HOST:PORT` means tcp)."""
+    m = _ADDRESS.fullmatch(text.strip())
+    if m is None or (m["scheme"] is not None and m["scheme"] not in SCHEMES):
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not a scheduler address; expected tcp://HOST:PORT (as `dask scheduler` "
+            f"prints it; also {', '.join(s + '://' for s in SCHEMES[1:])})"
+        )
+    port = int(m["port"])
+    if not 1 <= port <= 65535:
+        raise argparse.ArgumentTypeError(f"{text!r}: port {port} is not 1 to 65535")
+    return text.strip()
 
 
 def require_dask(what: str = "this command") -> None:
@@ -61,14 +93,24 @@ def connect(workers: int | None = None, scheduler: str | None = None):
     """A Client on the cluster at `scheduler`, or on an embedded LocalCluster of `workers`
     processes (default: one per core)."""
     require_dask()
+    import dask
     from distributed import Client, LocalCluster
 
+    # Dask keeps the last messages of each connection for debugging, tasks and their arguments
+    # (a run's scenario) with them: a thousand by default, so memory would grow with the tasks
+    with dask.config.set({"distributed.admin.low-level-log-length": MESSAGES_KEPT}):
+        with _connected(Client, LocalCluster, workers, scheduler) as client:
+            yield client
+
+
+@contextlib.contextmanager
+def _connected(Client, LocalCluster, workers, scheduler):
     # Ctrl-C raises KeyboardInterrupt here, as `collide2d run` stops on it: also when the process
     # started with SIGINT ignored, as a shell starts a job in the background (`collide2d sweep
     # ... &`; Python would leave it ignored, and a `kill -INT` would go unanswered)
     with _sigint(signal.default_int_handler):
         if scheduler:
-            with Client(scheduler, timeout=CONNECT_TIMEOUT_S) as client:
+            with _joined(Client, scheduler) as client:
                 yield client
             return
         # worker processes start with SIGINT ignored (they inherit it): Ctrl-C on a terminal
@@ -89,6 +131,19 @@ def connect(workers: int | None = None, scheduler: str | None = None):
             cluster.close()
 
 
+def _joined(Client, scheduler: str):
+    """A Client on the scheduler at `scheduler`, or SchedulerUnreachable within about
+    CONNECT_TIMEOUT_S (also when what answers there is no Dask scheduler)."""
+    try:
+        return Client(scheduler, timeout=CONNECT_TIMEOUT_S)
+    except Exception as exc:  # a timeout, a refused or unknown host, a server that is not Dask
+        detail = " ".join(str(exc).split())[:200] or type(exc).__name__
+        raise SchedulerUnreachable(
+            f"no Dask scheduler answered at {scheduler} within {CONNECT_TIMEOUT_S} s ({detail}); "
+            "start one with `dask scheduler`, or check the address"
+        ) from None
+
+
 def progress_for(total: int, label: str, quiet: bool) -> Progress | None:
     """A progress bar of runs (done/total, rate and time left) on stderr when it is a terminal and
     not quiet, else None."""
@@ -97,33 +152,47 @@ def progress_for(total: int, label: str, quiet: bool) -> Progress | None:
     return Progress(total, label, unit=" runs")
 
 
-def run_all(client, fn, items, on_result, *, progress=None, label="collide2d", sizes=None) -> bool:
+def run_all(
+    client, fn, items, on_result, *, progress=None, label="collide2d", size=None, window=None
+) -> bool:
     """Run fn(item) for every item on the cluster; on_result(i, value, error) for each as it
-    finishes. True when every item got its result, False when cancelled by Ctrl-C. `progress`
-    counts items, or `sizes[i]` for item i (runs in a batch)."""
+    finishes. True when every item got its result, False when cancelled by Ctrl-C. `items` may be
+    an iterator: it is read as tasks are sent, at most `window` tasks in flight at a time (None:
+    all at once), so what waits to be sent is never held. `progress` counts items, or
+    `size(item)` each (runs in a batch)."""
     from distributed import as_completed
 
     token = uuid.uuid4().hex[:12]
-    futures = [
-        client.submit(fn, item, key=f"{label}-{token}-{i}", pure=False)
-        for i, item in enumerate(items)
-    ]
-    index = {f.key: i for i, f in enumerate(futures)}
+    source = enumerate(items)
+    pending: dict = {}  # key -> (index, size, future)
+    finished = as_completed()
+
+    def send() -> bool:
+        for i, item in source:
+            future = client.submit(fn, item, key=f"{label}-{token}-{i}", pure=False)
+            pending[future.key] = (i, size(item) if size is not None else 1, future)
+            finished.add(future)
+            return True
+        return False
+
     done = 0
     try:
-        for future in as_completed(futures):
-            i = index[future.key]
+        while send() and (window is None or len(pending) < window):
+            pass
+        for future in finished:
+            i, count, _ = pending.pop(future.key)
             try:
                 value, error = future.result(), None
             except Exception as exc:  # a task that failed, or one that killed its workers
                 value, error = None, exc
             on_result(i, value, error)
             future.release()
-            done += sizes[i] if sizes is not None else 1
+            done += count
             if progress is not None:
                 progress.update(done)
+            send()
     except KeyboardInterrupt:
-        client.cancel(futures)
+        client.cancel([f for _i, _n, f in pending.values()])
         if progress is not None:
             progress.close()
         return False

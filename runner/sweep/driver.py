@@ -1,24 +1,30 @@
-"""A sweep's runs on a Dask cluster: each run's figures and final positions, whatever the order.
+"""A sweep's runs on a Dask cluster: each run's figures, kept by run number, whatever the order.
 
-`run_sweep(client, runs)` submits the runs in batches (`batch_size`: about eight tasks per worker
-thread, so that a run of a few milliseconds does not pay the scheduler's few milliseconds per
-task, while the work stays spread), each task `runs.run_batch` on the batch's loaded scenarios,
-and collects what comes back by run index, so each row exists once however many times a task was
-run (a task whose worker died is run again by the scheduler). A run that raised (a bug) gives a
-row with status `error` and the exception in its note; a task that kept killing its workers gives
-such a row for each of its runs. Ctrl-C cancels what is still pending and returns the runs
-finished so far with `complete` False.
+`run_sweep(client, plan)` sends the plan's runs in their sorted order (`plan.Plan.runs`) in batches
+(`batch_size`: about eight tasks per worker thread, so that a run of a few milliseconds does not
+pay the scheduler's few milliseconds per task, while the work stays spread), each task
+`runs.run_batch` on the batch's runs as (their combination's scenario, their seed), and at most
+WINDOW_PER_THREAD tasks per worker thread in flight: the scenarios are loaded as their batch is
+sent (`plan.Plan.base`) and dropped when it is done, so memory does not grow with the runs. What
+comes back is kept by run number in a `results.Table`, so each row exists once however many times
+a task was run (a task whose worker died is run again by the scheduler). A run that raised (a bug)
+gives a row with status `error` and the exception in its note; a task that kept killing its
+workers gives such a row for each of its runs. Ctrl-C cancels what is still pending and returns
+the runs finished so far with `complete` False.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 
 from collide2d.runner.sweep import cluster
+from collide2d.runner.sweep.results import Table
 from collide2d.runner.sweep.runs import error_figures, run_batch
 
 TASKS_PER_THREAD = 8
 MAX_BATCH = 32  # runs in one task
+WINDOW_PER_THREAD = 4  # tasks in flight per worker thread
 
 
 def batch_size(runs: int, threads: int) -> int:
@@ -26,29 +32,41 @@ def batch_size(runs: int, threads: int) -> int:
     return max(1, min(MAX_BATCH, math.ceil(runs / (max(threads, 1) * TASKS_PER_THREAD))))
 
 
-def run_sweep(client, runs, *, progress=None, on_row=None, batch=None) -> tuple[dict, dict, bool]:
-    """(figures by run index, final positions by run index, complete)."""
+def run_sweep(client, plan, *, progress=None, on_row=None, batch=None) -> tuple[Table, bool]:
+    """(the table of the runs done, complete)."""
+    threads = sum(client.nthreads().values())
     if batch is None:
-        batch = batch_size(len(runs), sum(client.nthreads().values()))
-    batches = [runs[k : k + batch] for k in range(0, len(runs), batch)]
-    figures: dict[int, dict] = {}
-    positions: dict = {}
+        batch = batch_size(len(plan), threads)
+    table = Table(plan)
+    sent: dict[int, list] = {}  # task number -> its runs, until its result is taken
+
+    def batches():
+        runs = plan.runs()
+        for i in itertools.count():
+            chunk = list(itertools.islice(runs, batch))
+            if not chunk:
+                return
+            sent[i] = chunk
+            yield [(plan.base(r.combo), r.seed) for r in chunk]
 
     def take(i: int, value, error) -> None:
+        runs = sent.pop(i)
         if error is not None:
-            value = [(error_figures(error), None)] * len(batches[i])
-        for run, (row, pos) in zip(batches[i], value, strict=True):
-            figures[run.index], positions[run.index] = row, pos
+            value = [(error_figures(error), None)] * len(runs)
+        for run, (row, pos) in zip(runs, value, strict=True):
+            table.take(run, row, pos)
             if on_row is not None:
                 on_row(run, row)
 
     complete = cluster.run_all(
         client,
         run_batch,
-        [[r.scenario for r in b] for b in batches],
+        batches(),
         take,
         progress=progress,
         label="collide2d-sweep",
-        sizes=[len(b) for b in batches],
+        size=len,
+        window=max(2, WINDOW_PER_THREAD * threads),
     )
-    return figures, positions, complete
+    table.finish()
+    return table, complete

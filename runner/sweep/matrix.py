@@ -4,10 +4,11 @@ An `Axis` is one swept key with its values: a run setting (`model`, `fps`, `tick
 `geometry`) or a dotted scenario key (`world.width`, `generate.0.count`: mapping keys and list
 indices from the top of the file). `parse_set` reads `--set KEY=V1,V2,...` (values are YAML, split
 on the commas outside brackets and quotes, so `--set generate.0.size=[10,10],[20,20]` and
-`--set objects.0.name="a, b",c` work), `parse_seeds`
-reads `--seeds 1-100` (also `7` and `1-5,9`). `expand` makes the runs: the product of every axis
-and seed for each scenario, each run's scenario loaded and checked in full before anything runs
-(a located `ScenarioError` naming the run's values when one is refused). A setting the run's model
+`--set objects.0.name="a, b",c` work), `parse_seeds` reads `--seeds 1-100` (also `7` and `1-5,9`).
+The runs are the product of every axis and seed for each scenario: `choices` gives each combination
+of the axes' values, `combo_of` loads it in full as a `Combo` (the runs of every seed share it;
+`runner.sweep.plan` checks the seeds), and `load_run` loads one run (a located `ScenarioError`
+naming the run's values when one is refused). A setting the run's model
 does not take (`substeps` off `stepped`; `substeps` and `geometry` under `paper`) is left out and
 the runs it would have told apart count once. A seed goes to every `generate` block of the file.
 
@@ -22,7 +23,7 @@ from __future__ import annotations
 
 import itertools
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import yaml
 
@@ -53,17 +54,6 @@ class Axis:
     nodes: tuple
     texts: tuple[str, ...]
     origin: str  # where it was given: "--set KEY=..." or "FILE:LINE:COL"
-
-
-@dataclass(frozen=True)
-class Run:
-    """One run of the sweep: its scenario, loaded with the run's values, and those values."""
-
-    index: int
-    scenario: Scenario
-    params: dict  # column -> value as shown (str), every swept key, the seed and the settings
-    sort_key: tuple
-    ref_key: tuple = field(default=())  # what an `exact` run must share to be its reference
 
 
 def split_values(text: str) -> list[str]:
@@ -283,18 +273,24 @@ def _sort_value(text: str):
         return (1, 0.0, text)
 
 
-def _file_model(path: str, limits: Limits) -> str:
-    return load(path, limits=limits).model
+def seed_key(seed: int) -> tuple:
+    """A seed's place in a run's sort key."""
+    return (0, float(seed), str(seed))
 
 
-def expand(
-    scenarios: list[str],
-    axes: list[Axis],
-    seeds: tuple[int, ...] | None,
-    limits: Limits | None = None,
-) -> list[Run]:
-    """Every run of the matrix, loaded and checked, in the sorted order of their parameters."""
-    limits = limits or Limits()
+def _file_model(path: str, seed: int | None, limits: Limits) -> str:
+    """The model of the file itself (as loaded with the sweep's first seed, if any: the file's
+    own seed need not place its objects)."""
+    said = f"in the sweep run seed={seed}" if seed is not None else path
+    try:
+        return load(path, limits=limits, edit=_edit({}, seed, said)).model
+    except ScenarioError as exc:
+        raise ScenarioError(exc.path, exc.line, exc.col, f"{said}: {exc.message}") from None
+
+
+def check_axes(scenarios: list[str], axes: list[Axis], seeds) -> int:
+    """The runs of the matrix before settings a model does not take count once (SweepError for
+    a key swept twice, a value given twice, an unknown model, more than MAX_RUNS runs)."""
     keys = [a.key for a in axes]
     repeated = [k for k in keys if keys.count(k) > 1]
     if repeated:
@@ -314,31 +310,61 @@ def expand(
     count *= len(scenarios) * (len(seeds) if seeds else 1)
     if count > MAX_RUNS:
         raise SweepError(f"the sweep has {count:,} runs, more than {MAX_RUNS:,}")
-    dotted = [a for a in axes if a.key not in RUN_KEYS]
-    runs: dict[tuple, Run] = {}
-    names: dict[str, str] = {}
-    for path in scenarios:
-        base_model = _file_model(path, limits)
-        for combo in itertools.product(*(range(len(a.texts)) for a in axes)):
-            chosen = {a.key: (a.nodes[i], a.texts[i]) for a, i in zip(axes, combo, strict=True)}
-            model = ys.value(chosen["model"][0]) if "model" in chosen else base_model
-            for key in ("substeps", "geometry"):
-                if key in chosen and key not in SCENARIO_OPTIONS[model]:
-                    del chosen[key]  # this model does not take it: the runs count once
-            for seed in seeds or (None,):
-                run = _make_run(path, chosen, seed, model, dotted, limits, len(runs))
-                if run.scenario.name in names and names[run.scenario.name] != path:
-                    raise SweepError(
-                        f"{path} and {names[run.scenario.name]} are both named "
-                        f"{run.scenario.name!r}; rows are told apart by the scenario's name"
-                    )
-                names[run.scenario.name] = path
-                runs.setdefault(run.sort_key, run)
-    ordered = [runs[k] for k in sorted(runs)]
-    return [Run(i, r.scenario, r.params, r.sort_key, r.ref_key) for i, r in enumerate(ordered)]
+    return count
 
 
-def _make_run(path, chosen, seed, model, dotted, limits, index) -> Run:
+def choices(path: str, axes: list[Axis], seed: int | None, limits: Limits):
+    """Each combination of the axes' values for the scenario at `path`: {key: (node, text)},
+    without the settings its model does not take (see the module docstring)."""
+    base_model = _file_model(path, seed, limits)
+    for combo in itertools.product(*(range(len(a.texts)) for a in axes)):
+        chosen = {a.key: (a.nodes[i], a.texts[i]) for a, i in zip(axes, combo, strict=True)}
+        model = ys.value(chosen["model"][0]) if "model" in chosen else base_model
+        for key in ("substeps", "geometry"):
+            if key in chosen and key not in SCENARIO_OPTIONS[model]:
+                del chosen[key]  # this model does not take it: the runs count once
+        yield chosen, model
+
+
+@dataclass(frozen=True, eq=False)
+class Combo:
+    """One scenario file with one value of each swept key: the runs of every seed share it.
+
+    `head` and `tail` are a run's sort key before and after its seed (the scenario's name and the
+    dotted keys' values; the run settings), `params` its columns but the seed, `ref` what an
+    `exact` run must share with it, besides the seed, to be its reference (`runner.sweep.results`).
+    """
+
+    path: str
+    values: dict  # key -> YAML node, as the edit puts them in
+    overrides: dict  # fps, ticks: the loader's overrides
+    shown: tuple[str, ...]  # KEY=VALUE of each swept key, for messages
+    params: dict
+    head: tuple
+    tail: tuple
+    ref: tuple
+
+
+def load_run(combo: Combo, seed: int | None, limits: Limits) -> Scenario:
+    """The scenario of the run of `combo` with `seed`, loaded and checked in full (a located
+    ScenarioError naming the run's values when refused)."""
+    said = list(combo.shown) + ([f"seed={seed}"] if seed is not None else [])
+    shown = f"in the sweep run {', '.join(said) or combo.path}"
+    try:
+        return load(
+            combo.path,
+            overrides=combo.overrides,
+            limits=limits,
+            edit=_edit(combo.values, seed, shown),
+        )
+    except ScenarioError as exc:
+        raise ScenarioError(exc.path, exc.line, exc.col, f"{shown}: {exc.message}") from None
+    except SweepError as exc:
+        raise SweepError(f"{combo.path}: {exc}") from None
+
+
+def combo_of(path, chosen, model, dotted, seed, limits) -> tuple[Combo, Scenario]:
+    """The Combo of one choice of values for `path`, and its run with `seed` loaded in full."""
     values = {k: node for k, (node, _t) in chosen.items()}
     if "model" not in values and any(k in values for k in ("substeps", "geometry")):
         values["model"] = _scalar(model, None)
@@ -347,25 +373,15 @@ def _make_run(path, chosen, seed, model, dotted, limits, index) -> Run:
         if key in values:
             v = ys.value(values[key]) if isinstance(values[key], yaml.ScalarNode) else None
             overrides[key] = v if isinstance(v, int) and not isinstance(v, bool) else chosen[key][1]
-    shown_values = [f"{k}={t}" for k, (_n, t) in chosen.items()]
-    if seed is not None:
-        shown_values.append(f"seed={seed}")
-    shown = f"in the sweep run {', '.join(shown_values) or path}"
-    try:
-        scenario = load(path, overrides=overrides, limits=limits, edit=_edit(values, seed, shown))
-    except ScenarioError as exc:
-        raise ScenarioError(exc.path, exc.line, exc.col, f"{shown}: {exc.message}") from None
-    except SweepError as exc:
-        raise SweepError(f"{path}: {exc}") from None
+    shown = tuple(f"{k}={t}" for k, (_n, t) in chosen.items())
+    draft = Combo(path, values, overrides, shown, {}, (), (), ())
+    scenario = load_run(draft, seed, limits)
     params = {"scenario": scenario.name}
-    sort_key: list = [scenario.name]
+    head: list = [scenario.name]
     for axis in dotted:
         text = chosen[axis.key][1]
         params[axis.key] = text
-        sort_key.append(_sort_value(text))
-    if seed is not None:
-        params["seed"] = str(seed)
-        sort_key.append((0, float(seed), str(seed)))
+        head.append(_sort_value(text))
     takes = SCENARIO_OPTIONS[scenario.model]
     settings = {
         "model": scenario.model,
@@ -375,12 +391,10 @@ def _make_run(path, chosen, seed, model, dotted, limits, index) -> Run:
         "geometry": scenario.geometry if scenario.model != "paper" else "",
     }
     params.update(settings)
-    sort_key += [_sort_value(settings[k]) for k in RUN_KEYS]
-    ref_key = tuple(sort_key[: len(sort_key) - len(RUN_KEYS)]) + (
-        settings["fps"],
-        settings["ticks"],
-    )
-    return Run(index, scenario, params, tuple(sort_key), ref_key)
+    tail = tuple(_sort_value(settings[k]) for k in RUN_KEYS)
+    ref = (tuple(head), settings["fps"], settings["ticks"])
+    combo = Combo(path, values, overrides, shown, params, tuple(head), tail, ref)
+    return combo, scenario
 
 
 def columns(axes: list[Axis], seeds) -> list[str]:

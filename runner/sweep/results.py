@@ -1,29 +1,34 @@
 """The results of a sweep: one row per run, sorted by its parameters, and the files OUT/sweep/.
 
-`rows(runs, figures, positions)` joins each finished run's parameters (`matrix.Run.params`) with
-the figures its worker measured (`runs.run_one`), in the runs' sorted order, so the table is the
-same whatever the worker count or the order runs finished in. When the sweep includes the `exact`
-model, each run's `position_error_px` is the mean distance of its final positions from those of
-the `exact` run of the same scenario, swept keys, seed, fps and ticks (the same horizon; the
-exact run of the same geometry when both are swept, else of the exact geometry), computed by the
-benchmark's one definition (`runner.bench.error.position_error`).
+A `Table` keeps the figures each worker measured (`runs.run_one`) by run number, a few numbers a
+row in arrays sized to the plan (no run's scenario, no dict per row), so its memory is a small
+fixed cost per run. The rows come out in the plan's sorted order (`plan.Plan.runs`: each run's
+parameters, `plan.Run.params`, then its figures), the same whatever the worker count or the order
+runs finished in. When the sweep includes the `exact` model, each run's `position_error_px` is the
+mean distance of its final positions from those of the `exact` run of the same scenario, swept
+keys, seed, fps and ticks (the same horizon; the exact run of the same geometry when both are
+swept, else of the exact geometry), computed by the benchmark's one definition
+(`runner.bench.error.position_error`). Final positions are kept only until every run of that
+reference group is done (the runs are sent in order, so a group is done soon after it starts).
 
 `write(folder, ...)` writes `results.csv` (the parameter columns, then `FIGURES`; `run_time_s`, the
 wall time, is the last column and the only one that changes between two sweeps), `results.md` (one
 table per scenario), both safe to open whatever a value holds (`runner.escape`: no text cell runs
 as a spreadsheet formula, no cell breaks its markdown row), `sweep.json` (runs asked, done,
 complete or not) and, with the `plot` extra and position errors, `runtime_vs_error.png` (the
-benchmark's plot). Every file is replaced atomically.
+benchmark's plot), row by row into `folder`: the sweep's staging folder, swapped in whole
+(`runner.sweep.folder`).
 """
 
 from __future__ import annotations
 
 import csv
-import io
 import json
 from pathlib import Path
 
-from collide2d.runner import escape, outputs
+import numpy as np
+
+from collide2d.runner import escape
 from collide2d.runner.bench.error import mark_pareto, position_error
 
 FIGURES = (
@@ -40,45 +45,102 @@ FIGURES = (
     "run_time_s",
 )
 PLOT = "runtime_vs_error.png"
+STATUSES = ("ok", "stopped", "error")
+_INTS = ("objects", "wall_events", "pair_events", "left_world")
+_FLOATS = ("energy_drift", "momentum_drift", "worst_overlap_px", "position_error_px", "run_time_s")
 
 
-def _reference(run, done: dict, positions: dict, by_key: dict):
-    """The final positions of the exact run that `run` is measured against, or None."""
-    candidates = [
-        r
-        for r in by_key.get(run.ref_key, ())
-        if r.index in done and positions.get(r.index) is not None
-    ]
-    if not candidates:
-        return None
-    geometry = run.params["geometry"] or "box"
-    for wanted in (geometry, "exact"):
-        for r in candidates:
-            if r.params["geometry"] == wanted:
-                return positions[r.index]
-    return positions[candidates[0].index]
+class Table:
+    """The figures of a sweep's finished runs, by run number (see the module docstring)."""
 
+    def __init__(self, plan):
+        n = len(plan)
+        self.plan = plan
+        self.status = np.full(n, -1, np.int8)  # index into STATUSES; -1 not done
+        self.ints = np.zeros((n, len(_INTS)), np.int64)
+        self.floats = np.zeros((n, len(_FLOATS)), np.float64)
+        self.has = np.zeros((n, len(_INTS) + len(_FLOATS)), np.bool_)
+        self.notes: dict[int, str] = {}
+        self.done = 0
+        self._groups: dict[tuple, list] = {}  # reference group -> [(run, positions)]
 
-def rows(runs, figures: dict, positions: dict) -> list[dict]:
-    """The finished runs' rows, in the runs' order (see the module docstring)."""
-    with_error = any(r.params["model"] == "exact" for r in runs)
-    by_key: dict[tuple, list] = {}
-    for r in runs:
-        if r.params["model"] == "exact":
-            by_key.setdefault(r.ref_key, []).append(r)
-    out = []
-    for run in runs:
-        if run.index not in figures:
-            continue
+    def take(self, run, figures: dict, positions) -> None:
+        """Keep run `run`'s figures (and its final positions while its group needs them)."""
+        i = run.index
+        if self.status[i] < 0:
+            self.done += 1
+        self.status[i] = STATUSES.index(figures["status"])
+        for k, name in enumerate(_INTS):
+            if name in figures and figures[name] != "":
+                self.ints[i, k], self.has[i, k] = figures[name], True
+        for k, name in enumerate(_FLOATS):
+            if name in figures and figures[name] != "":
+                self.floats[i, k], self.has[i, len(_INTS) + k] = figures[name], True
+        if figures.get("note"):
+            self.notes[i] = figures["note"]
+        if not self.plan.with_exact:
+            return
+        group = self._groups.setdefault(run.ref_key, [])
+        group.append((run, positions))
+        if len(group) == self.plan.ref_sizes[run.combo.ref]:
+            self._measure(self._groups.pop(run.ref_key))
+
+    def finish(self) -> None:
+        """Measure the groups left with the runs done (a cancelled sweep)."""
+        for key in list(self._groups):
+            self._measure(self._groups.pop(key))
+
+    def _measure(self, group: list) -> None:
+        """position_error_px of each run of one reference group against its exact run."""
+        group.sort(key=lambda rp: rp[0].index)
+        exact = [(r, p) for r, p in group if r.params["model"] == "exact" and p is not None]
+        if not exact:
+            return
+        column = len(_INTS) + _FLOATS.index("position_error_px")
+        for run, pos in group:
+            if pos is None:
+                continue
+            ref = _reference(run, exact)
+            self.floats[run.index, column - len(_INTS)] = position_error(pos, ref)
+            self.has[run.index, column] = True
+
+    def row(self, run) -> dict | None:
+        """The row of `run` (its parameters and figures), None when it did not finish."""
+        i = run.index
+        if self.status[i] < 0:
+            return None
         row = dict(run.params)
         row.update({k: "" for k in FIGURES})
-        row.update(figures[run.index])
-        if with_error and positions.get(run.index) is not None:
-            ref = _reference(run, figures, positions, by_key)
-            if ref is not None:
-                row["position_error_px"] = position_error(positions[run.index], ref)
-        out.append(row)
-    return out
+        row["status"] = STATUSES[self.status[i]]
+        for k, name in enumerate(_INTS):
+            if self.has[i, k]:
+                row[name] = int(self.ints[i, k])
+        for k, name in enumerate(_FLOATS):
+            if self.has[i, len(_INTS) + k]:
+                row[name] = float(self.floats[i, k])
+        row["note"] = self.notes.get(i, "")
+        return row
+
+    def count(self, status: str) -> int:
+        """Runs done with this status."""
+        return int(np.count_nonzero(self.status == STATUSES.index(status)))
+
+    def rows(self):
+        """The finished runs' rows, in the runs' sorted order."""
+        for run in self.plan.runs():
+            row = self.row(run)
+            if row is not None:
+                yield row
+
+
+def _reference(run, exact: list):
+    """The final positions of the exact run that `run` is measured against."""
+    geometry = run.params["geometry"] or "box"
+    for wanted in (geometry, "exact"):
+        for r, pos in exact:
+            if r.params["geometry"] == wanted:
+                return pos
+    return exact[0][1]
 
 
 def _text(value, digits: int = 9) -> str:
@@ -87,44 +149,50 @@ def _text(value, digits: int = 9) -> str:
     return str(value)
 
 
-def csv_text(columns: list[str], table: list[dict]) -> str:
-    buf = io.StringIO()
-    writer = csv.writer(buf, lineterminator="\n")
+def write_csv(file, columns: list[str], rows) -> None:
+    """results.csv of `rows` (dicts) into the open text `file`."""
+    writer = csv.writer(file, lineterminator="\n")
     header = list(columns) + list(FIGURES)
     writer.writerow(header)
-    for row in table:
+    for row in rows:
         writer.writerow([_text(escape.csv_cell(row[c])) for c in header])
-    return buf.getvalue()
 
 
-def markdown(columns: list[str], table: list[dict], total: int, complete: bool) -> str:
-    lines = ["# Sweep", ""]
+def write_markdown(file, columns: list[str], rows, total: int, done: int, complete: bool):
+    """results.md of `rows` (dicts, a scenario's rows together) into the open text `file`."""
+    file.write("# Sweep\n\n")
     if complete:
-        lines.append(f"{len(table)} runs.")
+        file.write(f"{done} runs.\n")
     else:
-        lines.append(
-            f"**Incomplete**: cancelled with {len(table)} of {total} runs done; the rows below "
-            "are the runs that finished."
+        file.write(
+            f"**Incomplete**: cancelled with {done} of {total} runs done; the rows below "
+            "are the runs that finished.\n"
         )
     shown = [c for c in columns if c != "scenario"] + [c for c in FIGURES if c != "note"]
-    for scenario in dict.fromkeys(r["scenario"] for r in table):
-        mine = [r for r in table if r["scenario"] == scenario]
-        lines += ["", f"## {escape.one_line(scenario)}", ""]
-        lines.append("| " + " | ".join(escape.markdown_cell(c) for c in shown) + " |")
-        lines.append("|" + "---|" * len(shown))
-        for r in mine:
-            cells = (escape.markdown_cell(_text(r[c], 4)) for c in shown)
-            lines.append("| " + " | ".join(cells) + " |")
-        notes = [r for r in mine if r["note"]]
+    scenario, notes = None, []
+
+    def end_scenario():
         if notes:
-            lines.append("")
+            file.write("\n")
             for r in notes:
                 said = ", ".join(f"{c}={r[c]}" for c in columns if c != "scenario" and r[c])
-                lines.append(escape.one_line(f"- {said}: {r['note']}"))
-    return "\n".join(lines) + "\n"
+                file.write(escape.one_line(f"- {said}: {r['note']}") + "\n")
+        notes.clear()
+
+    for r in rows:
+        if r["scenario"] != scenario:
+            end_scenario()
+            scenario = r["scenario"]
+            file.write(f"\n## {escape.one_line(scenario)}\n\n")
+            file.write("| " + " | ".join(escape.markdown_cell(c) for c in shown) + " |\n")
+            file.write("|" + "---|" * len(shown) + "\n")
+        file.write("| " + " | ".join(escape.markdown_cell(_text(r[c], 4)) for c in shown) + " |\n")
+        if r["note"]:
+            notes.append({c: r[c] for c in (*columns, "note")})
+    end_scenario()
 
 
-def _plot(columns: list[str], table: list[dict], folder: Path) -> list[str]:
+def _plot(columns: list[str], rows, folder: Path) -> list[str]:
     """runtime_vs_error.png through the benchmark's plot, when there are position errors."""
     from collide2d.runner.bench import plots
 
@@ -137,7 +205,7 @@ def _plot(columns: list[str], table: list[dict], folder: Path) -> list[str]:
             "run_time_s": r["run_time_s"],
             "error_long_px": r["position_error_px"],
         }
-        for r in table
+        for r in rows
         if r["position_error_px"] != "" and r["run_time_s"] != ""
     ]
     if not points:
@@ -147,17 +215,16 @@ def _plot(columns: list[str], table: list[dict], folder: Path) -> list[str]:
     return plots.plots(points, folder)
 
 
-def write(
-    folder: Path, columns: list[str], table: list[dict], total: int, complete: bool
-) -> list[str]:
-    """Write the sweep's files into `folder` (made if missing); the names written."""
-    outputs.make_folder(folder)
-    outputs.atomic_write_text(folder / "results.csv", csv_text(columns, table))
-    outputs.atomic_write_text(folder / "results.md", markdown(columns, table, total, complete))
-    status = {"runs": total, "done": len(table), "complete": complete}
-    outputs.atomic_write_text(folder / "sweep.json", json.dumps(status, indent=2) + "\n")
+def write(folder: Path, table: Table, complete: bool) -> list[str]:
+    """Write the sweep's files into the empty `folder`; the names written."""
+    plan = table.plan
+    with open(folder / "results.csv", "w", encoding="utf-8", newline="") as f:
+        write_csv(f, plan.columns, table.rows())
+    with open(folder / "results.md", "w", encoding="utf-8", newline="") as f:
+        write_markdown(f, plan.columns, table.rows(), len(plan), table.done, complete)
+    status = {"runs": len(plan), "done": table.done, "complete": complete}
+    (folder / "sweep.json").write_text(json.dumps(status, indent=2) + "\n", encoding="utf-8")
     written = ["results.csv", "results.md", "sweep.json"]
-    plotted = _plot(columns, table, folder)
-    if not plotted and (folder / PLOT).is_file():
-        (folder / PLOT).unlink()  # a previous sweep's plot would not match these rows
-    return written + plotted
+    if plan.with_exact:
+        written += _plot(plan.columns, table.rows(), folder)
+    return written

@@ -6,7 +6,8 @@ the world (`mark_outside`); this first run also loads or compiles the kernels, s
 lands in the timing. Then once as `collide2d run` does (`runner.run.drive`, no frames, no log),
 timed: its summary gives the wall time, the events by type and the energy and momentum at both
 ends. A model that stops the run (a runaway) makes a row with status `stopped` and its message.
-`run_batch(scenarios)` runs several, in order, as one Dask task (`runner.sweep.driver`).
+`run_batch(runs)` runs several, in order, as one Dask task (`runner.sweep.driver`), each given as
+its combination's scenario and its seed, whose objects it draws first (`runner.sweep.reseed`).
 
 Kernels are numba's with `cache=True`: a worker process compiles (or loads from the cache on
 disk) each kernel the first time it runs it and keeps it for every later run it is given.
@@ -21,6 +22,7 @@ import numpy as np
 from collide2d.engine.errors import Runaway
 from collide2d.engine.invariants import max_penetration
 from collide2d.engine.jit import njit
+from collide2d.runner import lanes
 
 OUTSIDE_TOL_PX = 1e-9  # px a box may stick out of the world by rounding
 STATUS_OK = "ok"
@@ -59,15 +61,19 @@ def _checked(scenario) -> tuple[float, int]:
     return deepest, int(left.sum())
 
 
-def run_batch(scenarios) -> list[tuple[dict, np.ndarray | None]]:
-    """run_one of each scenario, in order; a run that raises (a bug) is a row with status
-    `error` and the exception in its note, and the others still run."""
+def run_batch(runs) -> list[tuple[dict, np.ndarray | None]]:
+    """run_one of each run, in order, given as (its combination's scenario, its seed or None:
+    `runner.sweep.plan.scenario_of` draws the run's objects); a run that raises (a bug) is a row
+    with status `error` and the exception in its note, and the others still run."""
+    from collide2d.runner.sweep.plan import scenario_of
+
     out = []
-    for scenario in scenarios:
-        try:
-            out.append(run_one(scenario))
-        except Exception as exc:
-            out.append((error_figures(exc), None))
+    with lanes.loads(len(runs)):
+        for base, seed in runs:
+            try:
+                out.append(run_one(scenario_of(base, seed)))
+            except Exception as exc:
+                out.append((error_figures(exc), None))
     return out
 
 

@@ -4,6 +4,7 @@ mid-sweep; every process started here is ended here."""
 
 from __future__ import annotations
 
+import io
 import json
 import os
 import shutil
@@ -17,8 +18,8 @@ from pathlib import Path
 import pytest
 from interrupt import STARTED, interrupted
 
-from collide2d.runner.sweep import driver, results
-from collide2d.runner.sweep.matrix import columns, expand, parse_set
+from collide2d.runner.sweep import driver, plan, results
+from collide2d.runner.sweep.matrix import parse_set
 from collide2d.runner.sweep.runs import run_one
 
 distributed = pytest.importorskip("distributed")
@@ -57,9 +58,10 @@ def test_sweep_on_the_default_local_cluster_matches_an_in_process_one(tmp_path, 
     assert done.stdout == "" and done.stderr == ""
     written = (out / "sweep" / "results.csv").read_text()
     axes = [parse_set("model=exact,paper"), parse_set("ticks=40")]
-    runs = expand([FIFTY], axes, (1, 2))
-    figures, positions, _ = driver.run_sweep(client, runs)
-    mine = results.csv_text(columns(axes, (1, 2)), results.rows(runs, figures, positions))
+    table, _ = driver.run_sweep(client, plan.check([FIFTY], axes, (1, 2)))
+    buf = io.StringIO()
+    results.write_csv(buf, table.plan.columns, table.rows())
+    mine = buf.getvalue()
     assert _without_wall_time(written) == _without_wall_time(mine)
     assert json.loads((out / "sweep" / "sweep.json").read_text())["complete"] is True
 
@@ -151,7 +153,7 @@ def test_a_worker_killed_mid_sweep_loses_no_row(tmp_path):
                 log=tmp_path / f"worker-{name}.log",
             )
             procs.append(workers[name])
-        runs = expand([FIFTY], [parse_set("ticks=4000")], tuple(range(1, 9)))
+        checked = plan.check([FIFTY], [parse_set("ticks=4000")], tuple(range(1, 9)))
         killed = []
 
         def kill_a_busy_worker(run, row):
@@ -171,20 +173,18 @@ def test_a_worker_killed_mid_sweep_loses_no_row(tmp_path):
         try:
             with distributed.Client(address, timeout=START_S) as client:
                 client.wait_for_workers(2, timeout=START_S)
-                figures, positions, complete = driver.run_sweep(
-                    client, runs, on_row=kill_a_busy_worker
-                )
+                table, complete = driver.run_sweep(client, checked, on_row=kill_a_busy_worker)
         finally:
             watchdog.cancel()
         assert not fired, f"the sweep took more than {SWEEP_S} s; the cluster was killed"
         ((victim, busy),) = killed  # a worker with a run in hand, killed while rows were missing
         assert busy and workers[victim].wait(timeout=30) == -signal.SIGKILL
-        assert complete and sorted(figures) == list(range(len(runs)))
-        for run in runs:
-            want, _pos = run_one(run.scenario)
-            got = figures[run.index]
+        assert complete and table.done == len(checked)
+        for run in checked.runs():
+            want, _pos = run_one(checked.scenario(run))
+            got = table.row(run)
             assert got["status"] == "ok"
-            assert {k: v for k, v in got.items() if k != "run_time_s"} == {
+            assert {k: v for k, v in got.items() if k in want and k != "run_time_s"} == {
                 k: v for k, v in want.items() if k != "run_time_s"
             }
     finally:

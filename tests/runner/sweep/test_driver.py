@@ -14,10 +14,12 @@ import pytest
 
 from collide2d.runner.progress import Progress
 from collide2d.runner.run import drive
-from collide2d.runner.sweep import driver, results
+from collide2d.runner.sweep import driver, plan, results
 from collide2d.runner.sweep.driver import batch_size
-from collide2d.runner.sweep.matrix import columns, expand, parse_set
+from collide2d.runner.sweep.matrix import parse_set
 from collide2d.runner.sweep.runs import mark_outside, run_batch, run_one
+
+from .planned import expand
 
 distributed = pytest.importorskip("distributed")
 
@@ -32,55 +34,64 @@ def _without_wall_time(text: str) -> str:
 
 
 @pytest.fixture(scope="module")
+def checked():
+    return plan.check([FIFTY], AXES, tuple(sorted(SEEDS)))
+
+
+@pytest.fixture(scope="module")
 def runs():
     return expand([FIFTY], AXES, tuple(sorted(SEEDS)))
 
 
-def test_rows_hold_each_runs_own_figures(client, runs):
-    figures, positions, complete = driver.run_sweep(client, runs)
-    assert complete and sorted(figures) == list(range(6))
-    table = results.rows(runs, figures, positions)
-    assert [(r["seed"], r["model"]) for r in table] == [
+def _csv(table) -> str:
+    buf = io.StringIO()
+    results.write_csv(buf, table.plan.columns, table.rows())
+    return buf.getvalue()
+
+
+def test_rows_hold_each_runs_own_figures(client, checked, runs):
+    table, complete = driver.run_sweep(client, checked)
+    assert complete and table.done == 6
+    rows = list(table.rows())
+    assert [(r["seed"], r["model"]) for r in rows] == [
         (s, m) for s in ("1", "2", "3") for m in ("exact", "paper")
     ]
-    for run, row in zip(runs, table, strict=True):
+    positions = {}
+    for run, row in zip(runs, rows, strict=True):
         model, summary = drive(run.scenario)
-        assert row["status"] == "ok"
+        assert row["status"] == "ok", row["note"]
         assert (row["wall_events"], row["pair_events"]) == (
             summary["events"]["wall"],
             summary["events"]["pair"],
         )
         assert row["objects"] == 50 and row["left_world"] == 0
-        np.testing.assert_array_equal(positions[run.index], model.positions())
-    for exact, paper in zip(table[::2], table[1::2], strict=True):
+        positions[run.params["seed"], run.params["model"]] = model.positions()
+    for exact, paper in zip(rows[::2], rows[1::2], strict=True):
         # the exact model keeps energy; it is its own reference; paper is measured against it
         assert abs(exact["energy_drift"]) < 1e-12 and exact["position_error_px"] == 0.0
         assert exact["worst_overlap_px"] < 1e-9 and paper["worst_overlap_px"] >= 0.0
-        index = {(r.params["seed"], r.params["model"]): r.index for r in runs}
-        ref = positions[index[exact["seed"], "exact"]]
-        mine = positions[index[paper["seed"], "paper"]]
+        ref = positions[exact["seed"], "exact"]
+        mine = positions[paper["seed"], "paper"]
         want = float(np.mean(np.hypot(*(mine - ref).T)))
         assert paper["position_error_px"] == pytest.approx(want, rel=1e-12)
         assert paper["position_error_px"] > 1.0
 
 
-def test_the_table_is_the_same_bytes_on_one_worker_or_two(client, runs, tmp_path):
-    figures, positions, _ = driver.run_sweep(client, runs)
-    two = results.csv_text(columns(AXES, SEEDS), results.rows(runs, figures, positions))
+def test_the_table_is_the_same_bytes_on_one_worker_or_two(client, checked, tmp_path):
+    two = _csv(driver.run_sweep(client, checked)[0])
     with (
         distributed.LocalCluster(
             n_workers=1, threads_per_worker=1, processes=False, dashboard_address=":0"
         ) as one_cluster,
         distributed.Client(one_cluster) as one,
     ):
-        figures1, positions1, _ = driver.run_sweep(one, runs)
-    one_text = results.csv_text(columns(AXES, SEEDS), results.rows(runs, figures1, positions1))
+        one_text = _csv(driver.run_sweep(one, checked)[0])
     assert _without_wall_time(one_text) == _without_wall_time(two)
     assert one_text.splitlines()[0].endswith(",note,run_time_s")
     assert len(one_text.splitlines()) == 7
 
 
-def test_ctrl_c_keeps_the_finished_rows_marked_incomplete(client, runs, tmp_path):
+def test_ctrl_c_keeps_the_finished_rows_marked_incomplete(client, checked, tmp_path):
     seen = []
 
     def interrupt(run, row):
@@ -88,11 +99,12 @@ def test_ctrl_c_keeps_the_finished_rows_marked_incomplete(client, runs, tmp_path
         if len(seen) == 2:
             raise KeyboardInterrupt
 
-    figures, positions, complete = driver.run_sweep(client, runs, on_row=interrupt)
+    table, complete = driver.run_sweep(client, checked, on_row=interrupt)
     assert not complete
-    assert sorted(figures) == sorted(seen) and len(seen) == 2
-    table = results.rows(runs, figures, positions)
-    written = results.write(tmp_path / "sweep", columns(AXES, SEEDS), table, len(runs), False)
+    assert table.done == 2 and len(seen) == 2
+    assert sorted(r.index for r in checked.runs() if table.row(r) is not None) == sorted(seen)
+    (tmp_path / "sweep").mkdir()
+    written = results.write(tmp_path / "sweep", table, False)
     assert "results.csv" in written
     status = json.loads((tmp_path / "sweep" / "sweep.json").read_text())
     assert status == {"runs": 6, "done": 2, "complete": False}
@@ -141,20 +153,16 @@ def test_progress_counts_runs_and_gives_an_eta():
     assert "<" in shown  # an estimate of the time left
 
 
-def test_runs_in_batches_give_the_same_rows(client, runs):
+def test_runs_in_batches_give_the_same_rows(client, checked):
     assert [batch_size(n, t) for n, t in ((200, 2), (8, 2), (6, 2), (10**6, 4))] == [13, 1, 1, 32]
-    one = driver.run_sweep(client, runs, batch=1)
-    four = driver.run_sweep(client, runs, batch=4)
-    assert four[2] and sorted(four[0]) == list(range(6))
-    strip = [
-        {k: v for k, v in r.items() if k != "run_time_s"} for r in results.rows(runs, *one[:2])
-    ]
-    assert strip == [
-        {k: v for k, v in r.items() if k != "run_time_s"} for r in results.rows(runs, *four[:2])
-    ]
+    one, _ = driver.run_sweep(client, checked, batch=1)
+    four, complete = driver.run_sweep(client, checked, batch=4)
+    assert complete and four.done == 6
+    strip = [{k: v for k, v in r.items() if k != "run_time_s"} for r in one.rows()]
+    assert strip == [{k: v for k, v in r.items() if k != "run_time_s"} for r in four.rows()]
 
 
 def test_a_run_that_raises_is_an_error_row_and_its_batch_goes_on(runs):
-    done = run_batch([runs[0].scenario, None, runs[1].scenario])
+    done = run_batch([(runs[0].scenario, None), (None, None), (runs[1].scenario, None)])
     assert [row["status"] for row, _pos in done] == ["ok", "error", "ok"]
     assert done[1][0]["note"].startswith("AttributeError: ") and done[1][1] is None

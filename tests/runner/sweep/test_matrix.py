@@ -10,7 +10,9 @@ import pytest
 
 from collide2d.runner.scenario import ScenarioError, load, loads
 from collide2d.runner.sweep import matrix
-from collide2d.runner.sweep.matrix import SweepError, expand, parse_seeds, parse_set
+from collide2d.runner.sweep.matrix import SweepError, parse_seeds, parse_set
+
+from .planned import expand
 
 SCENARIOS = Path(__file__).resolve().parents[3] / "scenarios"
 FIFTY = str(SCENARIOS / "paper_fifty_boxes.yaml")

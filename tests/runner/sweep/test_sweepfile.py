@@ -118,7 +118,7 @@ def test_without_dask_sweep_says_how_to_install_it(tmp_path, capsys, monkeypatch
 
 
 def test_the_example_sweep_file_expands_to_its_runs():
-    from collide2d.runner.sweep.matrix import expand
+    from .planned import expand
 
     example = SCENARIOS.parent / "sweeps" / "paper_fps.yaml"
     scenarios, axes, seeds = sweepfile.read(str(example))

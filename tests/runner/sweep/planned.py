@@ -1,0 +1,22 @@
+"""The sweep tests' view of a small plan: every run with its scenario loaded (as a worker has it),
+which a sweep itself never holds all at once."""
+
+from __future__ import annotations
+
+from collide2d.runner.sweep import plan
+
+
+class Loaded:
+    """One run of a checked plan and its scenario."""
+
+    def __init__(self, checked, run):
+        self.run = run
+        self.index = run.index
+        self.params = run.params
+        self.scenario = checked.scenario(run)
+
+
+def expand(paths, axes, seeds, limits=None) -> list[Loaded]:
+    """Every run of the checked matrix, in order, each with its scenario."""
+    checked = plan.check(paths, axes, seeds, limits)
+    return [Loaded(checked, run) for run in checked.runs()]
