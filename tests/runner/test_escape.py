@@ -83,7 +83,7 @@ def test_a_text_cell_never_starts_a_formula_and_numbers_stay_numbers(tmp_path):
         }
         for text in texts
     ]
-    rows = _cells(results.csv_text(columns, table))[1:]
+    rows = _cells(_written(results.write_csv, columns, table))[1:]
     assert [r[0] for r in rows] == [r[1] for r in rows] == [r[-2] for r in rows] == want
     for row in rows:
         assert row[2 + results.FIGURES.index("energy_drift")] == "-0.25"
@@ -92,6 +92,13 @@ def test_a_text_cell_never_starts_a_formula_and_numbers_stay_numbers(tmp_path):
     cells = [dict(zip(report.COLUMNS, r, strict=True)) for r in _cells(report.csv_text(bench))]
     assert [c["model"] for c in cells[1:]] == [c["note"] for c in cells[1:]] == want
     assert {(c["ratio"], c["n"]) for c in cells[1:]} == {("-1.5", "-2")}
+
+
+def _written(write, *args) -> str:
+    """What a results writer writes into a file, as text."""
+    file = io.StringIO()
+    write(file, *args)
+    return file.getvalue()
 
 
 def _table_rows(md: str) -> list[str]:
@@ -112,7 +119,7 @@ def test_a_markdown_cell_stays_one_cell_of_one_row():
         {"scenario": "s|x\ny", "value": t, **{k: "" for k in results.FIGURES}, "note": t}
         for t in texts
     ]
-    md = results.markdown(columns, table, len(texts), True)
+    md = _written(results.write_markdown, columns, table, len(texts), len(texts), True)
     rows = _table_rows(md)
     width = len(_cells_of(rows[0]))
     assert len(rows) == 2 + len(texts) and {len(_cells_of(r)) for r in rows} == {width}
