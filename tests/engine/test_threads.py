@@ -58,7 +58,7 @@ def test_a_near_list_too_small_for_a_share_grows(monkeypatch):
 
 
 def run_paper(monkeypatch, chunks, bodies, world, broadphase=None):
-    from collide2d.engine.models import paper as paper_model
+    from collide2d.engine.models.paper import model as paper_model
 
     monkeypatch.setattr(paper_model, "chunks_for", lambda n: chunks)
     model = make("paper", world, bodies, broadphase=broadphase)
