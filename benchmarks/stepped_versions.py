@@ -1,7 +1,9 @@
 """The stepped model against an earlier version of itself, in one process, on the standard scene.
 
-The earlier version's `engine/models/stepped*.py` are taken from a git revision (`git show`) into
-a temporary folder, their imports of each other pointed there, and both versions step the same
+The earlier version's stepped model (the package `engine/models/stepped/`, or before it the
+modules `engine/models/stepped*.py` and `engine/stepcontact.py`) is taken from a git revision
+(`git show`) into a temporary folder, its imports of its own modules pointed there (each module
+one flat file), and both versions step the same
 scene in turns: medians of REPEATS timings of about a second each, per body-step, in CPU time of
 this process (`--clock cpu`, the default, less sensitive to other jobs on the machine than the
 wall clock; with more than one thread use `--clock wall`). Both must end in the same positions
@@ -29,23 +31,28 @@ ROOT = Path(__file__).resolve().parents[1]
 REPEATS = 7
 
 
+# The files of the stepped model at any revision: its package, or its flat modules of before.
+MODEL_FILES = re.compile(r"engine/(models/stepped(/\w+|\w*)|stepcontact)\.py")
+
+
 def _old_model(rev: str, folder: Path):
     """The Model class of the stepped model at `rev`, its modules copied into `folder`."""
     listing = subprocess.run(
-        ["git", "ls-tree", "--name-only", rev, "engine/models/"],
+        ["git", "ls-tree", "-r", "--name-only", rev, "engine/"],
         cwd=ROOT, capture_output=True, text=True, check=True,
     ).stdout.split()  # fmt: skip
-    for path in listing:
-        name = Path(path).name
-        if not re.fullmatch(r"stepped\w*\.py", name):
-            continue
+    flat = {}  # each module's import name at `rev` -> its flat name here, and its path
+    for path in filter(MODEL_FILES.fullmatch, listing):
+        name = "collide2d." + path[: -len(".py")].replace("/", ".").removesuffix(".__init__")
+        flat[name] = ("old_" + name.removeprefix("collide2d.engine.").replace(".", "_"), path)
+    names = re.compile("(" + "|".join(map(re.escape, sorted(flat, key=len)[::-1])) + r")\b")
+    for new, path in flat.values():
         text = subprocess.run(
             ["git", "show", f"{rev}:{path}"], cwd=ROOT, capture_output=True, text=True, check=True
         ).stdout
-        text = re.sub(r"collide2d\.engine\.models\.(stepped\w*)", r"old_\1", text)
-        (folder / f"old_{name}").write_text(text)
+        (folder / f"{new}.py").write_text(names.sub(lambda m: flat[m[1]][0], text))
     sys.path.insert(0, str(folder))
-    return importlib.import_module("old_stepped").Model
+    return importlib.import_module(flat["collide2d.engine.models.stepped"][0]).Model
 
 
 def main() -> None:

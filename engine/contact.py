@@ -5,7 +5,7 @@ box's top-left corner), the position of B's corner relative to A's, `q = p_B - p
 velocity relative to A's, `u = v_B - v_A` (px/s). Output: overlap depth and contact normal
 (`penetration`), the times the pair enters and leaves contact (`sweep`) and the next contact
 under the exact model's rules (`next_contact`); the stepped model's contact after a step is
-built on them in `stepcontact.py`.
+built on them in `models/stepped/approach.py`.
 
 All of it rests on one picture. A and B overlap exactly when q lies in the Minkowski difference
 `M = shape_A ⊕ (-shape_B)`, a convex set, and without rotation q moves on the straight line

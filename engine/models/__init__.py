@@ -11,6 +11,12 @@ Every model is a class built as `Model(world, bodies, **options)` with the same 
 
 `make` picks one by name. Each model's tick runs move -> walls -> pairs -> record. A model that
 cannot carry a scene on (when built, or in `advance`) raises an `engine.errors.Runaway`.
+
+Each model is a package of its own, `paper/`, `stepped/` and `exact/`, holding what only that
+model uses and re-exporting its `Model`; what the models share stays at the top of the engine.
+`make` imports only the package of the model it builds, so a run loads no other model. This
+module may import the engine's shared modules; it imports a model's package only in `make`, and
+a model's package may import this module's constants (MAX_EVENTS_PER_TICK).
 """
 
 from __future__ import annotations

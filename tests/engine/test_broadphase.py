@@ -21,7 +21,12 @@ from collide2d.engine.broadphase import (
     sweep_pairs,
     workspace,
 )
-from collide2d.engine.cells import MAX_CELLS_PER_OBJECT, grid_cell, grid_dims, static_cells
+from collide2d.engine.models.exact.cells import (
+    MAX_CELLS_PER_OBJECT,
+    grid_cell,
+    grid_dims,
+    static_cells,
+)
 
 
 def brute_pairs(lo, hi, static):

@@ -97,7 +97,7 @@ SIGNATURES = """
 import numpy as np
 from numba import types
 from collide2d.engine import sort
-from collide2d.engine.models import paper
+from collide2d.engine.models.paper import model as paper
 
 rng = np.random.default_rng(1)
 n = 100

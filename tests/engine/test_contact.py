@@ -26,8 +26,8 @@ from collide2d.engine.contact import (
     rounded_sweep,
 )
 from collide2d.engine.events import AXIS_NORMAL, AXIS_X, AXIS_XY, AXIS_Y
+from collide2d.engine.models.stepped.approach import box_clip, box_overlap_axis, box_step_contact
 from collide2d.engine.shapes import edge_normals, pixel_hull
-from collide2d.engine.stepcontact import box_clip, box_overlap_axis, box_step_contact
 from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON
 
 INF = math.inf

@@ -19,9 +19,9 @@ from collide2d.engine import events as ev
 from collide2d.engine import jit
 from collide2d.engine.errors import NoRoom, Runaway
 from collide2d.engine.invariants import kinetic_energy
-from collide2d.engine.models import exact as exact_model
 from collide2d.engine.models import make
-from collide2d.engine.models.exact import MAX_EVENTS_PER_TICK, EventCapExceeded
+from collide2d.engine.models.exact import model as exact_model
+from collide2d.engine.models.exact.model import MAX_EVENTS_PER_TICK, EventCapExceeded
 from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies, Looks, WorldSpec
 
 # --- helpers --------------------------------------------------------------------------------------

@@ -1,8 +1,8 @@
-"""engine/horizonqueue.py: after any sequence of updates (and looks at the first horizon between
-them, as the event loop makes) the first horizon found is the earliest one (ties by key), every
-horizon is filed once, in its own bucket, and the next horizon of an instant is the one of the
-smallest key; for any bucket width (walks of one bucket, a whole ring without a horizon, times
-too far for a bucket number), in both lanes."""
+"""engine/models/exact/horizonqueue.py: after any sequence of updates (and looks at the first
+horizon between them, as the event loop makes) the first horizon found is the earliest one (ties
+by key), every horizon is filed once, in its own bucket, and the next horizon of an instant is the
+one of the smallest key; for any bucket width (walks of one bucket, a whole ring without a horizon,
+times too far for a bucket number), in both lanes."""
 
 from __future__ import annotations
 
@@ -12,8 +12,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from collide2d.engine import jit
-from collide2d.engine.eventqueue import RANK_CROSS, RANK_WALL, make_key, split_key
-from collide2d.engine.horizonqueue import (
+from collide2d.engine.models.exact.heap import RANK_CROSS, RANK_WALL, make_key, split_key
+from collide2d.engine.models.exact.horizonqueue import (
     FAR,
     Q_NEXT,
     QS_TOP,

@@ -25,8 +25,8 @@ pytestmark = pytest.mark.skipif(DISABLE_JIT, reason="NUMBA_DISABLE_JIT: nothing 
 
 # Every kernel compiled with _nrt=False, by module and name (a new one is added here on purpose).
 EXPECTED = {
-    ("collide2d.engine.models.paper", "_run"),
-    ("collide2d.engine.models.exact", "_run"),
+    ("collide2d.engine.models.paper.model", "_run"),
+    ("collide2d.engine.models.exact.model", "_run"),
 }
 
 

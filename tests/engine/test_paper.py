@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from collide2d.engine.events import AXIS_NAMES, EV_PAIR, EV_WALL, SIDE_NAMES
-from collide2d.engine.models.paper import STAGES, Model
+from collide2d.engine.models.paper.model import STAGES, Model
 from collide2d.engine.world import Bodies, WorldSpec
 
 
@@ -301,7 +301,7 @@ def test_dense_crowd_equals_the_reference_and_logging_changes_nothing():
 
 def test_reach_boxes_in_int64_give_the_int32_run(monkeypatch):
     """A world too large for int32 reach boxes keeps them in int64, with the same run."""
-    from collide2d.engine.models import paper
+    from collide2d.engine.models.paper import model as paper
 
     rng = np.random.default_rng(3)
     cells = rng.choice(16 * 12, size=60, replace=False)

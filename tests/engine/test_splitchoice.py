@@ -117,8 +117,8 @@ def gas(n, seed):
 def test_a_run_whose_stretches_alternate_ways_gives_the_bytes_of_one_thread(model, monkeypatch):
     # every phase one tick, the other way timed after each: the run goes split, one thread,
     # split ... and still gives the bytes of a run on one thread in one call
-    from collide2d.engine.models import paper as paper_model
-    from collide2d.engine.models import stepped as stepped_model
+    from collide2d.engine.models.paper import model as paper_model
+    from collide2d.engine.models.stepped import model as stepped_model
 
     world, bodies = gas(300, 5)
     if model == "paper":

@@ -19,9 +19,9 @@ from collide2d.engine.events import (
 )
 from collide2d.engine.invariants import kinetic_energy, momentum
 from collide2d.engine.models import make
-from collide2d.engine.models import stepped as stepped_model
-from collide2d.engine.models.stepped import STAGES
-from collide2d.engine.models.stepped_list import (
+from collide2d.engine.models.stepped import model as stepped_model
+from collide2d.engine.models.stepped.approach import box_clip, box_step_contact
+from collide2d.engine.models.stepped.candidates import (
     BANDS,
     REORDER_ROWS,
     ST_BANDS,
@@ -30,10 +30,10 @@ from collide2d.engine.models.stepped_list import (
     keys_within,
     within_reach,
 )
-from collide2d.engine.models.stepped_narrow import narrow
-from collide2d.engine.models.stepped_step import step
+from collide2d.engine.models.stepped.model import STAGES
+from collide2d.engine.models.stepped.narrow import narrow
+from collide2d.engine.models.stepped.step import step
 from collide2d.engine.response import exchange, fold, separate
-from collide2d.engine.stepcontact import box_clip, box_step_contact
 from collide2d.engine.world import KIND_CIRCLE, Bodies, Looks, WorldSpec
 
 

@@ -9,7 +9,7 @@ import pytest
 
 from collide2d.engine import raster, threads
 from collide2d.engine.models import make
-from collide2d.engine.models import stepped as stepped_model
+from collide2d.engine.models.stepped import model as stepped_model
 from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies, Looks, WorldSpec
 from collide2d.runner.cli import main
 
@@ -58,7 +58,7 @@ def test_a_near_list_too_small_for_a_share_grows(monkeypatch):
 
 
 def run_paper(monkeypatch, chunks, bodies, world, broadphase=None):
-    from collide2d.engine.models import paper as paper_model
+    from collide2d.engine.models.paper import model as paper_model
 
     monkeypatch.setattr(paper_model, "chunks_for", lambda n: chunks)
     model = make("paper", world, bodies, broadphase=broadphase)

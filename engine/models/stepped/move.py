@@ -1,6 +1,6 @@
 """The stepped model's first stage: every object moves for one step and folds back at the walls.
 
-Input: the model's state (`stepped.State`: one row of `body` per object, x, y, vx, vy, w, h, in
+Input: the model's state (`model.State`: one row of `body` per object, x, y, vx, vy, w, h, in
 the broad phase's order), the step dt and the world's sides. Output: the state moved
 in place, the wall folds as rows (object id and axis, folds at the low and the high wall, which
 came first) logged in id order, and how far any object now is from where the candidate list was

@@ -18,7 +18,7 @@ much walking finding the next takes.
 The queue is one tuple Q = (QT, QC, QL, QH, QS, QW), small, as the event loop's memory
 traffic is most of its time: each object's horizon time QT (n,) float64 (inf: none, or a static
 object; the bucket of a finite one is QT·QW[0], rounded down) and what it is, QC (n,) int8 (rank
-× 4 + side or direction: its event queue key, eventqueue.py, is `horizon_key`, so ties go
+× 4 + side or direction: its event queue key, heap.py, is `horizon_key`, so ties go
 crossings first, then walls, by id); its links QL (n, 2) int32 (next and previous object in its
 bucket's list, -1 for none); the first object of each ring slot QH (slots,) int32 (-1: empty;
 slots a power of two); the scalar state QS (the bucket the walk is at, every filed horizon's
@@ -30,9 +30,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from collide2d.engine.eventqueue import ID_BITS, RANK_WALL, make_key
-from collide2d.engine.exactstate import INF, hot
 from collide2d.engine.jit import njit
+from collide2d.engine.models.exact.heap import ID_BITS, RANK_WALL, make_key
+from collide2d.engine.models.exact.state import INF, hot
 from collide2d.engine.sort import median
 
 # Columns of QL: the next and previous object in the same bucket's list.

@@ -1,15 +1,15 @@
 """The stepped model's narrow phase: which listed pairs are in contact after a step, in the
 order their contacts began.
 
-Input: the state (`stepped.State`), the candidate keys (pairs of indices inside, from
-`stepped_list`) and the step dt. Output: `near`, the pairs in contact as keys of object ids
+Input: the state (`model.State`), the candidate keys (pairs of indices inside, from
+`candidates`) and the step dt. Output: `near`, the pairs in contact as keys of object ids
 ascending, sorted by `when`, the time each contact began (s from the step's start, swept back
 along the pair's relative velocity; -inf when the motion cannot tell), then by key: a total
 order, so the result is the same whatever order the objects are kept in inside.
 
 A pair is in contact when its boxes overlap now with positive area, or overlapped during the step
 (swept back on straight lines, both objects clear of the walls this step: a corner passed through
-within it). Each bucket of the list (stepped_list) is tested only as far as its bands can touch
+within it). Each bucket of the list (candidates.py) is tested only as far as its bands can touch
 by now. Most listed pairs are far apart: a cheap reach test (contact.box_reach, without
 branches) drops them before any sweep.
 
@@ -30,7 +30,8 @@ import numpy as np
 from collide2d.engine.broadphase import KEY_MASK, KEY_SHIFT, index
 from collide2d.engine.contact import axis_reach, box_sweep
 from collide2d.engine.jit import njit, prange
-from collide2d.engine.models.stepped_list import (
+from collide2d.engine.models.stepped.approach import box_clip
+from collide2d.engine.models.stepped.candidates import (
     BANDS,
     ST_BANDS,
     block_count,
@@ -38,7 +39,7 @@ from collide2d.engine.models.stepped_list import (
     reach_bands,
     start_reach,
 )
-from collide2d.engine.models.stepped_motion import (
+from collide2d.engine.models.stepped.move import (
     B_H,
     B_VX,
     B_VY,
@@ -49,7 +50,6 @@ from collide2d.engine.models.stepped_motion import (
     move_range,
 )
 from collide2d.engine.sort import sort_by_time
-from collide2d.engine.stepcontact import box_clip
 from collide2d.engine.threads import join_shares, shares_total
 
 
@@ -104,7 +104,7 @@ def _contact_range(body, ext, keys, first, last, near, when, base, room, dt, sid
 @njit(cache=True)
 def _tested_range(body, ext, keys, state, bucket, bands, near, when, base, room, dt, sides):
     """`_contact_range` over the first `bands` bands of a bucket of the list (state[ST_BANDS +
-    bucket] on, see stepped_list)."""
+    bucket] on, see candidates.py)."""
     at = ST_BANDS + bucket
     return _contact_range(
         body, ext, keys, state[at], state[at + bands], near, when, base, room, dt, sides
@@ -178,7 +178,7 @@ def _move_blocks(body, static, ext, anchor, dt, sides, folds, n_folds, keys, sta
                  first, last, near, when, base, room):
     """Move blocks first ... last-1 one by one (fold rows from row n_folds), each block's own
     pairs tested right after its move, while its rows are in the cache: the bands that its own
-    drift and `start` (where any object began the step, stepped_list.start_reach) allow, since
+    drift and `start` (where any object began the step, candidates.start_reach) allow, since
     both objects are in it. Returns (fold rows now, the blocks' drift, how many pairs in
     contact, written from near[base] while within room)."""
     n = body.shape[0]
@@ -202,13 +202,13 @@ def _move_blocks(body, static, ext, anchor, dt, sides, folds, n_folds, keys, sta
 def move_narrow(
     body, static, ext, anchor, dt, sides, folds, keys, state, params, near, when, chunks
 ):
-    """The move (stepped_motion) and the narrow phase (`narrow`) together, block by block: each
+    """The move (move.py) and the narrow phase (`narrow`) together, block by block: each
     block moved, then its own pairs tested while its rows are in the cache; then the pairs that
     reach into earlier blocks, with the drift of every object moved by then. The same pairs in
     contact as `narrow` after `move_walls` (the bands each pair needs are tested either way).
     Split among `chunks` threads when more than one (`_move_narrow_split`). Returns (fold rows
     and drift, as move_walls; how many pairs in contact, as narrow). params as the last step
-    left them (stepped_list.start_reach). The list must hold for this step: the caller makes it
+    left them (candidates.start_reach). The list must hold for this step: the caller makes it
     anew and tests again when the drift says it did not."""
     if chunks > 1:
         return _move_narrow_split(
@@ -241,7 +241,7 @@ def _move_narrow_split(body, static, ext, anchor, dt, sides, folds, keys, state,
     """`move_narrow` with the blocks cut into `chunks` contiguous runs, one per thread: each run
     moves its blocks and tests their own pairs; once every block has moved, the pairs that reach
     into earlier blocks (perhaps another run's), with the reach of all. Fold rows and pairs in
-    contact are joined in run order (stepped_motion.join_folds, `_join_sorted`)."""
+    contact are joined in run order (move.join_folds, `_join_sorted`)."""
     n = body.shape[0]
     room = near.shape[0]
     share = room // chunks

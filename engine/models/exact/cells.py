@@ -18,8 +18,9 @@ import math
 import numpy as np
 
 from collide2d.engine.broadphase import CELL_MARGIN
-from collide2d.engine.eventqueue import RANK_CROSS, RANK_PAIR
-from collide2d.engine.exactstate import (
+from collide2d.engine.jit import njit
+from collide2d.engine.models.exact.heap import RANK_CROSS, RANK_PAIR
+from collide2d.engine.models.exact.state import (
     CELL,
     DIR_DOWN,
     DIR_LEFT,
@@ -35,7 +36,6 @@ from collide2d.engine.exactstate import (
     Y,
     hot,
 )
-from collide2d.engine.jit import njit
 
 # Aim for about this many moving objects per cell when they are sparse: larger cells mean fewer
 # cell crossings but more neighbours to test. Tuned on a gas of 10,000 boxes (`collide2d bench

@@ -2,8 +2,8 @@
 object has drifted its margin, made anew only then, kept by block and band, and the order the
 objects are kept in.
 
-Input: the state (`stepped.State`), the step just taken, the margin (px) and the broad phase's
-method, cell and scratch (the `bp` tuple the model keeps, see `stepped_step.run`). Output: the
+Input: the state (`model.State`), the step just taken, the margin (px) and the broad phase's
+method, cell and scratch (the `bp` tuple the model keeps, see `step.run`). Output: the
 candidate keys (pairs of indices inside, `broadphase.KEY_SHIFT`) sorted by bucket, where each
 bucket begins (in the model's `state`), each object anchored where it is, and the state put back
 in the broad phase's order when it strayed from it.
@@ -16,7 +16,7 @@ those reaching into an earlier block (`cross`); in each, BANDS bands by how far 
 boxes were (nearest first, each band in the broad phase's order). A pair farther apart than twice
 the largest drift since cannot touch yet, so a step tests only a prefix of each bucket
 (`reach_bands`); and the narrow phase can test a block's own pairs right after its move, while
-its rows are still in the cache (stepped_narrow.move_narrow). When the objects have strayed from
+its rows are still in the cache (narrow.move_narrow). When the objects have strayed from
 the order the broad phase found them in
 (the cells' row-by-row order, or the sweep's order on x) by more than REORDER_ROWS rows on
 average, they are put back in it and the keys renamed to match: objects near in space are then
@@ -40,13 +40,13 @@ from collide2d.engine.broadphase import (
     index,
 )
 from collide2d.engine.jit import njit, prange
-from collide2d.engine.models.stepped_motion import B_H, B_VX, B_VY, B_W, B_X, B_Y
+from collide2d.engine.models.stepped.move import B_H, B_VX, B_VY, B_W, B_X, B_Y
 from collide2d.engine.threads import PARALLEL_MIN_OBJECTS
 
 # Where the model's `state` array keeps the keys listed (-1: no list yet), the method, whether
 # pairs can happen at all, the wall and pair event counters, this step's overlapping pairs, how
 # many chunks (threads) the move and narrow stages split into (1: none), how many steps ran the
-# move and the narrow phase together (stepped_narrow.move_narrow), and from ST_BANDS on where
+# move and the narrow phase together (narrow.move_narrow), and from ST_BANDS on where
 # each bucket of the list begins (`bucket_count` + 1 entries; see the module docstring).
 ST_KEYS, ST_METHOD, ST_POSSIBLE, ST_WALLS, ST_PAIRS, ST_NEAR, ST_CHUNKS, ST_FUSED, ST_BANDS = (
     range(9)
@@ -75,7 +75,7 @@ REORDER_ROWS = 0.5
 # drift (px: the farthest any object is from its anchor on an axis), its reach (px: the same over
 # each object's whole path in the step, where it began too: `reach`), how much the drift grew in
 # the last step (px) and the farthest from its anchor an object pushed apart in the last response
-# ended (px, stepped_pairs).
+# ended (px, pairs.py).
 P_MARGIN, P_CELL, P_SLACK, P_DRIFT, P_REACH, P_GROWTH, P_PUSHED = range(7)
 PARAMS_SIZE = 7
 

@@ -14,8 +14,8 @@ overlap began before the step, first, in ascending (a, b) order), each tested ag
 state so that it sees what the pairs before it changed (a pair that only comes to overlap through
 such a push waits for the next step). A pair in contact that approaches along the contact normal
 gets the elastic exchange. The normal is the axis along which the pair started overlapping, found
-from its relative velocity (stepcontact.box_step_contact; for exact shapes the direction of
-approach, stepcontact.step_contact), and the pair is pushed apart along it, shared by inverse mass,
+from its relative velocity (approach.box_step_contact; for exact shapes the direction of
+approach, approach.step_contact), and the pair is pushed apart along it, shared by inverse mass,
 never out of the world, by twice the depth it went in since that instant: each object ends where a
 bounce at the contact instant would have put it, as the walls reflect. Only when the motion cannot
 tell (the overlap began before the previous step, or nothing moves) the axis of the smaller overlap
@@ -30,18 +30,18 @@ tests the listed pairs on the current boxes (and their sweeps over the step: eac
 within its margin too), sorts the few in contact, and takes them in that order: exactly the
 pairs, in exactly the order, of testing every pair. The same argument pair by pair lets a step
 skip the listed pairs that were farther apart than twice the drift so far: the list is kept in
-bands by that distance (stepped_list.reach_bands), within buckets by the block of rows its pairs
+bands by that distance (candidates.reach_bands), within buckets by the block of rows its pairs
 sit in, so that while the list holds a step tests each block's pairs right behind the block's
-move, from the cache (stepped_narrow.move_narrow). Pairs of two static
+move, from the cache (narrow.move_narrow). Pairs of two static
 objects are never listed, and with no movable object (or fewer than two objects) the pair stage is
 skipped; the `skip=False` option turns both skips off, and `broadphase` ("sweep", "grid",
 "cells") forces a method instead of the scene's choice (for tests and `collide2d bench`).
 
 Events go to the one event log of events.py. The step's stages are one kernel,
-`stepped_step.step` (STAGES: move, broad, narrow, response), each stage in a module of its own:
-`stepped_motion` (move and walls), `stepped_list` (the candidate list and the order the objects
-are kept in), `stepped_narrow` (the listed pairs in contact, in order) and `stepped_pairs` (the
-exchange and the push). `stepped_step.run` runs all of them every step of many ticks in one call,
+`step.step` (STAGES: move, broad, narrow, response), each stage in a module of its own:
+`move` (move and walls), `candidates` (the candidate list and the order the objects
+are kept in), `narrow` (the listed pairs in contact, in order) and `pairs` (the
+exchange and the push). `step.run` runs all of them every step of many ticks in one call,
 `Model.profile` the same kernel one stage at a time to time each. The state is a `State`: one row
 of 6 floats per object (position, velocity, size), so that a stage reads everything it needs of
 an object from one place in memory.
@@ -56,7 +56,7 @@ import numpy as np
 
 from collide2d.engine.broadphase import KEY_SHIFT, METHOD_SWEEP, choose, marker, workspace
 from collide2d.engine.events import event_records, new_log
-from collide2d.engine.models.stepped_list import (
+from collide2d.engine.models.stepped.candidates import (
     BAND_SHIFT,
     PARAMS_SIZE,
     ST_CHUNKS,
@@ -65,8 +65,8 @@ from collide2d.engine.models.stepped_list import (
     blocks_for,
     state_size,
 )
-from collide2d.engine.models.stepped_motion import BODY_COLUMNS
-from collide2d.engine.models.stepped_step import STAGES, run, step
+from collide2d.engine.models.stepped.move import BODY_COLUMNS
+from collide2d.engine.models.stepped.step import STAGES, run, step
 from collide2d.engine.shapes import GEOMETRIES, build_cores
 from collide2d.engine.sort import median
 from collide2d.engine.splitchoice import SplitChoice
@@ -94,7 +94,7 @@ class State(NamedTuple):
     named tuple as it takes a tuple; the kernels unpack it by position)."""
 
     body: np.ndarray  # (n, 6) float64 per object x, y (top-left corner, px), vx, vy (px/s),
-    # w, h (px): stepped_motion.B_*
+    # w, h (px): move.B_*
     inv_mass: np.ndarray  # (n,) float64, 0 for static objects
     static: np.ndarray  # (n,) bool
     movable: np.ndarray  # (n,) bool: what the broad phase pairs
@@ -193,7 +193,7 @@ class Model:
         stage is timed from Python, so each count includes a call's overhead (microseconds),
         which dominates in small scenes. A scene that splits runs split (the clock does not
         choose here). The move and the narrow phase, which `advance` runs together block by block
-        while the list holds (stepped_narrow.move_narrow), run here one after the other, so that
+        while the list holds (narrow.move_narrow), run here one after the other, so that
         each has a time of its own."""
         self._bp[6][ST_CHUNKS] = self._split.chunks
         fps = float(self.world.fps)
@@ -244,12 +244,12 @@ class Model:
 
 
 def _reorder_scratch(n: int) -> tuple:
-    """The reorder's scratch (stepped_list._reorder): rows, ids, flags, inverse masses."""
+    """The reorder's scratch (candidates._reorder): rows, ids, flags, inverse masses."""
     return (np.empty((n, BODY_COLUMNS)), np.empty(n, np.int64), np.empty(n, np.uint8), np.empty(n))
 
 
 def _broad_phase(world, pos, vel, size, movable, substeps, skip, broadphase):
-    """The candidate list's state and scratch (see `stepped_step.run`): its margin from the
+    """The candidate list's state and scratch (see `step.run`): its margin from the
     fastest step and the box sizes, the method and cell from the scene or `broadphase`
     (broadphase.choose)."""
     n = pos.shape[0]

@@ -1,20 +1,22 @@
 """The exact model's predictions: an object's next wall contact, cell crossing and contacts.
 
-A prediction job (a row of `jobs`, see exactstate.py) names an object; `predict` sets its horizon
+A prediction job (a row of `jobs`, see state.py) names an object; `predict` sets its horizon
 (the first of its next wall contact and its next cell crossing) in the horizon queue
 (horizonqueue.py) and pushes its contacts with the objects in the 3×3 cells around it that come no
-later than the horizon on the event queue (eventqueue.py). A pair is swept from the later of its
+later than the horizon on the event queue (heap.py). A pair is swept from the later of its
 two clocks (contact.next_contact), so a predicted time depends only on the pair's
 state.
 """
 
 from __future__ import annotations
 
-from collide2d.engine.cells import C_HEAD
 from collide2d.engine.contact import box_next_contact, box_reach, next_contact
-from collide2d.engine.eventqueue import RANK_CROSS, RANK_PAIR, RANK_WALL, make_key, push
 from collide2d.engine.events import SIDE_BOTTOM, SIDE_LEFT, SIDE_RIGHT, SIDE_TOP
-from collide2d.engine.exactstate import (
+from collide2d.engine.jit import njit
+from collide2d.engine.models.exact.cells import C_HEAD
+from collide2d.engine.models.exact.heap import RANK_CROSS, RANK_PAIR, RANK_WALL, make_key, push
+from collide2d.engine.models.exact.horizonqueue import set_horizon
+from collide2d.engine.models.exact.state import (
     CELL,
     CNT,
     DIR_DOWN,
@@ -41,8 +43,6 @@ from collide2d.engine.exactstate import (
     Y,
     hot,
 )
-from collide2d.engine.horizonqueue import set_horizon
-from collide2d.engine.jit import njit
 from collide2d.engine.world import KIND_BOX
 
 

@@ -17,7 +17,7 @@ rank, a, b) so that ties go cell crossings first (bookkeeping, never logged), th
 side), then pairs in (a, b) order: each moving object's *horizon*, the first of its next wall
 contact and its next cell crossing, filed by its time in a bucket of a calendar queue that
 predicting the object again moves it out of and into in constant time (horizonqueue.py); and the
-predicted contacts, in a 4-ary heap in preallocated arrays that grow when full (eventqueue.py),
+predicted contacts, in a 4-ary heap in preallocated arrays that grow when full (heap.py),
 each entry recording the counters of its objects when predicted and skipped as stale if either
 has changed since. The next event is, of
 the events at the earliest one's instant, the one of the smallest key.
@@ -54,10 +54,11 @@ error is NoRoom naming them (the hot loop keeps no record for this).
 
 The kernel counts the wall and pair events as they happen, logged or not (`event_counts`).
 
-The parts live in their own modules: the state layout (floats F (n, 8), ints N (n, 8), scalar
-state; exactstate.py), the horizon queue (horizonqueue.py), the event queue (a 4-ary heap;
-eventqueue.py), the grid's per-cell lists (cells.py), the predictions (prediction.py), objects with
-no room to move (noroom.py) and the event log (events.py). This module applies events (`_on_cross`,
+The parts live in their own modules beside this one: the state layout (floats F (n, 8), ints
+N (n, 8), scalar state; state.py), the horizon queue (horizonqueue.py), the event queue (a 4-ary
+heap; heap.py), the grid's per-cell lists (cells.py), the predictions (prediction.py) and a jam's
+objects (jam.py); from the shared engine, objects with no room to move (engine/noroom.py) and the
+event log (engine/events.py). This module applies events (`_on_cross`,
 `_on_wall`, `_on_pair`) and runs the main loop, `_run`: take the next event, apply it, predict
 again for what it touched. The kernel `_run` (with `predict` inlined) allocates nothing: growing
 the heap or the event log is done in Python between calls (the kernel stops before an event it has
@@ -69,7 +70,19 @@ from __future__ import annotations
 import numpy as np
 
 from collide2d.engine import events, models
-from collide2d.engine.cells import (
+from collide2d.engine.errors import EventCapExceeded, NoRoom
+from collide2d.engine.events import (
+    AXIS_NAMES,
+    AXIS_X,
+    AXIS_Y,
+    EV_PAIR,
+    EV_WALL,
+    SIDE_LEFT,
+    SIDE_RIGHT,
+    SIDE_TOP,
+    put_event,
+)
+from collide2d.engine.models.exact.cells import (
     build_grid,
     cell_insert,
     cell_remove,
@@ -78,8 +91,7 @@ from collide2d.engine.cells import (
     room_around,
     room_needed,
 )
-from collide2d.engine.errors import EventCapExceeded, NoRoom
-from collide2d.engine.eventqueue import (
+from collide2d.engine.models.exact.heap import (
     HKEY,
     INSTANT_REL,
     INSTANT_S,
@@ -97,18 +109,17 @@ from collide2d.engine.eventqueue import (
     remove,
     split_key,
 )
-from collide2d.engine.events import (
-    AXIS_NAMES,
-    AXIS_X,
-    AXIS_Y,
-    EV_PAIR,
-    EV_WALL,
-    SIDE_LEFT,
-    SIDE_RIGHT,
-    SIDE_TOP,
-    put_event,
+from collide2d.engine.models.exact.horizonqueue import (
+    QS_TOP,
+    bucket_width,
+    first_horizon,
+    horizon_key,
+    new_horizons,
+    next_top,
 )
-from collide2d.engine.exactstate import (
+from collide2d.engine.models.exact.jam import jammed, listing
+from collide2d.engine.models.exact.prediction import predict, set_job
+from collide2d.engine.models.exact.state import (
     CELL,
     CNT,
     DIR_DOWN,
@@ -150,16 +161,7 @@ from collide2d.engine.exactstate import (
     hot,
     kernel,
 )
-from collide2d.engine.horizonqueue import (
-    QS_TOP,
-    bucket_width,
-    first_horizon,
-    horizon_key,
-    new_horizons,
-    next_top,
-)
-from collide2d.engine.noroom import jammed, listing, no_room, no_room_message
-from collide2d.engine.prediction import predict, set_job
+from collide2d.engine.noroom import no_room, no_room_message
 from collide2d.engine.response import exchange
 from collide2d.engine.shapes import GEOMETRIES, build_cores
 from collide2d.engine.world import Bodies, WorldSpec
@@ -519,7 +521,7 @@ class Model:
 
     def _runaway(self) -> EventCapExceeded | NoRoom:
         """The error of a tick stopped at the cap: NoRoom when the objects of the events that
-        would come next, at the instant it stopped, are jammed on an axis (noroom.jammed: they
+        would come next, at the instant it stopped, are jammed on an axis (jam.jammed: they
         collide again and again with no time passing, having no room to move), naming them; else
         EventCapExceeded. The model is stopped for good, so it runs up to RECENT more events of
         that tick, logged, to see them."""

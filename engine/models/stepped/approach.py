@@ -6,7 +6,7 @@ shapes started overlapping within the step (or cut a corner of each other within
 `box_clip`), the normal is the one where the line entered and the push twice the depth gone in
 since that instant, so each object ends where a bounce at the contact instant would have put it.
 When the motion cannot tell, the overlap decides (`box_overlap_axis` for boxes, the
-minimum-penetration contact for exact shapes). The geometry itself is `contact.py`'s.
+minimum-penetration contact for exact shapes). The geometry itself is engine/contact.py's.
 """
 
 from __future__ import annotations

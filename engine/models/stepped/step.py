@@ -2,17 +2,17 @@
 STAGES (move, broad, narrow, response), and `run`, which runs every stage of every step of a
 number of ticks in one call.
 
-Input: the world (width, height, fps), the substeps, the state (`stepped.State`), the geometry,
+Input: the world (width, height, fps), the substeps, the state (`model.State`), the geometry,
 the exact shapes' cores, the event log's buffers and the broad phase's state and scratch (`bp`,
 below). Output: the state advanced in place, the events logged, and the buffers that grew, which
 replace the caller's.
 
 While the candidate list holds, a step runs its move and narrow stages together, block by block
-(stepped_narrow.move_narrow: the same pairs, tested while their rows are in the cache); a step
-that may make the list anew runs them apart, as `stepped.Model.profile` always does.
+(narrow.move_narrow: the same pairs, tested while their rows are in the cache); a step
+that may make the list anew runs them apart, as `model.Model.profile` always does.
 
 `run` takes any number of ticks per call (the runner asks for thousands at once), so the cost of
-entering the kernel from Python is paid once per call, not once per step. `stepped.Model.profile`
+entering the kernel from Python is paid once per call, not once per step. `model.Model.profile`
 runs the same `step` one stage at a time to time each.
 """
 
@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from collide2d.engine.jit import njit
-from collide2d.engine.models.stepped_list import (
+from collide2d.engine.models.stepped.candidates import (
     P_DRIFT,
     P_GROWTH,
     P_MARGIN,
@@ -37,9 +37,9 @@ from collide2d.engine.models.stepped_list import (
     start_reach,
     within_reach,
 )
-from collide2d.engine.models.stepped_motion import log_walls, move_walls
-from collide2d.engine.models.stepped_narrow import move_narrow, narrow
-from collide2d.engine.models.stepped_pairs import respond
+from collide2d.engine.models.stepped.move import log_walls, move_walls
+from collide2d.engine.models.stepped.narrow import move_narrow, narrow
+from collide2d.engine.models.stepped.pairs import respond
 
 # The stages of one step, in the order `step` runs them; `Model.profile` times each by name
 # through the same kernel.
@@ -167,14 +167,14 @@ def run(world, substeps, tick0, ticks, log, S, exact, cores, rows, times, bp):
     """Run ticks tick0+1 ... tick0+ticks, every step all of `step`; returns (event buffers, how
     many events, bp): the buffers that grew replace the caller's.
 
-    S: the state arrays (a `stepped.State`). bp = (keys, near, order, lo, hi, folds, state,
+    S: the state arrays (a `model.State`). bp = (keys, near, order, lo, hi, folds, state,
     params, ws, when, finder, scratch, spare): the candidate list kept between calls (sorted by
-    bucket, stepped_list) and scratch
+    bucket, candidates.py) and scratch
     (`near`, `when`: this step's pairs in contact and the times their contacts began; `order`,
     `lo`, `hi`, `ws`: the broad phase's; `folds`: the move's fold rows; `finder`: the marker of
     the method, broadphase.marker, so that a kernel compiles only that pair finder; `scratch`:
-    the reorder's, stepped_list; `spare`: a second key buffer the relist sorts into); state and
-    params as stepped_list names their slots (ST_*,
+    the reorder's, candidates.py; `spare`: a second key buffer the relist sorts into); state and
+    params as candidates.py names their slots (ST_*,
     P_*).
     """
     width, height, fps = world

@@ -16,8 +16,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from collide2d.engine.exactstate import CNT, S_HEAP_N, hot
 from collide2d.engine.jit import njit
+from collide2d.engine.models.exact.state import CNT, S_HEAP_N, hot
 
 # Children per heap node: a 4-ary heap is half as deep as a binary one, and its four children
 # share a cache line.

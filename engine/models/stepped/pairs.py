@@ -1,14 +1,14 @@
 """The stepped model's response: each pair in contact after a step, in the order its contact
 began, gets the elastic exchange and is pushed apart.
 
-Input: the state (`stepped.State`), `near` from the narrow phase (keys of object ids, in order)
+Input: the state (`model.State`), `near` from the narrow phase (keys of object ids, in order)
 and the step dt. Output: velocities and positions changed in place, each pair that responded
 counted and, when the log is on, logged.
 
 Each pair is tested again on the current state, so that it sees what the pairs before it
 changed. The normal is the axis along which the pair started overlapping, found from its relative
-velocity (stepcontact.box_step_contact; for exact shapes the direction of approach,
-stepcontact.step_contact); an approaching pair gets the exchange (response.exchange) and is pushed
+velocity (approach.box_step_contact; for exact shapes the direction of approach,
+approach.step_contact); an approaching pair gets the exchange (response.exchange) and is pushed
 apart along it by twice the depth it went in since that instant (response.separate).
 """
 
@@ -17,16 +17,16 @@ from __future__ import annotations
 from collide2d.engine.broadphase import KEY_MASK, KEY_SHIFT
 from collide2d.engine.events import EV_PAIR, log_event
 from collide2d.engine.jit import njit
-from collide2d.engine.models.stepped_list import P_PUSHED, ST_PAIRS
-from collide2d.engine.models.stepped_motion import B_H, B_VX, B_VY, B_W, B_X, B_Y
+from collide2d.engine.models.stepped.approach import box_step_contact, step_contact
+from collide2d.engine.models.stepped.candidates import P_PUSHED, ST_PAIRS
+from collide2d.engine.models.stepped.move import B_H, B_VX, B_VY, B_W, B_X, B_Y
 from collide2d.engine.response import exchange, separate
-from collide2d.engine.stepcontact import box_step_contact, step_contact
 
 
 @njit(cache=True)
 def _contact(a, b, ea, eb, body, dt, exact, shape, radius, start, verts, normals):
     """(push, push_y, code, nx, ny) of a pair after a step of dt s (a, b inside; ea, eb their
-    ids): the normal from the direction of approach, stepcontact.box_step_contact / step_contact;
+    ids): the normal from the direction of approach, approach.box_step_contact / step_contact;
     push <= 0 when they do not overlap."""
     qx = body[b, B_X] - body[a, B_X]
     qy = body[b, B_Y] - body[a, B_Y]

@@ -1,7 +1,7 @@
 """The exact model's state layout: the columns of its arrays, its scalar state, its statuses.
 
-The exact model (engine/models/exact.py) keeps its objects in two arrays, floats F (n, 8) and ints
-N (n, 8), and its counters in `st` (int64) and `stf` (float64); the event queue (eventqueue.py),
+The exact model (model.py) keeps its objects in two arrays, floats F (n, 8) and ints
+N (n, 8), and its counters in `st` (int64) and `stf` (float64); the event queue (heap.py),
 the grid lists (cells.py) and the predictions (prediction.py) all read them by the names below.
 The `hot` and `kernel` decorators the exact model's kernels are compiled with live here too.
 """
