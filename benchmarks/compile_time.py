@@ -59,7 +59,7 @@ def listen(rows, where):
 # Run in a fresh process with an empty cache: the scenarios, compiled.
 CHILD = LISTENER + """
 import json, sys
-from collide2d.runner.cli import main
+from collide2d.runner.command.main import main
 
 rows, where = [], ["-"]
 listen(rows, where)
@@ -142,7 +142,7 @@ def _table(title: str, seconds: dict[str, list[float]], top: int) -> None:
 
 
 def main() -> None:
-    from collide2d.runner.options import positive_int
+    from collide2d.runner.command.options import positive_int
 
     argv = sys.argv[1:]
     pytest_args = argv[argv.index("--") + 1 :] if "--" in argv else []

@@ -67,7 +67,7 @@ def main() -> None:
     from collide2d.engine import threads
     from collide2d.engine.models import stepped
     from collide2d.runner.bench.scenes import standard_scene
-    from collide2d.runner.scenario import loads
+    from collide2d.runner.scenario.load import loads
 
     clock = time.process_time if args.clock == "cpu" else time.perf_counter
     threads.set_threads(args.threads)

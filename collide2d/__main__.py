@@ -2,6 +2,6 @@
 
 import sys
 
-from collide2d.runner.cli import main
+from collide2d.runner.command.main import main
 
 sys.exit(main())

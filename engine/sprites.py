@@ -5,7 +5,7 @@ not depend on where it is (its pixels move with it; the frame's edge only clips 
 pixels of object i drawn once at its own origin, by the same `engine.draw` kernels the renderer
 uses, give any frame: for each object in id order, its sprite's pixels at the rounded position
 plus their offsets, inside the world, in its colour, over the background. The run viewer
-(`runner.viewer`) draws its canvas this way, so it shows exactly the PNG frames' pixels.
+(`runner.output.viewerdata`) draws its canvas this way, so it shows exactly the PNG frames' pixels.
 """
 
 from __future__ import annotations

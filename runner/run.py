@@ -5,21 +5,20 @@ at every frame someone needs (and often enough to show progress and stream event
 those frames, and calls back with events and frames as they come. Two front ends sit on it:
 `simulate` keeps everything in memory (goldens, tests), `run_to_dir` streams the files of SPEC
 section 5 into a staging folder that replaces `OUT/NAME/` whole when the run is done, under a lock
-(`runner.rundir`), after `runner.budget` has checked what its frames will cost; the event log is
-counted as it is written, and a run whose log would pass what the frames leave of
-`--max-output-bytes` stops there with an error, its staging folder removed (the previous run
-stays). Frames are a `FrameRule`, so nothing sized by the number of ticks is built. A model that
-stops a run as a runaway (an `engine.errors.Runaway`: the exact model's event cap or an object
-with no room to move, the stepped model's fold limit) raises `RunStopped` with a message for the
-user. The summary counts the wall and pair events whether or not they are logged (the models
-count them as they happen).
-Each run's kernels run compiled or interpreted (`runner.lanes`, by the size of the run; the
-summary's `kernels` says which). Kernels compiled during a run (a first run, before numba has
-cached them) are timed apart (`runner.compiling`): the summary's `compile_time_s` holds them and
-`run_time_s` leaves them out.
-Ctrl-C during `run_to_dir` stops the run at the end of the current chunk of ticks: what was written
-so far (events, PNG frames, the final state at that tick, a summary with `interrupted_at_tick`)
-becomes OUT/NAME, without the GIF, which would be an animation of part of the run.
+(`runner.output.folder`), after `runner.output.budget` has checked what its frames will cost; the
+event log is counted as it is written, and a run whose log would pass what the frames leave of
+`--max-output-bytes` stops there with an error, its staging folder removed (the previous run stays).
+Frames are a `FrameRule`, so nothing sized by the number of ticks is built. A model that stops a run
+as a runaway (an `engine.errors.Runaway`: the exact model's event cap or an object with no room to
+move, the stepped model's fold limit) raises `RunStopped` with a message for the user. The summary
+counts the wall and pair events whether or not they are logged (the models count them as they
+happen). Each run's kernels run compiled or interpreted (`runner.lanes`, by the size of the run; the
+summary's `kernels` says which). Kernels compiled during a run (a first run, before numba has cached
+them) are timed apart (`runner.compiling`): the summary's `compile_time_s` holds them and
+`run_time_s` leaves them out. Ctrl-C during `run_to_dir` stops the run at the end of the current
+chunk of ticks: what was written so far (events, PNG frames, the final state at that tick, a summary
+with `interrupted_at_tick`) becomes OUT/NAME, without the GIF, which would be an animation of part
+of the run.
 """
 
 from __future__ import annotations
@@ -42,12 +41,16 @@ from collide2d.engine.errors import Runaway
 from collide2d.engine.events import empty_events
 from collide2d.engine.invariants import kinetic_energy, momentum
 from collide2d.engine.raster import Renderer
-from collide2d.runner import budget, compiling, lanes, outputs, rundir, viewer
-from collide2d.runner.frames import FrameRule
-from collide2d.runner.limits import Limits
-from collide2d.runner.overlay import Overlay
-from collide2d.runner.progress import Progress
-from collide2d.runner.scenario import Scenario, ScenarioError
+from collide2d.runner import compiling, lanes
+from collide2d.runner.command.progress import Progress
+from collide2d.runner.output import budget
+from collide2d.runner.output import files as outputs
+from collide2d.runner.output import folder as rundir
+from collide2d.runner.output import viewerdata as viewer
+from collide2d.runner.output.overlay import Overlay
+from collide2d.runner.scenario.frames import FrameRule
+from collide2d.runner.scenario.limits import Limits
+from collide2d.runner.scenario.load import Scenario, ScenarioError
 
 # Ticks per model call when nothing else ends a chunk: about CHUNK_S seconds of ticks at the
 # pace of the calls so far (FIRST_CHUNK_TICKS before any), at most CHUNK_TICKS: long enough that
@@ -91,15 +94,13 @@ def drive(
     """Run the scenario; returns (the model at the end, the summary).
 
     frames: the frames (0..ticks) to rasterise, a FrameRule or frame numbers; each is passed to
-    `on_frame(k, index_frame)` as an (H, W) uint8 palette-index image that is only valid during
-    the call.
-    log_events: record events and pass each chunk's array to `on_events`.
-    on_tick: called with the model at tick 0 and after every tick (the viewer records each
-    tick's state); the model then advances one tick per call.
-    overlay: a `runner.overlay.Overlay`; it may wrap the model, takes the events and draws over
-    each frame before `on_frame` sees it.
-    interruptible: Ctrl-C (SIGINT, in the main thread) ends the run after the current chunk of
-    ticks; the summary then holds `interrupted_at_tick`.
+    `on_frame(k, index_frame)` as an (H, W) uint8 palette-index image that is only valid during the
+    call. log_events: record events and pass each chunk's array to `on_events`. on_tick: called with
+    the model at tick 0 and after every tick (the viewer records each tick's state); the model then
+    advances one tick per call. overlay: a `runner.output.overlay.Overlay`; it may wrap the model,
+    takes the events and draws over each frame before `on_frame` sees it. interruptible: Ctrl-C
+    (SIGINT, in the main thread) ends the run after the current chunk of ticks; the summary then
+    holds `interrupted_at_tick`.
     """
     if not isinstance(frames, FrameRule):
         frames = FrameRule.of(frames, scenario.ticks)
@@ -305,8 +306,8 @@ class RunOptions:
     events: bool
     scale: int = 1
     quiet: bool = False
-    viewer: bool = False  # viewer.html beside the GIF (runner.viewer)
-    overlay: tuple = ()  # overlays drawn into the PNG and GIF frames (runner.overlay)
+    viewer: bool = False  # viewer.html beside the GIF (runner.output.viewerdata)
+    overlay: tuple = ()  # overlays drawn into the PNG and GIF frames (runner.output.overlay)
 
 
 def output_dir(out_root: str | os.PathLike, scenario: Scenario) -> Path:
@@ -329,7 +330,7 @@ def run_to_dir(
 
     The frames are planned and checked against the limits first; then, holding OUT/NAME's lock,
     everything is written into a staging folder that replaces OUT/NAME whole at the end (see
-    `runner.rundir`). On any failure the staging folder goes and the previous run stays.
+    `runner.output.folder`). On any failure the staging folder goes and the previous run stays.
     """
     limits = limits or Limits()
     plan = budget.plan_frames(
@@ -393,7 +394,7 @@ def _write_files(scenario: Scenario, folder: Path, options: RunOptions, plan) ->
         if gif.note and not options.quiet and sys.stderr.isatty():
             print(f"{scenario.name}: {gif.note}", file=sys.stderr)
     log = None
-    if options.events:  # within what the frames leave of --max-output-bytes (runner.budget)
+    if options.events:  # within what the frames leave of --max-output-bytes (runner.output.budget)
         log = outputs.EventsWriter(folder / "events.jsonl", scenario.names, plan.log_room)
     # the viewer refuses a run too long to view
     recorder = viewer.Recorder(scenario, layer) if options.viewer else None
@@ -473,7 +474,7 @@ def _tee(write, recorder):
 def _check_finite(scenario: Scenario, model, start, end) -> None:
     """RunStopped unless the summary's figures and the final state are finite numbers.
 
-    The scenario's bounds (runner.scenario, "Numbers") keep them finite; this makes sure that a
+    The scenario's bounds (runner.scenario.load, "Numbers") keep them finite; this makes sure that a
     model breaking them stops the run with a message instead of writing inf or nan."""
     figures = np.array([start[0], *start[1], end[0], *end[1]], np.float64)
     if not (

@@ -14,7 +14,7 @@ import time
 from pathlib import Path
 
 from collide2d.engine import models
-from collide2d.runner.exitcodes import EXIT_BAD_INPUT, EXIT_OK
+from collide2d.runner.command.exitcodes import EXIT_BAD_INPUT, EXIT_OK
 
 PARTS = ("scaling", "error", "peers", "skips", "targets", "paper", "exact", "raster")
 PARTS += ("stages", "load")  # runner/bench/stages.py, load.py
@@ -23,7 +23,7 @@ REPORT_DIR = "bench"
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
-    from collide2d.runner import lanes, outputs
+    from collide2d.runner import lanes
     from collide2d.runner.bench import (
         error,
         exact,
@@ -38,6 +38,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
         targets,
         timing,
     )
+    from collide2d.runner.output import files as outputs
 
     lanes.set_mode("on")  # every run the bench times is compiled (runner.lanes)
     parts = tuple(dict.fromkeys(args.part)) if args.part else DEFAULT_PARTS
@@ -161,6 +162,6 @@ def register(subparsers) -> None:
 
 
 def _positive(text: str) -> int:
-    from collide2d.runner.options import positive_int
+    from collide2d.runner.command.options import positive_int
 
     return positive_int(text)

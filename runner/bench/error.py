@@ -143,7 +143,7 @@ def error_ladder(names, models_, quick: bool, echo, folder: Path = PROJECT_SCENA
     """Each benchmark scenario (NAME.yaml in `folder`) under each model of `models_` and each
     (fps, substeps) of its ladder, against the exact model: one row each (see the module
     docstring), then the sensitivity rows and the glancing scan."""
-    from collide2d.runner.scenario import load
+    from collide2d.runner.scenario.load import load
 
     horizons = QUICK_HORIZONS_S if quick else HORIZONS_S
     rows = []

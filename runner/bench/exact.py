@@ -30,7 +30,7 @@ QUICK_GAS_TICKS = 30
 def events_per_second(text: str, ticks: int, repeats: int) -> tuple[float, int, int]:
     """(median events/s, events per run, objects) of the exact model over `ticks` ticks of the
     scenario text; building the model is not timed."""
-    from collide2d.runner.scenario import loads
+    from collide2d.runner.scenario.load import loads
 
     scenario = loads(text)
     world, bodies = scenario.world, scenario.bodies

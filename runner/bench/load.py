@@ -4,11 +4,12 @@ memory it takes, before the first tick.
 LOAD_N objects of the standard scene (boxes 10x10 px on a 12 px lattice, velocities to three
 decimals, four colours) are written four ways into a temporary folder: a YAML list with one flow
 mapping per line and the same list in block style as `yaml.safe_dump` writes it (both through the
-fast lane, runner.yamlfast), a CSV table (`objects: {file: bodies.csv}`, runner.table) and, once,
-the flow list read by the general path alone (the fast lane turned off). Each is loaded by
-`runner.scenario.load` in a fresh `python` process that reports the load's wall time and its peak
-resident memory (VmHWM on Linux, else `ru_maxrss`) beside that of the same process before loading
-(imports done); the median of LOAD_REPEATS processes. Rows are one figure each.
+fast lane, runner.scenario.fastlane), a CSV table (`objects: {file: bodies.csv}`,
+runner.scenario.table) and, once, the flow list read by the general path alone (the fast lane turned
+off). Each is loaded by `runner.scenario.load.load` in a fresh `python` process that reports the
+load's wall time and its peak resident memory (VmHWM on Linux, else `ru_maxrss`) beside that of the
+same process before loading (imports done); the median of LOAD_REPEATS processes. Rows are one
+figure each.
 """
 
 from __future__ import annotations
@@ -31,7 +32,8 @@ COLORS = ("red", "white", "blue", "green")
 
 _CHILD = """
 import json, resource, sys, time
-from collide2d.runner import scenario, yamlfast
+from collide2d.runner.scenario import load as scenario
+from collide2d.runner.scenario import fastlane as yamlfast
 def peak_kb():
     # this process's own high-water mark (ru_maxrss may carry the parent's across exec)
     try:

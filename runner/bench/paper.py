@@ -37,7 +37,7 @@ def demo_row(part: str, demo, ticks: int, rate: float, note: str) -> dict:
 def paper(quick: bool, echo, folder: Path = PROJECT_SCENARIOS) -> list[dict]:
     """One row per way of running the demo: ticks/s (the demo is read from `folder`)."""
     from collide2d.runner.run import drive
-    from collide2d.runner.scenario import load
+    from collide2d.runner.scenario.load import load
 
     ticks = QUICK_PAPER_TICKS if quick else PAPER_TICKS
     repeats = 1 if quick else PAPER_REPEATS

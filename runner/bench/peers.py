@@ -71,7 +71,7 @@ class PymunkTimer:
     about `target` s of it and returns steps/s."""
 
     def __init__(self, n: int, target: float):
-        from collide2d.runner.scenario import loads
+        from collide2d.runner.scenario.load import loads
 
         scenario = loads(standard_scene(n, "stepped"))
         self.dt = 1.0 / STANDARD_FPS

@@ -22,7 +22,7 @@ def plots(rows: list[dict], folder: Path) -> list[str]:
         from matplotlib import ticker
     except ImportError:
         return []
-    from collide2d.runner.outputs import atomic_path
+    from collide2d.runner.output.files import atomic_path
 
     written = []
     scale = [r for r in rows if r["part"] in ("scaling", "peers")]

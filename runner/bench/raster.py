@@ -4,9 +4,9 @@ The demo's 50 boxes (`scenarios/paper_fifty_boxes.yaml`, 320x240, outlines) move
 here, 1 px per frame on each axis, bouncing off the walls (`moving_positions`), and the part
 measures, each the median of several repeats after a warm-up: `Renderer.draw` frames/s with all
 boxes moving (the issue's target: at least 20,000) and with 5 of 50 moving (the
-erase-only-what-moved path), `Renderer.draw_full` for comparison; the seconds to render and stream
-a GIF of GIF_FRAMES frames through `runner.outputs.GifWriter`; the milliseconds to encode and write
-one PNG frame. Not a default part (`--part raster`).
+erase-only-what-moved path), `Renderer.draw_full` for comparison; the seconds to render and stream a
+GIF of GIF_FRAMES frames through `runner.output.files.GifWriter`; the milliseconds to encode and
+write one PNG frame. Not a default part (`--part raster`).
 """
 
 from __future__ import annotations
@@ -63,8 +63,8 @@ def _frames_per_second(renderer, path: np.ndarray, full: bool, repeats: int) -> 
 def raster(quick: bool, echo, folder: Path = PROJECT_SCENARIOS) -> list[dict]:
     """One row per measure (the demo is read from `folder`)."""
     from collide2d.engine.raster import Renderer, to_rgb
-    from collide2d.runner import outputs
-    from collide2d.runner.scenario import load
+    from collide2d.runner.output import files as outputs
+    from collide2d.runner.scenario.load import load
 
     frames = QUICK_RASTER_FRAMES if quick else RASTER_FRAMES
     repeats = 1 if quick else RASTER_REPEATS

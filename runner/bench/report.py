@@ -1,6 +1,6 @@
 """The reports of `collide2d bench`: bench.csv (one row per measurement, the columns of `COLUMNS`)
 and bench.md (the headline ratios first, then one table per part). Cells go through
-`runner.escape`: no text cell of bench.csv runs as a spreadsheet formula, no cell of bench.md
+`runner.output.escape`: no text cell of bench.csv runs as a spreadsheet formula, no cell of bench.md
 breaks its table row.
 """
 
@@ -10,7 +10,6 @@ import os
 
 import numpy as np
 
-from collide2d.runner import escape
 from collide2d.runner.bench import goals
 from collide2d.runner.bench.error import NUDGE_PX_S
 from collide2d.runner.bench.scenes import (
@@ -20,6 +19,7 @@ from collide2d.runner.bench.scenes import (
     STANDARD_SIZE_PX,
     STANDARD_SPEEDS,
 )
+from collide2d.runner.output import escape
 
 # The parts whose rows are one figure each (`value`, described by `note`), and their titles.
 FIGURE_PARTS = {

@@ -29,7 +29,7 @@ def skips(quick: bool, echo, folder: Path = PROJECT_SCENARIOS) -> list[dict]:
     from collide2d.engine.raster import Renderer
     from collide2d.engine.world import Bodies
     from collide2d.runner.run import drive
-    from collide2d.runner.scenario import load
+    from collide2d.runner.scenario.load import load
 
     ticks = 60 if quick else SKIP_TICKS
     demo = load(folder / f"{DEMO_SCENARIO}.yaml", overrides={"ticks": ticks})

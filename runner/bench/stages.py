@@ -48,7 +48,7 @@ def _rate(model, target: float, repeats: int) -> float:
 
 def stages(quick: bool, echo, ns=None) -> list[dict]:
     from collide2d.runner.bench import peers
-    from collide2d.runner.scenario import loads
+    from collide2d.runner.scenario.load import loads
 
     ns = list(ns or (QUICK_STAGE_N if quick else STAGE_N))
     target = QUICK_STAGE_TARGET_S if quick else STAGE_TARGET_S

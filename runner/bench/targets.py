@@ -21,7 +21,7 @@ QUICK_DEMO_TICKS = 20_000
 def targets(quick: bool, echo, folder: Path = PROJECT_SCENARIOS) -> list[dict]:
     """The section IV demo headless, and `collide2d run` of a small scenario, wall time; the
     scenario files are read from `folder`."""
-    from collide2d.runner.scenario import load
+    from collide2d.runner.scenario.load import load
 
     ticks = QUICK_DEMO_TICKS if quick else DEMO_TICKS
     demo = load(folder / f"{DEMO_SCENARIO}.yaml")

@@ -62,7 +62,7 @@ def drive_seconds(text: str, ticks: int) -> float:
     """Seconds `runner.run.drive` takes over `ticks` ticks of the scenario text (loading not
     counted; model set-up counted, as in a run)."""
     from collide2d.runner.run import drive
-    from collide2d.runner.scenario import loads
+    from collide2d.runner.scenario.load import loads
 
     scenario = loads(text, overrides={"ticks": ticks})
     began = time.perf_counter()

@@ -17,7 +17,7 @@ anything runs.
 
 `register(subparsers)` adds both commands to the `collide2d` parser; each sets `func(args) -> int`.
 The scenario loader and the simulator can be handed in (tests use synthetic ones); by default they
-are `runner.scenario.load` and `runner.run.simulate`.
+are `runner.scenario.load.load` and `runner.run.simulate`.
 """
 
 from __future__ import annotations
@@ -28,7 +28,12 @@ import traceback
 from functools import partial
 from pathlib import Path
 
-from collide2d.runner.exitcodes import EXIT_BAD_INPUT, EXIT_DIFFERENCE, EXIT_OK, EXIT_UNEXPECTED
+from collide2d.runner.command.exitcodes import (
+    EXIT_BAD_INPUT,
+    EXIT_DIFFERENCE,
+    EXIT_OK,
+    EXIT_UNEXPECTED,
+)
 from collide2d.runner.golden import bless_run, check_run, golden_frames, report, shown_path
 from collide2d.runner.golden.formats import Output, add_check_formats
 from collide2d.runner.golden.fromreport import add_from_report, bless_from_report
@@ -44,7 +49,7 @@ from collide2d.runner.golden.store import (
     scenario_files,
 )
 
-# `--report` given with no folder: the project's report folder (runner.config).
+# `--report` given with no folder: the project's report folder (runner.command.settings).
 REPORT_FROM_PROJECT = object()
 
 
@@ -62,8 +67,8 @@ class _Usage(Exception):
 
 
 def default_load(path, **kwargs):
-    """runner.scenario.load (imported when first needed)."""
-    from collide2d.runner.scenario import load
+    """runner.scenario.load.load (imported when first needed)."""
+    from collide2d.runner.scenario.load import load
 
     return load(path, **kwargs)
 
@@ -143,7 +148,7 @@ def _cluster_runs(args, scenarios, run):
 
 
 def _common(p) -> None:
-    from collide2d.runner.options import add_cap_argument, add_jit_argument
+    from collide2d.runner.command.options import add_cap_argument, add_jit_argument
 
     p.add_argument("--root", metavar="DIR", help="project folder holding scenarios/ and goldens/")
     p.add_argument("--quiet", action="store_true", help="no progress output")
@@ -323,7 +328,7 @@ def _prepare(args, load, refused=None):
     """(root, [(path, Scenario)]) for the command's arguments; _Usage on any bad input, before
     anything runs. With a list `refused`, a scenario file that cannot be read (refused, or an
     unexpected error reading it) is left out and added to it as (path, error) instead."""
-    from collide2d.runner.options import apply_jit
+    from collide2d.runner.command.options import apply_jit
 
     project = _project(args)
     apply_jit(args, project)
@@ -350,10 +355,10 @@ def _prepare(args, load, refused=None):
 
 
 def _project(args):
-    """The project (runner.config.Config) of --root, else found upward from here: the nearest
-    folder with a [tool.collide2d] table or a scenarios/ folder; _Usage when there is none or
-    its table is refused. Kept on `args` for the goldens folder."""
-    from collide2d.runner import config
+    """The project (runner.command.settings.Config) of --root, else found upward from here: the
+    nearest folder with a [tool.collide2d] table or a scenarios/ folder; _Usage when there is none
+    or its table is refused. Kept on `args` for the goldens folder."""
+    from collide2d.runner.command import settings as config
 
     try:
         if args.root:
@@ -394,7 +399,7 @@ def _load_all(paths, load, refused=None):
 
 def scenario_errors() -> tuple:
     """The exception types that mean "this scenario file is refused"."""
-    from collide2d.runner.scenario import ScenarioError
+    from collide2d.runner.scenario.load import ScenarioError
 
     return (ScenarioError,)
 
@@ -421,10 +426,10 @@ def _all_names(root, scenarios, load, project) -> list[str]:
 
 def _report_dir(args) -> Path | None:
     """The folder of `--report`, None without it; _Usage when it is the project folder, holds
-    it, or meets another of the project's folders (runner.config.Config.apart)."""
+    it, or meets another of the project's folders (runner.command.settings.Config.apart)."""
     if not args.report:
         return None
-    from collide2d.runner.config import FolderClash
+    from collide2d.runner.command.settings import FolderClash
 
     try:
         return args.project.apart("report", args.report, "--report")

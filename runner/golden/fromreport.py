@@ -17,7 +17,7 @@ import stat
 import sys
 from pathlib import Path
 
-from collide2d.runner.exitcodes import EXIT_BAD_INPUT, EXIT_OK
+from collide2d.runner.command.exitcodes import EXIT_BAD_INPUT, EXIT_OK
 from collide2d.runner.golden import report
 from collide2d.runner.golden import serialize as ser
 from collide2d.runner.golden.session import CREATED, UNCHANGED, UPDATED

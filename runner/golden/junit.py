@@ -15,9 +15,9 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-from collide2d.runner.escape import visible
 from collide2d.runner.golden.report import STATUS_FAILED, first_divergence
-from collide2d.runner.outputs import atomic_write_bytes
+from collide2d.runner.output.escape import visible
+from collide2d.runner.output.files import atomic_write_bytes
 
 SUITE_NAME = "collide2d.check"
 CLASS_NAME = "goldens"

@@ -1,14 +1,14 @@
 """The pytest plugin of the goldens: every scenario a test, `test_golden[fig2_case1]` (SPEC §7).
 
-Registered through the `pytest11` entry point of the distribution, so it loads in the pytest run
-of any project that installs collide2d.
-Inputs: the scenario files of the project (`ROOT/scenarios/`, ROOT found upward from the current
-directory or given by `--golden-root`; the folders and the scenarios' limits and model defaults
-come from ROOT's `[tool.collide2d]` table, runner.config) and the options below. In a project
-with that table, every scenario file of its scenarios folder is collected as one test,
-`scenarios/NAME.yaml::golden`, with no test file or conftest; other projects are untouched.
-Outputs: test outcomes whose failure text is the same as `collide2d check` prints, a report per
-failing scenario, and with `--update-goldens` the goldens of the tests that ran.
+Registered through the `pytest11` entry point of the distribution, so it loads in the pytest run of
+any project that installs collide2d. Inputs: the scenario files of the project (`ROOT/scenarios/`,
+ROOT found upward from the current directory or given by `--golden-root`; the folders and the
+scenarios' limits and model defaults come from ROOT's `[tool.collide2d]` table,
+runner.command.settings) and the options below. In a project with that table, every scenario file of
+its scenarios folder is collected as one test, `scenarios/NAME.yaml::golden`, with no test file or
+conftest; other projects are untouched. Outputs: test outcomes whose failure text is the same as
+`collide2d check` prints, a report per failing scenario, and with `--update-goldens` the goldens of
+the tests that ran.
 
     --update-goldens     bless what runs instead of comparing (refused with exit status 2 when the
                          CI environment variable is set)
@@ -32,7 +32,7 @@ from pathlib import Path
 
 import pytest
 
-from collide2d.runner import escape
+from collide2d.runner.output import escape
 
 # Every pytest run of the project loads this plugin: the harness (numpy, Pillow, the engine) is
 # imported inside the hooks and fixtures that use it, so that it costs nothing until they run.
@@ -82,9 +82,9 @@ def pytest_configure(config) -> None:
 def _check_report_option(config) -> None:
     """--golden-report DIR by the rule of `collide2d check --report DIR`: a folder of its own,
     neither the project folder, nor holding it, nor meeting one of its folders (exit status 2;
-    runner.config.Config.apart). A project that cannot be found is left to the golden tests,
-    which fail saying why."""
-    from collide2d.runner.config import ConfigError, FolderClash
+    runner.command.settings.Config.apart). A project that cannot be found is left to the golden
+    tests, which fail saying why."""
+    from collide2d.runner.command.settings import ConfigError, FolderClash
     from collide2d.runner.golden.store import GoldenError
 
     try:
@@ -98,9 +98,9 @@ def _check_report_option(config) -> None:
 
 
 def _project(config):
-    """The project's runner.config.Config: --golden-root's, else the nearest one upward with a
-    [tool.collide2d] table or a scenarios/ folder (GoldenError when there is neither)."""
-    from collide2d.runner import config as cfg
+    """The project's runner.command.settings.Config: --golden-root's, else the nearest one upward
+    with a [tool.collide2d] table or a scenarios/ folder (GoldenError when there is neither)."""
+    from collide2d.runner.command import settings as cfg
     from collide2d.runner.golden.store import find_root
 
     given = config.getoption("golden_root")
@@ -125,7 +125,7 @@ def pytest_collect_file(file_path, parent):
     golden test."""
     if file_path.suffix not in (".yaml", ".yml"):
         return None
-    from collide2d.runner import config as cfg
+    from collide2d.runner.command import settings as cfg
 
     try:
         project = cfg.find(file_path.parent)
@@ -240,8 +240,8 @@ def _basetemp(config) -> Path:
 
 
 def check_golden(node, path, project, load, simulate, basetemp) -> None:
-    """The golden test of the scenario file `path` in `project` (a runner.config.Config), run as
-    the test `node`: check it, or bless it under --update-goldens; pytest.fail with the text
+    """The golden test of the scenario file `path` in `project` (a runner.command.settings.Config),
+    run as the test `node`: check it, or bless it under --update-goldens; pytest.fail with the text
     `collide2d check` prints. `basetemp()`: the folder a failure's report goes under when no
     --golden-report is given."""
     from collide2d.runner.golden import bless_run, check_run, shown_path

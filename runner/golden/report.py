@@ -31,7 +31,7 @@ import numpy as np
 from collide2d.runner.golden import reportpage
 from collide2d.runner.golden.compare import FrameDiff
 from collide2d.runner.golden.store import GoldenError, link_message, shown_path
-from collide2d.runner.outputs import atomic_write_bytes, encode_png, write_json
+from collide2d.runner.output.files import atomic_write_bytes, encode_png, write_json
 
 REPORT_FORMAT = 1
 # Diff image colours (RGB) and how bright the grey copy of the frame under them is (0..1).

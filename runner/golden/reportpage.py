@@ -26,10 +26,10 @@ import json
 
 import numpy as np
 
-from collide2d.runner.escape import visible
 from collide2d.runner.golden import compare
 from collide2d.runner.golden import serialize as ser
-from collide2d.runner.outputs import encode_png
+from collide2d.runner.output.escape import visible
+from collide2d.runner.output.files import encode_png
 
 # Crops: the changed pixels' box grown by CROP_MARGIN px on each side and to at least CROP_MIN px,
 # enlarged by a whole factor to about CROP_TARGET px on its longer side (at most CROP_MAX_ZOOM).

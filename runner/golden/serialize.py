@@ -7,7 +7,7 @@ change in a diff viewer and the same results always give the same bytes:
 
     manifest.json               format version, what was run, and a hash of every other file
     events.jsonl                one `engine.events.format_event` line per event
-    final.csv                   `id,x,y,vx,vy` as `runner.outputs.final_csv_text` writes it
+    final.csv                   `id,x,y,vx,vy` as `runner.output.files.final_csv_text` writes it
     frames/frame_000012.png     RGB PNG, deterministic encoding, no metadata
 
 A frame is identified by its decoded pixels, never by its PNG bytes (zlib builds differ across
@@ -37,7 +37,7 @@ from PIL import Image, UnidentifiedImageError
 
 from collide2d import __version__
 from collide2d.engine.events import event_dict, format_event
-from collide2d.runner.outputs import encode_png, final_csv_text
+from collide2d.runner.output.files import encode_png, final_csv_text
 
 # The golden folder's layout version; a reader refuses other versions with a clear message.
 FORMAT_VERSION = 1

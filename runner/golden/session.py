@@ -4,10 +4,10 @@
 module joins them for one scenario, and `cli` (the `check` and `bless` commands) and `plugin`
 (pytest) drive it.
 
-Inputs: a Scenario (`runner.scenario`), its RunResult (`runner.run.simulate` with the scenario's
-golden frames kept) and a `GoldenStore`. Outputs: `check_run` -> a `report.Outcome` (passed, failed,
-missing or unreadable, with every difference found); `bless_run` -> a `Blessed` record (created,
-updated or unchanged, with a one-line summary of what changed).
+Inputs: a Scenario (`runner.scenario.load`), its RunResult (`runner.run.simulate` with the
+scenario's golden frames kept) and a `GoldenStore`. Outputs: `check_run` -> a `report.Outcome`
+(passed, failed, missing or unreadable, with every difference found); `bless_run` -> a `Blessed`
+record (created, updated or unchanged, with a one-line summary of what changed).
 """
 
 from __future__ import annotations

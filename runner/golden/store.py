@@ -17,8 +17,8 @@ A write builds the whole new golden in a sibling temporary folder `goldens/.NAME
 instant leaves either the old golden whole or the new one whole: between the two renames the old
 golden waits whole under its aside name, where `read` finds it and the next write puts it back.
 Leftovers are recognised by that exact name pattern, only as real folders, and a live process's own
-temporaries are left alone (the names, the swap and the recovery are `runner.swapdir`'s). A golden
-whose files all equal what is on disk is not rewritten. Nothing is ever written when the `CI`
+temporaries are left alone (the names, the swap and the recovery are `runner.output.swap`'s). A
+golden whose files all equal what is on disk is not rewritten. Nothing is ever written when the `CI`
 environment variable is set, and a golden folder is only removed by `remove` (the `--prune` of
 `bless`), and only when it holds a golden's manifest (`is_golden`): a folder of anything else is
 never listed as an unused golden, nor removed.
@@ -35,9 +35,9 @@ from pathlib import Path
 
 import numpy as np
 
-from collide2d.runner import swapdir
 from collide2d.runner.golden import serialize as ser
-from collide2d.runner.scenario import NAME_PATTERN
+from collide2d.runner.output import swap as swapdir
+from collide2d.runner.scenario.load import NAME_PATTERN
 
 GOLDENS_DIR = "goldens"
 SCENARIOS_DIR = "scenarios"

@@ -4,8 +4,8 @@ Input: the scene list built in code (`scenes.scenes(quick)`), each a `Scene` of 
 `WorldSpec`, `Bodies`, a tick count, the models it applies to). Output: one `CaseResult` per scene
 and model with its figures (ticks run, events, largest energy and momentum drift, largest
 penetration, run time) and a verdict, written as `OUT/stress/report.md` and `report.json` (each
-through a temporary name and a rename, runner.outputs) and summed up on stdout; the exit status is 1
-when an invariant broke, else 0.
+through a temporary name and a rename, runner.output.files) and summed up on stdout; the exit status
+is 1 when an invariant broke, else 0.
 
 One module per concept:
 - `scenes`: the hostile scenes (`Scene`, `scenes(quick)`);

@@ -12,11 +12,11 @@ import sys
 import time
 
 from collide2d.engine.models import MODEL_NAMES
-from collide2d.runner.exitcodes import EXIT_BAD_INPUT, EXIT_DIFFERENCE, EXIT_OK
+from collide2d.runner.command.exitcodes import EXIT_BAD_INPUT, EXIT_DIFFERENCE, EXIT_OK
 
 
 def cmd_stress(args: argparse.Namespace) -> int:
-    from collide2d.runner import outputs
+    from collide2d.runner.output import files as outputs
     from collide2d.runner.stress.cases import VERDICT_FAIL, run_suite
     from collide2d.runner.stress.report import (
         HEADER,

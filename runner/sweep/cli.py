@@ -16,7 +16,7 @@ import os
 import sys
 from pathlib import Path
 
-from collide2d.runner.exitcodes import EXIT_BAD_INPUT, EXIT_OK, EXIT_UNEXPECTED
+from collide2d.runner.command.exitcodes import EXIT_BAD_INPUT, EXIT_OK, EXIT_UNEXPECTED
 
 EXIT_CANCELLED = 130
 REPORT_DIR = "sweep"
@@ -29,7 +29,7 @@ LOCAL_WORKERS_PER_CORE = 8
 
 def local_workers(text: str) -> int:
     """argparse type of --workers: a whole number from 1 to LOCAL_WORKERS_PER_CORE x the cores."""
-    from collide2d.runner.options import positive_int
+    from collide2d.runner.command.options import positive_int
 
     value = positive_int(text)
     cores = os.cpu_count() or 1
@@ -65,7 +65,7 @@ def add_cluster_arguments(parser: argparse.ArgumentParser) -> None:
 
 def register(subparsers) -> None:
     """Add the `sweep` subcommand to an argparse subparsers object."""
-    from collide2d.runner.options import add_limit_arguments
+    from collide2d.runner.command.options import add_limit_arguments
 
     p = subparsers.add_parser(
         "sweep",
@@ -101,7 +101,7 @@ def register(subparsers) -> None:
 
 def matrix_from_args(args):
     """(scenario paths, axes, seeds) from the command line (and a sweep file)."""
-    from collide2d.runner.options import limits_from_args
+    from collide2d.runner.command.options import limits_from_args
     from collide2d.runner.sweep import matrix, sweepfile
 
     limits = limits_from_args(args)
@@ -122,7 +122,7 @@ def matrix_from_args(args):
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
-    from collide2d.runner import config
+    from collide2d.runner.command import settings as config
     from collide2d.runner.sweep import cluster, driver, folder, matrix, plan, results
 
     project = config.find()

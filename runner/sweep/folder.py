@@ -1,12 +1,12 @@
 """OUT/sweep/ whole, as a run folder is: the lock, the staging folder and the swap.
 
-A sweep into OUT takes `OUT/.sweep.lock` (`runner.rundir.RunLock`: a second sweep, or a run of a
-scenario named `sweep`, into the same OUT is refused while it is held, naming the process that
+A sweep into OUT takes `OUT/.sweep.lock` (`runner.output.folder.RunLock`: a second sweep, or a run
+of a scenario named `sweep`, into the same OUT is refused while it is held, naming the process that
 holds it) for as long as it runs, writes its files into a fresh sibling staging folder and, only
-when all of them are written, swaps it in for `OUT/sweep` (`runner.rundir.swap_in`). So
+when all of them are written, swaps it in for `OUT/sweep` (`runner.output.folder.swap_in`). So
 `OUT/sweep/` always holds one whole sweep, the old or the new; on any failure the staging folder
 goes and the old sweep stays. What a killed sweep left is finished or removed by the next one
-(`runner.rundir.clean_leftovers`).
+(`runner.output.folder.clean_leftovers`).
 
 Nothing is followed through a symbolic link, and the old folder is replaced only when it holds
 nothing but the files a sweep writes (SWEEP_FILES): a file a user put there is never deleted.
@@ -19,7 +19,9 @@ import os
 import stat
 from pathlib import Path
 
-from collide2d.runner import outputs, rundir, swapdir
+from collide2d.runner.output import files as outputs
+from collide2d.runner.output import folder as rundir
+from collide2d.runner.output import swap as swapdir
 
 NAME = "sweep"
 SWEEP_FILES = ("results.csv", "results.md", "sweep.json", "runtime_vs_error.png")

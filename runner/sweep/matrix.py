@@ -28,10 +28,10 @@ from dataclasses import dataclass
 import yaml
 
 from collide2d.engine.models import MODEL_NAMES, SCENARIO_OPTIONS
-from collide2d.runner import yamlsafe as ys
-from collide2d.runner.limits import Limits
-from collide2d.runner.objects import MAX_SEED
-from collide2d.runner.scenario import Scenario, ScenarioError, load
+from collide2d.runner.scenario import parse as ys
+from collide2d.runner.scenario.limits import Limits
+from collide2d.runner.scenario.load import Scenario, ScenarioError, load
+from collide2d.runner.scenario.objects import MAX_SEED
 
 RUN_KEYS = ("model", "fps", "ticks", "substeps", "geometry")
 MAX_RUNS = 1_000_000  # runs in one sweep

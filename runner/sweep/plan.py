@@ -24,7 +24,7 @@ from collections import OrderedDict
 from dataclasses import dataclass
 
 from collide2d.runner import lanes
-from collide2d.runner.limits import Limits
+from collide2d.runner.scenario.limits import Limits
 from collide2d.runner.sweep import matrix
 from collide2d.runner.sweep.matrix import RUN_KEYS, Combo, SweepError
 from collide2d.runner.sweep.reseed import Reseeded, reseed
@@ -118,7 +118,7 @@ def check(
     progress=None,
 ) -> Plan:
     """Check every run of the matrix (see the module docstring); `progress(total)` gives a bar
-    (runner.progress.Progress) or None."""
+    (runner.command.progress.Progress) or None."""
     limits = limits or Limits()
     count = matrix.check_axes(scenarios, axes, seeds)
     dotted = [a for a in axes if a.key not in RUN_KEYS]

@@ -1,16 +1,16 @@
 """A loaded scenario drawn again for another seed: what a sweep's seed changes, and nothing more.
 
-A sweep's seed goes to every `generate` block of the file (`runner.sweep.matrix`), and the only
-part of a loaded scenario that a block's seed changes is what `runner.generate` draws from it: the
-positions and velocities of the block's objects, the last rows of `bodies` (`Scenario.generated`
-keeps each block's spec). So `reseed(scenario, seed)` draws the blocks again around the same
-listed objects, exactly as the loader does (`runner.assemble.bodies`), and refuses what the loader
+A sweep's seed goes to every `generate` block of the file (`runner.sweep.matrix`), and the only part
+of a loaded scenario that a block's seed changes is what `runner.scenario.generate` draws from it:
+the positions and velocities of the block's objects, the last rows of `bodies` (`Scenario.generated`
+keeps each block's spec). So `reseed(scenario, seed)` draws the blocks again around the same listed
+objects, exactly as the loader does (`runner.scenario.assemble.bodies`), and refuses what the loader
 would refuse for that seed: boxes that cannot all be placed (`PlacementError`) and, under the
-`exact` model, a moving object left with no room on an axis it moves on
-(`engine.noroom.no_room`). The result is the scenario the loader gives for the file with that seed
-(a test holds the two equal), at the cost of the drawing alone: no file read, no YAML, no checks
-that the seed cannot change. `Reseeded` is raised with the loader's reason when refused; the
-sweep then loads that run in full for the located message.
+`exact` model, a moving object left with no room on an axis it moves on (`engine.noroom.no_room`).
+The result is the scenario the loader gives for the file with that seed (a test holds the two
+equal), at the cost of the drawing alone: no file read, no YAML, no checks that the seed cannot
+change. `Reseeded` is raised with the loader's reason when refused; the sweep then loads that run in
+full for the located message.
 """
 
 from __future__ import annotations
@@ -20,8 +20,8 @@ import dataclasses
 import numpy as np
 
 from collide2d.engine.noroom import no_room, no_room_message
-from collide2d.runner import generate as gen
 from collide2d.runner import lanes
+from collide2d.runner.scenario import generate as gen
 
 
 class Reseeded(Exception):

@@ -13,8 +13,8 @@ reference group is done (the runs are sent in order, so a group is done soon aft
 
 `write(folder, ...)` writes `results.csv` (the parameter columns, then `FIGURES`; `run_time_s`, the
 wall time, is the last column and the only one that changes between two sweeps), `results.md` (one
-table per scenario), both safe to open whatever a value holds (`runner.escape`: no text cell runs
-as a spreadsheet formula, no cell breaks its markdown row), `sweep.json` (runs asked, done,
+table per scenario), both safe to open whatever a value holds (`runner.output.escape`: no text cell
+runs as a spreadsheet formula, no cell breaks its markdown row), `sweep.json` (runs asked, done,
 complete or not) and, with the `plot` extra and position errors, `runtime_vs_error.png` (the
 benchmark's plot), row by row into `folder`: the sweep's staging folder, swapped in whole
 (`runner.sweep.folder`).
@@ -28,8 +28,8 @@ from pathlib import Path
 
 import numpy as np
 
-from collide2d.runner import escape
 from collide2d.runner.bench.error import mark_pareto, position_error
+from collide2d.runner.output import escape
 
 FIGURES = (
     "status",

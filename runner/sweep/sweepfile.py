@@ -20,9 +20,9 @@ from pathlib import Path
 
 import yaml
 
-from collide2d.runner import yamlsafe as ys
-from collide2d.runner.limits import Limits
-from collide2d.runner.nodes import Nodes
+from collide2d.runner.scenario import parse as ys
+from collide2d.runner.scenario.limits import Limits
+from collide2d.runner.scenario.nodes import Nodes
 from collide2d.runner.sweep.matrix import Axis, SweepError, check_key, parse_seeds
 
 FORMAT_VERSION = 1

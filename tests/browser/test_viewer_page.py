@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from collide2d.runner import cli
+from collide2d.runner.command import main as cli
 
 from .conftest import save_screenshot, shot
 

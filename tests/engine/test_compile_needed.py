@@ -17,7 +17,7 @@ from collide2d.engine import broadphase as bp
 from collide2d.engine.draw import shapes_marker
 from collide2d.engine.raster import Renderer
 from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON
-from collide2d.runner.scenario import loads
+from collide2d.runner.scenario.load import loads
 
 
 @njit
@@ -188,7 +188,7 @@ def test_the_sweep_compiles_no_other_pair_finder(tmp_path):
 
 SPRITES = LISTEN + """
 from collide2d.engine.sprites import sprites
-from collide2d.runner.scenario import loads
+from collide2d.runner.scenario.load import loads
 scene = loads(
     "version: 1\\nworld: {width: 40, height: 30}\\nticks: 1\\nobjects:\\n"
     "  - {shape: box, size: [3, 2], position: [2, 2]}\\n"

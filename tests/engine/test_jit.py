@@ -72,7 +72,7 @@ def test_an_interpreted_run_never_imports_numba(tmp_path):
     )
     code = (
         "import sys\n"
-        "from collide2d.runner.cli import main\n"
+        "from collide2d.runner.command.main import main\n"
         f"status = main(['run', {str(scenario)!r}, '--out', {str(tmp_path / 'out')!r}, "
         "'--quiet', '--jit', sys.argv[1]])\n"
         "print(status, 'numba' in sys.modules)\n"

@@ -11,7 +11,7 @@ from collide2d.engine import raster, threads
 from collide2d.engine.models import make
 from collide2d.engine.models.stepped import model as stepped_model
 from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies, Looks, WorldSpec
-from collide2d.runner.cli import main
+from collide2d.runner.command.main import main
 
 
 def dense_boxes(n, seed, world):

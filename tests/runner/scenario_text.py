@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from collide2d.runner.scenario import ScenarioError, loads
+from collide2d.runner.scenario.load import ScenarioError, loads
 
 DATA = Path(__file__).parent / "data"
 BASE = "version: 1\nworld: {width: 100, height: 80, fps: 10}\n"

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from scenario_text import BASE, check_refused, objects
 
-from collide2d.runner.scenario import loads
+from collide2d.runner.scenario.load import loads
 
 # ----------------------------------------------------------------------------- placement
 

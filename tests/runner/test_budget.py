@@ -15,10 +15,11 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from collide2d.runner import budget, outputs
-from collide2d.runner.cli import main
-from collide2d.runner.limits import Limits
-from collide2d.runner.scenario import load
+from collide2d.runner.command.main import main
+from collide2d.runner.output import budget
+from collide2d.runner.output import files as outputs
+from collide2d.runner.scenario.limits import Limits
+from collide2d.runner.scenario.load import load
 
 SCENE = """version: 1
 name: tiny

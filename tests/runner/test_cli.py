@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from interrupt import STARTED, interrupted
 
-from collide2d.runner.cli import demo_path, main
+from collide2d.runner.command.main import demo_path, main
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENARIOS = ROOT / "scenarios"
@@ -368,7 +368,7 @@ def test_a_ctrl_c_that_lands_in_a_finalizer_is_raised_just_after_it():
     import os
     import signal
 
-    from collide2d.runner import cli
+    from collide2d.runner.command import main as cli
 
     class Freed:
         def __del__(self):

@@ -1,5 +1,5 @@
-"""Tests of runner/config.py and `collide2d config`: the [tool.collide2d] table, its checks, and
-the precedence command line > scenario > table > defaults."""
+"""Tests of runner/command/settings.py and `collide2d config`: the [tool.collide2d] table, its
+checks, and the precedence command line > scenario > table > defaults."""
 
 from __future__ import annotations
 
@@ -7,10 +7,10 @@ from pathlib import Path
 
 import pytest
 
-from collide2d.runner import config
-from collide2d.runner.cli import main
-from collide2d.runner.limits import Limits
-from collide2d.runner.scenario import ScenarioError, loads
+from collide2d.runner.command import settings as config
+from collide2d.runner.command.main import main
+from collide2d.runner.scenario.limits import Limits
+from collide2d.runner.scenario.load import ScenarioError, loads
 
 SCENARIO = "version: 1\nticks: 3\nobjects:\n  - {shape: box, size: 4, position: [1, 1]}\n"
 
@@ -125,7 +125,7 @@ def test_the_tables_threads_are_put_in_force_unless_the_command_line_names_some(
     import argparse
 
     from collide2d.engine import jit, threads
-    from collide2d.runner.options import apply_threads
+    from collide2d.runner.command.options import apply_threads
 
     found = config.find(project(tmp_path, "[tool.collide2d]\nthreads = 1\n"))
     jit.numba_module()  # the count is put in force once numba is loaded: load it first

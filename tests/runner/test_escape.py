@@ -1,4 +1,4 @@
-"""No name can break a terminal, a spreadsheet or a markdown table (runner/escape.py and the
+"""No name can break a terminal, a spreadsheet or a markdown table (runner/output/escape.py and the
 outputs that use it): control characters and undecodable bytes reach a terminal spelled out, a
 text cell of final.csv, results.csv or bench.csv never starts a formula while numbers stay
 numbers, and a cell of results.md or bench.md stays one cell of one row."""
@@ -13,10 +13,11 @@ import re
 import numpy as np
 import pytest
 
-from collide2d.runner import cli, outputs
 from collide2d.runner.bench import report
-from collide2d.runner.escape import VisibleStream, visible_streams
-from collide2d.runner.progress import Progress
+from collide2d.runner.command import main as cli
+from collide2d.runner.command.progress import Progress
+from collide2d.runner.output import files as outputs
+from collide2d.runner.output.escape import VisibleStream, visible_streams
 from collide2d.runner.sweep import results
 
 SCENE = "version: 1\nworld: {width: 20, height: 20}\nticks: 2\nobjects: []\n"

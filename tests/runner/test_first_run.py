@@ -24,8 +24,9 @@ import pytest
 
 import collide2d
 from collide2d.engine import jit
-from collide2d.runner import compiling, progress
-from collide2d.runner.cli import compile_notice, main
+from collide2d.runner import compiling
+from collide2d.runner.command import progress
+from collide2d.runner.command.main import compile_notice, main
 
 ROOT = Path(__file__).resolve().parents[2]
 SMALL = """version: 1
@@ -109,11 +110,12 @@ def test_the_notice_is_one_line_on_stderr(capsys):
 def test_run_loads_only_the_modules_of_its_command(tmp_path):
     code = (
         "import sys, numpy\nby_numpy = set(sys.modules)\n"  # numpy < 2 imports numpy.ma itself
-        "from collide2d.runner.cli import main\n"
+        "from collide2d.runner.command.main import main\n"
         f"assert main(['run', {str(small(tmp_path))!r}, '--out', {str(tmp_path / 'o')!r},"
         " '--quiet']) == 0\n"
         "print(sorted(m for m in sys.modules if m.startswith(('collide2d.runner.golden', "
-        "'collide2d.runner.stress', 'collide2d.runner.bench', 'collide2d.runner.init', "
+        "'collide2d.runner.stress', 'collide2d.runner.bench', "
+        "'collide2d.runner.command.newproject', "
         "'collide2d.engine.models.exact', 'collide2d.engine.models.stepped'))"
         " or m in {'numpy.ma', 'importlib.metadata'} - by_numpy))\n"
     )  # a run of a paper scene loads neither of the other models, nor what only costs start-up
@@ -121,7 +123,7 @@ def test_run_loads_only_the_modules_of_its_command(tmp_path):
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.strip() == "[]"
     code = (
-        "import sys\nfrom collide2d.runner.cli import main\nmain(['config'])\n"
+        "import sys\nfrom collide2d.runner.command.main import main\nmain(['config'])\n"
         "print('numba' in sys.modules)"
     )
     proc = subprocess.run(

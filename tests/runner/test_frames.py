@@ -8,7 +8,7 @@ import tracemalloc
 from hypothesis import given
 from hypothesis import strategies as st
 
-from collide2d.runner.frames import FrameRule
+from collide2d.runner.scenario.frames import FrameRule
 
 
 def rules(ticks: int):

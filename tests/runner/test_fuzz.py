@@ -17,8 +17,8 @@ import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from collide2d.runner.cli import main
-from collide2d.runner.scenario import (
+from collide2d.runner.command.main import main
+from collide2d.runner.scenario.load import (
     BLOCK_KEYS,
     OBJECT_KEYS,
     OUTPUT_KEYS,
@@ -28,7 +28,7 @@ from collide2d.runner.scenario import (
     ScenarioError,
     loads,
 )
-from collide2d.runner.yamlsafe import OptionError
+from collide2d.runner.scenario.parse import OptionError
 
 ROOT = Path(__file__).resolve().parents[2]
 KNOWN_KEYS = sorted(set(TOP_KEYS + WORLD_KEYS + OBJECT_KEYS + BLOCK_KEYS + OUTPUT_KEYS))

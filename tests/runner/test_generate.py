@@ -14,7 +14,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from scenario_text import any_overlap
 
-from collide2d.runner import generate as gen
+from collide2d.runner.scenario import generate as gen
 
 EMPTY = np.zeros((0, 2))
 
@@ -308,7 +308,7 @@ def test_100k_boxes_at_5_percent_coverage_are_fast():
 
 SCRIPT = """
 import json, numpy as np
-from collide2d.runner import generate as gen
+from collide2d.runner.scenario import generate as gen
 fixed = np.array([[3.5, 4.0], [20.0, 20.0]]); fsize = np.array([[6.0, 6.0], [9.0, 2.0]])
 blocks = [gen.BlockSpec(40, (3, 2), 5, speed_range=(1.0, 4.0), whole=True),
           gen.BlockSpec(20, (2, 2), 6, speed=2.5)]

@@ -17,8 +17,8 @@ import imageio.v3 as iio
 import pytest
 from PIL import Image
 
-from collide2d.runner.cli import main
-from collide2d.runner.scenario import ScenarioError, load
+from collide2d.runner.command.main import main
+from collide2d.runner.scenario.load import ScenarioError, load
 
 ROOT = Path(__file__).resolve().parents[2]
 DATA = Path(__file__).parent / "data"

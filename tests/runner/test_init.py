@@ -1,6 +1,6 @@
-"""Tests of `collide2d init` (runner/init.py) and of a project made by it: plain `pytest` collects
-one golden test per scenario through the plugin, with no test file or conftest, and `check` and
-`bless` read the same [tool.collide2d] table."""
+"""Tests of `collide2d init` (runner/command/newproject.py) and of a project made by it: plain
+`pytest` collects one golden test per scenario through the plugin, with no test file or conftest,
+and `check` and `bless` read the same [tool.collide2d] table."""
 
 from __future__ import annotations
 
@@ -12,11 +12,11 @@ from pathlib import Path
 
 import pytest
 
-from collide2d.runner import config
-from collide2d.runner import init as init_module
-from collide2d.runner.cli import main
+from collide2d.runner.command import newproject as init_module
+from collide2d.runner.command import settings as config
+from collide2d.runner.command.main import main
 from collide2d.runner.golden.store import GoldenStore
-from collide2d.runner.scenario import load
+from collide2d.runner.scenario.load import load
 
 if sys.version_info >= (3, 11):
     import tomllib

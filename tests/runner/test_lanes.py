@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 from collide2d.runner import lanes
-from collide2d.runner.cli import main
+from collide2d.runner.command.main import main
 from collide2d.runner.run import simulate
-from collide2d.runner.scenario import loads
+from collide2d.runner.scenario.load import loads
 
 SMALL = """version: 1
 name: small

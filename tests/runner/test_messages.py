@@ -7,10 +7,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from collide2d.runner.cli import main
-from collide2d.runner.nodes import MAX_ERRORS
+from collide2d.runner.command.main import main
 from collide2d.runner.run import simulate
-from collide2d.runner.scenario import ScenarioError, loads
+from collide2d.runner.scenario.load import ScenarioError, loads
+from collide2d.runner.scenario.nodes import MAX_ERRORS
 
 FOUR_MISTAKES = """version: 1
 ticks: 10

@@ -29,11 +29,11 @@ from hypothesis import strategies as st
 from collide2d.engine.invariants import kinetic_energy, momentum
 from collide2d.engine.world import Bodies
 from collide2d.runner import run as run_module
-from collide2d.runner import yamlsafe
-from collide2d.runner.cli import main
-from collide2d.runner.limits import Limits
+from collide2d.runner.command.main import main
 from collide2d.runner.run import RunStopped, simulate
-from collide2d.runner.scenario import (
+from collide2d.runner.scenario import parse as yamlsafe
+from collide2d.runner.scenario.limits import Limits
+from collide2d.runner.scenario.load import (
     MAX_INTEGER,
     MAX_MASS,
     MAX_SEED,

@@ -8,8 +8,8 @@ from scenario_text import BASE, any_overlap, check_refused, objects
 
 from collide2d.engine import motion
 from collide2d.engine.world import KIND_CIRCLE
-from collide2d.runner.objects import polygon_problem
-from collide2d.runner.scenario import loads
+from collide2d.runner.scenario.load import loads
+from collide2d.runner.scenario.objects import polygon_problem
 
 # ----------------------------------------------------------------------------- paper model
 
@@ -255,8 +255,8 @@ def _names_in_each_lane(tmp_path, monkeypatch, written: str) -> dict:
     """{lane: the first object's name, or the refusal's message} for an object named `written`
     in a YAML list (general path), a long list (the fast lane, when the name is a plain word), a
     CSV table and a .npy table; a second object is named "other"."""
-    from collide2d.runner import yamlfast
-    from collide2d.runner.scenario import ScenarioError, load
+    from collide2d.runner.scenario import fastlane as yamlfast
+    from collide2d.runner.scenario.load import ScenarioError, load
 
     monkeypatch.setattr(yamlfast, "FAST_MIN_OBJECTS", 2)
     quoted = "'" + written.replace("'", "''") + "'"

@@ -1,4 +1,4 @@
-"""Tests for runner.outputs: atomic writes, PNG, GIF schedule and stream, events, CSV, JSON."""
+"""Tests for runner.output.files: atomic writes, PNG, GIF schedule and stream, events, CSV, JSON."""
 
 from __future__ import annotations
 
@@ -29,7 +29,7 @@ from collide2d.engine.events import (
     empty_events,
     format_event,
 )
-from collide2d.runner import outputs
+from collide2d.runner.output import files as outputs
 
 PALETTE = np.array(
     [[0, 0, 0], [255, 0, 0], [0, 255, 0], [1, 2, 3], [250, 128, 7]],
@@ -103,7 +103,7 @@ def test_killed_gif_writer_leaves_old_gif_whole(tmp_path):
     script = textwrap.dedent(
         f"""
         import os, signal, numpy as np
-        from collide2d.runner import outputs
+        from collide2d.runner.output import files as outputs
         pal = np.array({PALETTE.tolist()}, np.uint8)
         g = outputs.GifWriter({str(target)!r}, pal, 8, 6, 10, 50)
         for i in range(20):

@@ -1,6 +1,6 @@
-"""Tests of runner/overlay.py and the paper model's `advance_to_response`: overlays draw in their
-own colours where they say, the run underneath is unchanged, Figure 2's frames show the overlap
-xdiff wide and ydiff tall, and goldens see overlays only when the scenario asks."""
+"""Tests of runner/output/overlay.py and the paper model's `advance_to_response`: overlays draw in
+their own colours where they say, the run underneath is unchanged, Figure 2's frames show the
+overlap xdiff wide and ydiff tall, and goldens see overlays only when the scenario asks."""
 
 from __future__ import annotations
 
@@ -11,10 +11,10 @@ import pytest
 from PIL import Image
 
 from collide2d.engine import models
-from collide2d.runner import cli
-from collide2d.runner.overlay import COLORS, LABEL_MAX_PX, Overlay, Staged, labels
+from collide2d.runner.command import main as cli
+from collide2d.runner.output.overlay import COLORS, LABEL_MAX_PX, Overlay, Staged, labels
 from collide2d.runner.run import drive, simulate
-from collide2d.runner.scenario import ScenarioError, load, loads
+from collide2d.runner.scenario.load import ScenarioError, load, loads
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -90,8 +90,9 @@ def test_overlays_draw_in_their_colours_over_a_copy():
 
 
 def test_a_long_name_is_cut_with_an_ellipsis_instead_of_overflowing():
-    """Found by hardening: a 5,000-character name ran its label off the frame."""
-    long, short = "W" * 5000, "ab"
+    """Found by hardening: a long name (here the longest a name may be) ran its label off the
+    frame."""
+    long, short = "W" * 100, "ab"
     scn = loads(
         "version: 1\nworld: {width: 400, height: 40}\nticks: 1\nobjects:\n"
         f"  - {{shape: box, size: 2, position: [10, 30], name: {long}}}\n"

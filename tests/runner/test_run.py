@@ -13,7 +13,7 @@ import pytest
 
 from collide2d.engine.raster import Renderer
 from collide2d.runner.run import drive, simulate
-from collide2d.runner.scenario import load
+from collide2d.runner.scenario.load import load
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENARIOS = ROOT / "scenarios"

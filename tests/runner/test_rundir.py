@@ -17,8 +17,10 @@ from pathlib import Path
 
 import pytest
 
-from collide2d.runner import outputs, rundir, swapdir
-from collide2d.runner.cli import main
+from collide2d.runner.command.main import main
+from collide2d.runner.output import files as outputs
+from collide2d.runner.output import folder as rundir
+from collide2d.runner.output import swap as swapdir
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENE = """version: 1
@@ -76,7 +78,8 @@ def test_a_dead_writers_lock_is_taken_over(first):
         [
             sys.executable,
             "-c",
-            "import sys, time; from pathlib import Path; from runner import rundir\n"
+            "import sys, time; from pathlib import Path\n"
+            "from collide2d.runner.output import folder as rundir\n"
             "with rundir.RunLock(Path(sys.argv[1]), 'busy'):\n"
             "    print('held', flush=True); time.sleep(60)",
             str(out),

@@ -12,8 +12,8 @@ import pytest
 from scenario_text import BASE, DATA, at, check_refused, objects, refused
 
 from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON
-from collide2d.runner.limits import Limits
-from collide2d.runner.scenario import ScenarioError, load, loads
+from collide2d.runner.scenario.limits import Limits
+from collide2d.runner.scenario.load import ScenarioError, load, loads
 
 # ----------------------------------------------------------------------------- the error type
 

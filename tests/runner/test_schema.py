@@ -9,8 +9,8 @@ import pytest
 import yaml
 from scenario_text import BASE, DATA, objects
 
-from collide2d.runner.scenario import TOP_KEYS, ScenarioError, loads
-from collide2d.runner.schema import json_schema
+from collide2d.runner.scenario.load import TOP_KEYS, ScenarioError, loads
+from collide2d.runner.scenario.schema import json_schema
 
 # ----------------------------------------------------------------------------- JSON Schema
 

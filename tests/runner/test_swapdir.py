@@ -1,4 +1,5 @@
-"""Tests of runner/swapdir.py: temporary names, leftovers, the swap, recovery, no link followed."""
+"""Tests of runner/output/swap.py: temporary names, leftovers, the swap, recovery, no link
+followed."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ import sys
 
 import pytest
 
-from collide2d.runner import swapdir
+from collide2d.runner.output import swap as swapdir
 
 
 def _folder(path, text):

@@ -12,9 +12,9 @@ import tracemalloc
 import numpy as np
 import pytest
 
-from collide2d.runner.cli import main
-from collide2d.runner.limits import Limits
-from collide2d.runner.scenario import ScenarioError, load
+from collide2d.runner.command.main import main
+from collide2d.runner.scenario.limits import Limits
+from collide2d.runner.scenario.load import ScenarioError, load
 
 HEAD = """version: 1
 name: table

@@ -8,9 +8,9 @@ from pathlib import Path
 
 import pytest
 
-from collide2d.runner import validate
-from collide2d.runner.limits import Limits
-from collide2d.runner.schema import json_schema
+from collide2d.runner.command import validate
+from collide2d.runner.scenario.limits import Limits
+from collide2d.runner.scenario.schema import json_schema
 
 DATA = Path(__file__).parent / "data"
 GOOD = str(DATA / "spec_example.yaml")  # 4 listed + 50 generated objects, paper, 12 ticks

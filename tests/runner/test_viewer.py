@@ -1,6 +1,6 @@
-"""Tests of runner/viewer.py and engine/sprites.py: the viewer's data is the run's state, packed;
-its sprites paint what engine/raster.py draws; long runs are refused before they start; the file
-stays small."""
+"""Tests of runner/output/viewerdata.py and engine/sprites.py: the viewer's data is the run's state,
+packed; its sprites paint what engine/raster.py draws; long runs are refused before they start; the
+file stays small."""
 
 from __future__ import annotations
 
@@ -15,9 +15,10 @@ import pytest
 
 from collide2d.engine.raster import render, round_positions
 from collide2d.engine.sprites import paint, sprites
-from collide2d.runner import cli, viewer
+from collide2d.runner.command import main as cli
+from collide2d.runner.output import viewerdata as viewer
 from collide2d.runner.run import drive
-from collide2d.runner.scenario import ScenarioError, load, loads
+from collide2d.runner.scenario.load import ScenarioError, load, loads
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENARIOS = sorted(p.stem for p in (ROOT / "scenarios").glob("*.yaml"))
@@ -125,7 +126,7 @@ def test_no_name_can_end_or_comment_out_the_viewers_data(tmp_path):
     """Found by hardening: an object named `<!--<script>` kept the viewer from starting (the
     browser read the rest of the page as the data's script). The data holds no `<`, `>` or `&`
     as such, and reads back the very names."""
-    names = ["<!--<script>", "</script><script>alert(1)</script>", "a & b", "]]> -->", "</SCRIPT "]
+    names = ["<!--<script>", "</script><script>alert(1)</script>", "a & b", "]]> -->", "</SCRIPT/"]
     objects = "".join(
         f"  - {{shape: box, size: 2, position: [{4 * i}, 4], name: {json.dumps(name)}}}\n"
         for i, name in enumerate(names)

@@ -1,5 +1,5 @@
-"""The fast lane for long object lists (runner.yamlfast): the same Scenario as the general path,
-to the byte, for every file it takes; every file it declines or finds fault with is read, or
+"""The fast lane for long object lists (runner.scenario.fastlane): the same Scenario as the general
+path, to the byte, for every file it takes; every file it declines or finds fault with is read, or
 refused in the same words at the same place, by the general path."""
 
 from __future__ import annotations
@@ -9,10 +9,10 @@ import re
 import numpy as np
 import pytest
 
-from collide2d.runner import scenario as scenario_module
-from collide2d.runner import yamlfast
-from collide2d.runner.limits import Limits
-from collide2d.runner.scenario import ScenarioError, loads
+from collide2d.runner.scenario import fastlane as yamlfast
+from collide2d.runner.scenario import load as scenario_module
+from collide2d.runner.scenario.limits import Limits
+from collide2d.runner.scenario.load import ScenarioError, loads
 
 HEAD = """version: 1
 name: fast

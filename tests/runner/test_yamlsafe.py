@@ -8,9 +8,9 @@ import pytest
 import yaml
 from scenario_text import BASE, DATA, at, check_refused, objects, refused
 
-from collide2d.runner import yamlsafe as ys
-from collide2d.runner.limits import Limits
-from collide2d.runner.scenario import ScenarioError, load, loads
+from collide2d.runner.scenario import parse as ys
+from collide2d.runner.scenario.limits import Limits
+from collide2d.runner.scenario.load import ScenarioError, load, loads
 
 # ----------------------------------------------------------------------------- reading the file
 

@@ -9,7 +9,7 @@ import math
 import pytest
 
 from collide2d.runner.bench import peers
-from collide2d.runner.cli import main
+from collide2d.runner.command.main import main
 
 
 def rows_of(path):

@@ -9,7 +9,7 @@ import pytest
 from collide2d.engine import models
 from collide2d.runner.bench import error
 from collide2d.runner.bench.scenes import PROJECT_SCENARIOS
-from collide2d.runner.scenario import load, loads
+from collide2d.runner.scenario.load import load, loads
 
 
 def test_pareto_marks_the_rows_nothing_beats_on_both_counts():

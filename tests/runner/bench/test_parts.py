@@ -8,8 +8,8 @@ import numpy as np
 
 from collide2d.runner.bench import exact, paper, raster
 from collide2d.runner.bench.scenes import chain_scene
-from collide2d.runner.cli import main
-from collide2d.runner.scenario import loads
+from collide2d.runner.command.main import main
+from collide2d.runner.scenario.load import loads
 
 
 def quiet(_text):

@@ -7,7 +7,7 @@ import math
 import pytest
 
 from collide2d.runner.bench import peers, scenes
-from collide2d.runner.scenario import loads
+from collide2d.runner.scenario.load import loads
 
 
 def test_pymunk_steps_the_same_standard_scene():

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from collide2d.runner.bench import scenes
-from collide2d.runner.scenario import loads
+from collide2d.runner.scenario.load import loads
 
 
 @pytest.mark.parametrize("n", [50, 1_000, 10_000, 100_000])

@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 from collide2d.engine import threads
-from collide2d.runner import yamlfast
 from collide2d.runner.bench import load, peers, stages
-from collide2d.runner.scenario import load as load_scenario
+from collide2d.runner.scenario import fastlane as yamlfast
+from collide2d.runner.scenario.load import load as load_scenario
 
 
 def quiet(_text):

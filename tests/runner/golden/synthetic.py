@@ -14,7 +14,7 @@ and watches the check react, independent of the physics:
      "error": "MESSAGE"}                          (optional: the loader refuses the file)
 
 `load(path)` and `simulate(scenario, keep_frames=..., log_events=..., progress=...)` mimic
-`runner.scenario.load` and `runner.run.simulate`.
+`runner.scenario.load.load` and `runner.run.simulate`.
 """
 
 from __future__ import annotations
@@ -64,7 +64,7 @@ def load(path, *, overrides=None, limits=None):
     text = Path(path).read_text()
     data = json.loads(text)
     if "error" in data:
-        from collide2d.runner.scenario import ScenarioError
+        from collide2d.runner.scenario.load import ScenarioError
 
         raise ScenarioError(path, 1, 1, data["error"])
     g = data["golden"]

@@ -10,8 +10,8 @@ from pathlib import Path
 
 import pytest
 
-from collide2d.runner import outputs
 from collide2d.runner.golden import cli
+from collide2d.runner.output import files as outputs
 
 from . import synthetic
 
@@ -202,16 +202,14 @@ def test_check_keeps_checking_past_an_unreadable_scenario_and_files_it_as_one_ca
     bad = tree / "scenarios" / "bad.yaml"
     bad.write_bytes(data)
     if data == b"unreadable":
-        import builtins
-
-        real_open = builtins.open
+        real_open = os.open
 
         def refusing_open(file, *args, **kwargs):  # root reads any file: refuse as for a user
             if Path(file).name == "bad.yaml":
                 raise PermissionError(13, "Permission denied", str(file))
             return real_open(file, *args, **kwargs)
 
-        monkeypatch.setattr(builtins, "open", refusing_open)
+        monkeypatch.setattr(os, "open", refusing_open)
     capsys.readouterr()
     argv = ["check", "--junit", "out.xml", "--format", "json", "--report", "rep"]
     code = cli.main(argv, load=_real_or_synthetic, simulate=synthetic.simulate)

@@ -7,7 +7,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from collide2d.runner.cli import main
+from collide2d.runner.command.main import main
 from collide2d.runner.stress import cases
 from collide2d.runner.stress.scenes import scenes
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from collide2d.engine.models import MODEL_NAMES
-from collide2d.runner.generate import first_overlap
+from collide2d.runner.scenario.generate import first_overlap
 from collide2d.runner.stress.scenes import scenes
 
 

@@ -12,9 +12,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from collide2d.runner import rundir
-from collide2d.runner.cli import main
-from collide2d.runner.scenario import Scenario, ScenarioError, loads
+from collide2d.runner.command.main import main
+from collide2d.runner.output import folder as rundir
+from collide2d.runner.scenario.load import Scenario, ScenarioError, loads
 from collide2d.runner.sweep import cluster, driver
 from collide2d.runner.sweep.matrix import parse_set
 

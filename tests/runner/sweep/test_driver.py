@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from collide2d.runner.progress import Progress
+from collide2d.runner.command.progress import Progress
 from collide2d.runner.run import drive
 from collide2d.runner.sweep import driver, plan, results
 from collide2d.runner.sweep.driver import batch_size
@@ -120,7 +120,7 @@ def test_a_run_the_model_stops_is_a_row_with_its_message():
     runaway = expand([FIFTY], [parse_set("model=exact"), parse_set("ticks=5")], None)[0]
     figures, pos = run_one(runaway.scenario)
     assert figures["status"] == "ok" and pos.shape == (50, 2)
-    from collide2d.runner.scenario import loads
+    from collide2d.runner.scenario.load import loads
 
     jam = loads(
         "version: 1\nworld: {width: 20, height: 20, fps: 10}\n"

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from collide2d.runner.scenario import ScenarioError, load, loads
+from collide2d.runner.scenario.load import ScenarioError, load, loads
 from collide2d.runner.sweep import matrix
 from collide2d.runner.sweep.matrix import SweepError, parse_seeds, parse_set
 

@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from collide2d.runner.cli import main
-from collide2d.runner.scenario import ScenarioError
+from collide2d.runner.command.main import main
+from collide2d.runner.scenario.load import ScenarioError
 from collide2d.runner.sweep import sweepfile
 from collide2d.runner.sweep.cli import LOCAL_WORKERS_PER_CORE
 

@@ -1,8 +1,8 @@
 """The `config` command: print a project's effective settings and where each came from.
 
 `collide2d config [--root DIR] [--max-... N] [--max-events-per-tick N]` finds the project as every
-command does (`runner.config.find`, or `--root`), lays the command line's options over it, and
-prints one line per setting: name, value, source (`command line`, the `pyproject.toml
+command does (`runner.command.settings.find`, or `--root`), lays the command line's options over it,
+and prints one line per setting: name, value, source (`command line`, the `pyproject.toml
 [tool.collide2d]` table, or `default`). Model settings with no value in force are the scenario's
 own, else the model's default.
 """
@@ -11,11 +11,11 @@ from __future__ import annotations
 
 import argparse
 
-from collide2d.runner.exitcodes import EXIT_OK
+from collide2d.runner.command.exitcodes import EXIT_OK
 
 
 def register(subparsers) -> None:
-    from collide2d.runner.options import add_cap_argument, add_limit_arguments
+    from collide2d.runner.command.options import add_cap_argument, add_limit_arguments
 
     p = subparsers.add_parser(
         "config",
@@ -31,8 +31,8 @@ def register(subparsers) -> None:
 
 
 def run_config(args: argparse.Namespace) -> int:
-    from collide2d.runner import config
-    from collide2d.runner.limits import Limits
+    from collide2d.runner.command import settings as config
+    from collide2d.runner.scenario.limits import Limits
 
     project = config.at(args.root) if args.root else config.find()
     for key in Limits.__dataclass_fields__:

@@ -1,14 +1,14 @@
 """The `collide2d` command line (also `python -m collide2d`): parse, dispatch, map errors to exits.
 
-Each subcommand lives with what it drives (`run` here; `validate`/`schema` in runner.validate;
-`check`/`bless` in runner.golden.cli; `stress`, `bench` and `sweep` in runner.stress.cli,
-runner.bench.cli and runner.sweep.cli; `init` in runner.init, `config` in runner.configcli) and
-registers itself on the parser. A command line imports only the module of its command
-(`REGISTRARS`), so a run starts without loading the golden, stress, bench or sweep code; `--help`
-and an unknown command load them all.
-Exit status: 0 fine, 1 a check found a difference, 2 bad input or usage, 3 an unexpected error (one
-line naming the scenario; the traceback too with `--debug`). A refused scenario prints
-`FILE:LINE:COL: error: MESSAGE` on stderr and writes nothing.
+Each subcommand lives with what it drives (`run` here; `validate`/`schema` in
+runner.command.validate; `check`/`bless` in runner.golden.cli; `stress`, `bench` and `sweep` in
+runner.stress.cli, runner.bench.cli and runner.sweep.cli; `init` in runner.command.newproject,
+`config` in runner.command.showconfig) and registers itself on the parser. A command line imports
+only the module of its command (`REGISTRARS`), so a run starts without loading the golden, stress,
+bench or sweep code; `--help` and an unknown command load them all. Exit status: 0 fine, 1 a check
+found a difference, 2 bad input or usage, 3 an unexpected error (one line naming the scenario; the
+traceback too with `--debug`). A refused scenario prints `FILE:LINE:COL: error: MESSAGE` on stderr
+and writes nothing.
 """
 
 from __future__ import annotations
@@ -22,24 +22,24 @@ import threading
 import traceback
 from importlib import resources
 
-from collide2d.runner import escape
-from collide2d.runner.exitcodes import (
+from collide2d.runner.command.exitcodes import (
     EXIT_BAD_INPUT,
     EXIT_INTERRUPTED,
     EXIT_OK,
     EXIT_UNEXPECTED,
 )
+from collide2d.runner.output import escape
 
 # (module, its function that adds subcommands, the commands it adds), in `--help` order.
 REGISTRARS = (
-    ("collide2d.runner.cli", "register_run", ("run",)),
+    ("collide2d.runner.command.main", "register_run", ("run",)),
     ("collide2d.runner.golden.cli", "register", ("check", "bless")),
-    ("collide2d.runner.validate", "register", ("validate", "schema")),
+    ("collide2d.runner.command.validate", "register", ("validate", "schema")),
     ("collide2d.runner.stress.cli", "register", ("stress",)),
     ("collide2d.runner.bench.cli", "register", ("bench",)),
     ("collide2d.runner.sweep.cli", "register", ("sweep",)),
-    ("collide2d.runner.init", "register", ("init",)),
-    ("collide2d.runner.configcli", "register", ("config",)),
+    ("collide2d.runner.command.newproject", "register", ("init",)),
+    ("collide2d.runner.command.showconfig", "register", ("config",)),
 )
 
 
@@ -49,7 +49,7 @@ def demo_path() -> str:
 
 
 def register_run(subparsers) -> None:
-    from collide2d.runner.options import (
+    from collide2d.runner.command.options import (
         add_cap_argument,
         add_jit_argument,
         add_limit_arguments,
@@ -57,7 +57,7 @@ def register_run(subparsers) -> None:
         add_threads_argument,
         positive_int,
     )
-    from collide2d.runner.outputspec import OVERLAY_NAMES
+    from collide2d.runner.scenario.sections import OVERLAY_NAMES
 
     p = subparsers.add_parser(
         "run",
@@ -123,7 +123,7 @@ def register_run(subparsers) -> None:
 
 def overlay_names(text: str) -> tuple[str, ...]:
     """`--overlay a,b`: the overlay names in their fixed order; `none` for none."""
-    from collide2d.runner.outputspec import OVERLAY_NAMES
+    from collide2d.runner.scenario.sections import OVERLAY_NAMES
 
     names = [n.strip() for n in text.split(",") if n.strip()]
     if names == ["none"]:
@@ -138,19 +138,20 @@ def overlay_names(text: str) -> tuple[str, ...]:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    from collide2d.runner import config
-    from collide2d.runner.options import (
+    from collide2d.runner.command import settings as config
+    from collide2d.runner.command.options import (
         apply_jit,
         apply_threads,
         limits_from_args,
         overrides_from_args,
     )
     from collide2d.runner.run import RunOptions, run_to_dir
-    from collide2d.runner.scenario import load
+    from collide2d.runner.scenario.load import load
 
     project = config.find()
     if args.out and (project.file or project.scenarios.is_dir()):
-        try:  # a folder of its own, apart from the project's other folders (runner.config)
+        # a folder of its own, apart from the project's other folders (runner.command.settings)
+        try:
             project.apart("out", args.out, "--out")
         except config.FolderClash as exc:
             print(f"collide2d: error: {exc}", file=sys.stderr)
@@ -278,7 +279,7 @@ def main(argv: list[str] | None = None) -> int:
 
 def _answered(args: argparse.Namespace) -> int:
     """Run the command; its errors are printed and become its exit status."""
-    from collide2d.runner.yamlsafe import ScenarioError
+    from collide2d.runner.scenario.parse import ScenarioError
 
     try:
         with _ctrl_c_answered():

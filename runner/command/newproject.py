@@ -7,15 +7,15 @@ is left alone), and an `out/` line in `.gitignore`, then prints the next three c
 is overwritten: each step says whether it created, extended or kept its file.
 
 A pyproject.toml is read as TOML readers read it (its bytes as UTF-8, line ends untouched) and is
-extended only when the result says exactly what the file said plus the table, in the file's own
-line ends. What cannot be extended so is refused (`FILE:LINE:COL: error: ...`, exit 2): a file
-that is not valid TOML, one with a byte order mark, UTF-16 or not UTF-8, and a `tool` that is an
-inline table, an array of tables or a value. Refused too (`FILE: error: ...`): a file reached
-through a symbolic link (of the file or of a folder on its way) that leads outside the project
-folder (one that stays inside is written at the link's target, the link kept), and a folder, FIFO
-or device in place of a file (never opened). Every refusal comes before anything is written, and
-the files are written all or nothing (`runner.filebatch`): when one cannot be written (a full
-disk), none is changed and the error names it (exit 2).
+extended only when the result says exactly what the file said plus the table, in the file's own line
+ends. What cannot be extended so is refused (`FILE:LINE:COL: error: ...`, exit 2): a file that is
+not valid TOML, one with a byte order mark, UTF-16 or not UTF-8, and a `tool` that is an inline
+table, an array of tables or a value. Refused too (`FILE: error: ...`): a file reached through a
+symbolic link (of the file or of a folder on its way) that leads outside the project folder (one
+that stays inside is written at the link's target, the link kept), and a folder, FIFO or device in
+place of a file (never opened). Every refusal comes before anything is written, and the files are
+written all or nothing (`runner.command.filebatch`): when one cannot be written (a full disk), none
+is changed and the error names it (exit 2).
 """
 
 from __future__ import annotations
@@ -28,9 +28,9 @@ import stat
 from importlib import resources
 from pathlib import Path
 
-from collide2d.runner.exitcodes import EXIT_OK
-from collide2d.runner.filebatch import FileBatch
-from collide2d.runner.yamlsafe import OptionError
+from collide2d.runner.command.exitcodes import EXIT_OK
+from collide2d.runner.command.filebatch import FileBatch
+from collide2d.runner.scenario.parse import OptionError
 
 EXAMPLE = "example.yaml"
 
@@ -90,7 +90,7 @@ def run_init(args: argparse.Namespace) -> int:
 def init(root: Path) -> list[str]:
     """Make `root` a project; returns one line per file: what was done to it. Every file is read
     and every refusal made before anything is written, and the writes are all or nothing."""
-    from collide2d.runner import config
+    from collide2d.runner.command import settings as config
 
     project = root.resolve()
     batch = FileBatch()
@@ -157,7 +157,7 @@ def _target(path: Path, project: Path) -> Path:
 def _toml_text(pyproject: Path, data: bytes) -> str:
     """The text of a pyproject.toml as TOML readers see it (UTF-8, no newline translation); a
     ConfigError for an encoding they refuse, which init does not edit either."""
-    from collide2d.runner.config import ConfigError
+    from collide2d.runner.command.settings import ConfigError
 
     def refuse(why: str, line: int = 1, col: int = 1):
         return ConfigError(str(pyproject), line, col, f"{why}; init changes nothing in it")
@@ -182,7 +182,7 @@ def _with_table(pyproject: Path, text: str, data: dict) -> str:
     """`text` with TABLE_TEXT appended, in the file's line ends; a ConfigError when that would
     not say what `text` said plus the table (a `tool` that is an inline table, an array of tables
     or a value: TOML lets no `[tool.collide2d]` section extend those)."""
-    from collide2d.runner.config import ConfigError, parse
+    from collide2d.runner.command.settings import ConfigError, parse
 
     newline = "\r\n" if text.split("\n", 1)[0].endswith("\r") else "\n"
     sep = "" if not text or text.endswith("\n") else newline

@@ -20,8 +20,8 @@ lane reads it instead. A block-style item is first written as the one flow mappi
 (`_block_items`) when it has the simplest block form: its keys at one indent, each value plain on
 its key's line, or an [x, y] pair as two `- number` lines. Then the values of each key are taken
 from the lines (when every line has the first line's keys, in its order, with values of the same
-forms, by one pattern over the whole list, its groups the columns; else line by line), converted
-and checked a column at a time with numpy, and handed on as a `runner.table.Table`; the rest of
+forms, by one pattern over the whole list, its groups the columns; else line by line), converted and
+checked a column at a time with numpy, and handed on as a `runner.scenario.table.Table`; the rest of
 the file, with the list's lines blanked (so every line keeps its number), goes through the general
 path as before.
 
@@ -34,7 +34,7 @@ flow mappings, quoted or tagged values, anchors and aliases, comments or blank l
 list, polygons, numbers with leading zeros (YAML 1.1 octal), exponents, underscores, or other YAML
 1.1 forms, words YAML reads as booleans or null where a text is asked for, two objects of one name,
 and lists shorter than FAST_MIN_OBJECTS. Names pass the one rule for object names
-(`runner.objects.object_names`) as the general path's do.
+(`runner.scenario.objects.object_names`) as the general path's do.
 """
 
 from __future__ import annotations
@@ -48,8 +48,8 @@ import numpy as np
 
 from collide2d.engine import motion
 from collide2d.engine.world import KIND_BOX, KIND_CIRCLE
-from collide2d.runner import colors
-from collide2d.runner import generate as gen
+from collide2d.runner.scenario import colors
+from collide2d.runner.scenario import generate as gen
 
 FAST_MIN_OBJECTS = 1000  # shorter lists take the general path (it is fast enough there)
 
@@ -331,9 +331,9 @@ def _number(values: list[str]) -> np.ndarray:
 
 
 def table(split_: Split, world, paper: bool, max_objects: int):
-    """The objects of the list as a runner.table.Table, every check of the general path run by
-    column; FallBack when anything would make the general path refuse or read it otherwise."""
-    from collide2d.runner.objects import (
+    """The objects of the list as a runner.scenario.table.Table, every check of the general path run
+    by column; FallBack when anything would make the general path refuse or read it otherwise."""
+    from collide2d.runner.scenario.objects import (
         DEFAULT_COLOR,
         DEFAULT_MASS,
         MAX_MASS,
@@ -342,7 +342,7 @@ def table(split_: Split, world, paper: bool, max_objects: int):
         NameRefused,
         object_names,
     )
-    from collide2d.runner.table import Table
+    from collide2d.runner.scenario.table import Table
 
     n = split_.n
     if n > max_objects:
@@ -450,7 +450,7 @@ def table(split_: Split, world, paper: bool, max_objects: int):
             raise FallBack
     except NameRefused:
         raise FallBack from None
-    # inside the world and apart, as runner.assemble checks listed objects
+    # inside the world and apart, as runner.scenario.assemble checks listed objects
     if np.any((pos < 0) | (pos + size > np.array([world.width, world.height]))):
         raise FallBack
     if not np.all(np.isfinite(pos)) or gen.first_overlap(pos, size) is not None:

@@ -6,7 +6,7 @@ over) and writes every file into a fresh sibling folder `OUT/.NAME.PID.XXXXXXXX.
 all of it is written does the staging folder take the place of `OUT/NAME`: in one atomic exchange
 of the two names where the system offers one (Linux `renameat2`), else by moving the old folder
 aside and the new one in, a step that the next run under the lock finishes if it was cut between
-the two renames (the names, the swap and that recovery are `runner.swapdir`'s). So `OUT/NAME`
+the two renames (the names, the swap and that recovery are `runner.output.swap`'s). So `OUT/NAME`
 always holds one complete run, the old or the new. On any failure the staging folder is removed
 and the old run stays as it was.
 
@@ -23,7 +23,7 @@ import re
 import stat
 from pathlib import Path
 
-from collide2d.runner import swapdir
+from collide2d.runner.output import swap as swapdir
 
 try:
     import fcntl

@@ -1,9 +1,9 @@
 """The `output` and `golden` sections: the frames a run keeps, what it writes, how goldens compare.
 
 A `frames` entry is `all`, `none`, `last`, a list of frame numbers or `{every: k}`; its count is
-checked against `Limits.max_frames` by arithmetic (`runner.frames.FrameRule`), so nothing sized by
-`ticks` is built. A listed frame past the last one is refused, unless `--ticks` shortened the run,
-where it is dropped. Goldens default to frames 0, ticks // 2 and ticks.
+checked against `Limits.max_frames` by arithmetic (`runner.scenario.frames.FrameRule`), so nothing
+sized by `ticks` is built. A listed frame past the last one is refused, unless `--ticks` shortened
+the run, where it is dropped. Goldens default to frames 0, ticks // 2 and ticks.
 """
 
 from __future__ import annotations
@@ -13,15 +13,15 @@ from dataclasses import dataclass
 
 import yaml
 
-from collide2d.runner import yamlsafe as ys
-from collide2d.runner.frames import FrameRule
-from collide2d.runner.limits import Limits
-from collide2d.runner.nodes import Nodes
+from collide2d.runner.scenario import parse as ys
+from collide2d.runner.scenario.frames import FrameRule
+from collide2d.runner.scenario.limits import Limits
+from collide2d.runner.scenario.nodes import Nodes
 
 FRAME_WORDS = ("all", "none", "last")
 EVERY_KEYS = ("every",)
 OUTPUT_KEYS = ("frames", "gif", "events", "viewer", "overlay")
-# Debug overlays a scenario may ask to draw into its frames (runner.overlay draws them).
+# Debug overlays a scenario may ask to draw into its frames (runner.output.overlay draws them).
 OVERLAY_NAMES = ("velocity", "boxes", "contacts", "labels", "overlap")
 GOLDEN_KEYS = ("frames", "time_tolerance", "max_diff_pixels", "color_threshold")
 
@@ -34,8 +34,9 @@ class Output:
     )
     gif: bool
     events: bool
-    viewer: bool = False  # viewer.html beside the GIF (runner.viewer)
-    overlay: tuple[str, ...] = ()  # overlays drawn into every frame, goldens too (runner.overlay)
+    viewer: bool = False  # viewer.html beside the GIF (runner.output.viewerdata)
+    # overlays drawn into every frame, goldens too (runner.output.overlay)
+    overlay: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)

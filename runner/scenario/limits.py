@@ -1,9 +1,9 @@
 """The bounds on what a scenario may ask for (SPEC section 8), each one a command-line option.
 
-`Limits` is read by the safe YAML reader (`runner.yamlsafe`: file size, YAML values, aliases), by
-the scenario readers (objects, ticks, world sides, frames) and by the run (`runner.budget`: output
-bytes, frame memory; `runner.run`: the event log's share of the output bytes). It depends on
-nothing, so any module may import it.
+`Limits` is read by the safe YAML reader (`runner.scenario.parse`: file size, YAML values, aliases),
+by the scenario readers (objects, ticks, world sides, frames) and by the run
+(`runner.output.budget`: output bytes, frame memory; `runner.run`: the event log's share of the
+output bytes). It depends on nothing, so any module may import it.
 """
 
 from __future__ import annotations

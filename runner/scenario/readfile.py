@@ -13,7 +13,7 @@ from __future__ import annotations
 import os
 import stat
 
-from collide2d.runner.yamlsafe import ScenarioError
+from collide2d.runner.scenario.parse import ScenarioError
 
 READ_CHUNK_BYTES = 2**20  # a file is read in pieces of this many bytes
 _O_NONBLOCK = getattr(os, "O_NONBLOCK", 0)

@@ -28,7 +28,8 @@ import numpy as np
 from PIL import GifImagePlugin, Image
 
 from collide2d.engine.events import event_dict, format_event, format_number
-from collide2d.runner import escape, swapdir
+from collide2d.runner.output import escape
+from collide2d.runner.output import swap as swapdir
 
 # zlib level of every PNG (0-9): fixed so that the same pixels give the same bytes.
 PNG_COMPRESS_LEVEL = 6

@@ -2,21 +2,21 @@
 
 `ObjectReader` reads every object field at its place (shape and its size key, position, velocity or
 speed, colour, mass, static, fill, name) and returns `Listed` objects and `Block`s, from which
-`runner.assemble` builds the arrays. What differs between models is one `ModelRules` value instead
-of a flag threaded through each reader: under the paper model positions are whole pixels, every
-velocity component of a moving object is a rate the model can take at the world's fps
+`runner.scenario.assemble` builds the arrays. What differs between models is one `ModelRules` value
+instead of a flag threaded through each reader: under the paper model positions are whole pixels,
+every velocity component of a moving object is a rate the model can take at the world's fps
 (`engine.motion.paper_rate`) and generated velocities are drawn as whole numbers; under geometry
 `exact` a polygon must be convex with some area (`polygon_problem`).
 
 Masses lie in [MIN_MASS, MAX_MASS] and velocity components in [-MAX_SPEED, MAX_SPEED] (see the
-"Numbers" paragraph of `runner.scenario`); polygon points lie within MAX_POINT_OFFSET px of the
+"Numbers" paragraph of `runner.scenario.load`); polygon points lie within MAX_POINT_OFFSET px of the
 object's position.
 
-An object's name follows one rule wherever it is written (a list here, a table in `runner.table`,
-the fast lane in `runner.yamlfast`, a generate block's `name`): `object_names`. Surrounding
-whitespace is not part of it, a name left empty is no name, and a name holds at most
-MAX_OBJECT_NAME_CHARS characters of text; that no two objects share one is checked once all are
-known (`runner.assemble.check_names`).
+An object's name follows one rule wherever it is written (a list here, a table in
+`runner.scenario.table`, the fast lane in `runner.scenario.fastlane`, a generate block's `name`):
+`object_names`. Surrounding whitespace is not part of it, a name left empty is no name, and a name
+holds at most MAX_OBJECT_NAME_CHARS characters of text; that no two objects share one is checked
+once all are known (`runner.scenario.assemble.check_names`).
 """
 
 from __future__ import annotations
@@ -29,10 +29,10 @@ import yaml
 
 from collide2d.engine import motion
 from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, WorldSpec
-from collide2d.runner import generate as gen
-from collide2d.runner import yamlsafe as ys
-from collide2d.runner.limits import Limits
-from collide2d.runner.nodes import Nodes, fmt
+from collide2d.runner.scenario import generate as gen
+from collide2d.runner.scenario import parse as ys
+from collide2d.runner.scenario.limits import Limits
+from collide2d.runner.scenario.nodes import Nodes, fmt
 
 DEFAULT_COLOR = (255, 255, 255)
 DEFAULT_MASS = 1.0  # mass units
@@ -284,7 +284,7 @@ class ObjectReader(Nodes):
         if "objects" not in top:
             return []
         node = top["objects"][1]
-        if isinstance(node, yaml.MappingNode):  # a table of objects (runner.table)
+        if isinstance(node, yaml.MappingNode):  # a table of objects (runner.scenario.table)
             return []
         items = self.seq(node, "objects")
         if len(items) > self.limits.max_objects:

@@ -1,18 +1,18 @@
 """A few files written all or nothing (`collide2d init`): every file whole, or none changed.
 
 `FileBatch.add(target, data, old)` stages the new bytes of a file (`old`: its current bytes, None
-for a file to create); `commit()` writes them. Each file is written whole under a temporary name
-in its target's folder (`.NAME.PID.HEX.tmp`, as `runner.outputs` names its temporaries), with the
+for a file to create); `commit()` writes them. Each file is written whole under a temporary name in
+its target's folder (`.NAME.PID.HEX.tmp`, as `runner.output.files` names its temporaries), with the
 permission bits of the file it replaces; only once every one is written are they renamed over their
 targets, one by one. When a write fails (a full disk, a refused permission) every temporary is
 removed and no target has changed; when a rename fails (rare: each temporary already sits beside its
 target), the targets renamed before it get their old bytes back the same way, and a file created is
 removed. Folders made for the files are removed again when the batch fails, if still empty. The
-OSError is then raised, naming the file. (Nothing is flushed to disk: like every output, this
-guards against a failed write or a killed process, not against a power cut.)
+OSError is then raised, naming the file. (Nothing is flushed to disk: like every output, this guards
+against a failed write or a killed process, not against a power cut.)
 
 Targets are paths as they are written: a caller that must not write through a symbolic link
-resolves and checks them first (`runner.init` does).
+resolves and checks them first (`runner.command.newproject` does).
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ import stat
 from dataclasses import dataclass
 from pathlib import Path
 
-from collide2d.runner.swapdir import temp_name
+from collide2d.runner.output.swap import temp_name
 
 
 @dataclass

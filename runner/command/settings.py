@@ -22,7 +22,7 @@ Precedence: the command line, then the scenario file, then this table, then the 
 relative to the project folder and must stay inside it; the four are apart: none is the project
 folder, another's folder, or inside another (`Config.apart` holds a folder named on the command
 line, as `check --report DIR`, to the same rule). Model settings have the bounds a scenario file's
-`model` has (runner.scenario). Read with `tomllib` (Python 3.11+) or `tomli` (3.10).
+`model` has (runner.scenario.load). Read with `tomllib` (Python 3.11+) or `tomli` (3.10).
 """
 
 from __future__ import annotations
@@ -34,8 +34,8 @@ import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from collide2d.runner.limits import Limits
-from collide2d.runner.yamlsafe import ScenarioError
+from collide2d.runner.scenario.limits import Limits
+from collide2d.runner.scenario.parse import ScenarioError
 
 PYPROJECT = "pyproject.toml"
 TABLE = "tool.collide2d"
@@ -288,9 +288,9 @@ def _config(root: Path, pyproject: Path | None, table: dict) -> Config:
 
 
 def _model_bounds() -> dict:
-    """The whole-number model settings and their (lowest, highest): runner.scenario's, read when a
-    table sets one (the scenario reader is not loaded for a project that sets none)."""
-    from collide2d.runner.scenario import MODEL_BOUNDS
+    """The whole-number model settings and their (lowest, highest): runner.scenario.load's, read
+    when a table sets one (the scenario reader is not loaded for a project that sets none)."""
+    from collide2d.runner.scenario.load import MODEL_BOUNDS
 
     return MODEL_BOUNDS
 

@@ -15,9 +15,9 @@ linear time); every other long plain scalar is text, and YAML's number patterns 
 it (see `_composing`). So every number is read at a cost linear in its text, and every integer a
 scenario holds is below 16**98 (about 1e118), far inside float64's range. Then `yaml.compose` with
 the safe loader (libyaml's when available) builds the node tree that the scenario readers walk by
-hand (`runner.nodes`, typed and located, under `runner.scenario`). `value` and `describe` read
-scalar nodes for them; a plain scalar YAML takes for an integer but that makes none (`0x_`: its
-digits are all underscores) is read as its text.
+hand (`runner.scenario.nodes`, typed and located, under `runner.scenario.load`). `value` and
+`describe` read scalar nodes for them; a plain scalar YAML takes for an integer but that makes none
+(`0x_`: its digits are all underscores) is read as its text.
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ import re
 
 import yaml
 
-from collide2d.runner.limits import Limits
+from collide2d.runner.scenario.limits import Limits
 
 MAX_YAML_DEPTH = 64  # nesting levels of YAML collections
 MAX_SHOWN_CHARS = 40  # characters of a text quoted in a message
@@ -106,9 +106,11 @@ class ScenarioErrors(ScenarioError):
 
 def read_file(path, limits: Limits) -> tuple[str, str]:
     """(text, SHA-256 of the bytes) of the file at `path`: a regular file of at most
-    `limits.max_file_bytes` (runner.readfile); a located ScenarioError when it cannot be read or
-    is not UTF-8."""
-    from collide2d.runner.readfile import read_regular  # it raises this module's ScenarioError
+    `limits.max_file_bytes` (runner.scenario.readfile); a located ScenarioError when it cannot be
+    read or is not UTF-8."""
+    from collide2d.runner.scenario.readfile import (
+        read_regular,  # it raises this module's ScenarioError
+    )
 
     shown = os.fspath(path)
     data = read_regular(path, limits.max_file_bytes, shown)

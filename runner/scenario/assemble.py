@@ -1,11 +1,11 @@
 """Objects to arrays: the checked objects and blocks of a scenario become `Bodies` and a palette.
 
-Listed objects are checked first (each inside the world, no two overlapping; touching is fine;
-under `geometry: exact` overlap is judged by the real shapes, so circles racked tightly in touching
-boxes are legal), then
-each generate block is drawn by `runner.generate` around them; the per-object arrays hold the listed
-objects first, then each block's objects, in id order. Colours are indexed into a palette of at most
-PALETTE_SIZE rows: row 0 the background, then each distinct object colour in order of first use.
+Listed objects are checked first (each inside the world, no two overlapping; touching is fine; under
+`geometry: exact` overlap is judged by the real shapes, so circles racked tightly in touching boxes
+are legal), then each generate block is drawn by `runner.scenario.generate` around them; the
+per-object arrays hold the listed objects first, then each block's objects, in id order. Colours are
+indexed into a palette of at most PALETTE_SIZE rows: row 0 the background, then each distinct object
+colour in order of first use.
 """
 
 from __future__ import annotations
@@ -15,11 +15,11 @@ from types import SimpleNamespace
 import numpy as np
 
 from collide2d.engine.world import Bodies, Looks, WorldSpec
-from collide2d.runner import generate as gen
 from collide2d.runner import lanes
-from collide2d.runner.nodes import Nodes, fmt
-from collide2d.runner.objects import Block, Listed
-from collide2d.runner.yamlsafe import ScenarioError
+from collide2d.runner.scenario import generate as gen
+from collide2d.runner.scenario.nodes import Nodes, fmt
+from collide2d.runner.scenario.objects import Block, Listed
+from collide2d.runner.scenario.parse import ScenarioError
 
 PALETTE_SIZE = 256  # palette rows: the background and up to 255 object colours
 
@@ -34,7 +34,7 @@ def bodies(
     table=None,
 ):
     """(Bodies, names, lines, palette) of the listed objects, or the rows of a `table`
-    (runner.table, checked already but for overlaps), then the generate blocks; starting
+    (runner.scenario.table, checked already but for overlaps), then the generate blocks; starting
     overlap judged by the real shapes under `geometry` exact."""
     if table is not None:
         listed = _TableRows(table, reader)

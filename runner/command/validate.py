@@ -14,21 +14,21 @@ import argparse
 import json
 import sys
 
-from collide2d.runner.exitcodes import EXIT_BAD_INPUT, EXIT_OK
-from collide2d.runner.options import (
+from collide2d.runner.command.exitcodes import EXIT_BAD_INPUT, EXIT_OK
+from collide2d.runner.command.options import (
     add_limit_arguments,
     add_override_arguments,
     limits_from_args,
     overrides_from_args,
 )
-from collide2d.runner.scenario import ScenarioError, load
-from collide2d.runner.schema import json_schema
+from collide2d.runner.scenario.load import ScenarioError, load
+from collide2d.runner.scenario.schema import json_schema
 
 
 def run_validate(args: argparse.Namespace) -> int:
     """Check every file of args.scenarios; print one line per file; 2 if any is bad, else 0."""
-    from collide2d.runner import config
-    from collide2d.runner.cli import plural
+    from collide2d.runner.command import settings as config
+    from collide2d.runner.command.main import plural
 
     project = config.find()
     limits = limits_from_args(args, project)

@@ -1,17 +1,16 @@
 """The JSON Schema (draft 2020-12) of the scenario format, for editors and `collide2d schema`.
 
 It states the shape of a file — keys, types, ranges that never change — from the same constants the
-loader (`runner.scenario`) checks against, so the two cannot drift apart. What a schema cannot say
-(limits, objects inside the world and apart, paper velocities, frames up to `ticks`, convex
+loader (`runner.scenario.load`) checks against, so the two cannot drift apart. What a schema cannot
+say (limits, objects inside the world and apart, paper velocities, frames up to `ticks`, convex
 polygons) only the loader checks.
 """
 
 from __future__ import annotations
 
 from collide2d.engine.models import MODEL_NAMES
-from collide2d.runner import colors
-from collide2d.runner.outputspec import OVERLAY_NAMES
-from collide2d.runner.scenario import (
+from collide2d.runner.scenario import colors
+from collide2d.runner.scenario.load import (
     BLOCK_SHAPES,
     DEFAULT_DURATION,
     DEFAULT_FPS,
@@ -33,6 +32,7 @@ from collide2d.runner.scenario import (
     NAME_PATTERN,
     SHAPES,
 )
+from collide2d.runner.scenario.sections import OVERLAY_NAMES
 
 
 def json_schema() -> dict:

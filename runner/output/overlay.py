@@ -10,7 +10,7 @@ names (`OVERLAYS`):
 - `boxes`: each object's pixel extent, outlined;
 - `contacts`: a ring around each object of a wall or pair event at the frame's tick;
 - `labels`: each object's name above it (Pillow's default font, without smoothing), on one line
-  (control characters spelled out, `runner.escape.one_line`) and at most LABEL_MAX_PX wide: a
+  (control characters spelled out, `runner.output.escape.one_line`) and at most LABEL_MAX_PX wide: a
   longer name is cut and ends in an ellipsis;
 - `overlap` (`paper` only; other models draw nothing for it): for each pair event at the frame's
   tick, both boxes where the pair rule saw them (`engine.models.paper.Model.advance_to_response`:
@@ -35,9 +35,9 @@ from collide2d.engine.draw import dda_line, midpoint_circle
 from collide2d.engine.events import EV_PAIR, EV_WALL
 from collide2d.engine.raster import round_positions
 from collide2d.engine.sprites import sprites
-from collide2d.runner import escape
-from collide2d.runner.outputspec import OVERLAY_NAMES
-from collide2d.runner.scenario import ScenarioError
+from collide2d.runner.output import escape
+from collide2d.runner.scenario.load import ScenarioError
+from collide2d.runner.scenario.sections import OVERLAY_NAMES
 
 OVERLAYS = OVERLAY_NAMES
 # Colours (RGB) of the overlays, added after the scenario's palette in this order.

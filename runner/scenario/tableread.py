@@ -1,21 +1,21 @@
-"""A table's bytes to one structured array: the CSV and `.npy` readers of `runner.table`.
+"""A table's bytes to one structured array: the CSV and `.npy` readers of `runner.scenario.table`.
 
-Both take the file's bytes, read once (`runner.readfile`), and give a numpy structured array whose
-field names are the columns, with a `Place` that turns (row, column) into the cell's place for a
-message. Nothing is parsed before the header has been checked and the row count held against
-`--max-objects`.
+Both take the file's bytes, read once (`runner.scenario.readfile`), and give a numpy structured
+array whose field names are the columns, with a `Place` that turns (row, column) into the cell's
+place for a message. Nothing is parsed before the header has been checked and the row count held
+against `--max-objects`.
 
-CSV: UTF-8 text (an initial byte-order mark dropped); lines end in LF, CRLF or CR alone (all read
-as LF first, so the row count and every line number mean what an editor shows). The header names
-the columns; the rows are read by `numpy.loadtxt` in one pass, numbers as float64 and each text
-column as text of its TEXT_CHARS width and one character more, so a longer cell is seen, never cut
-short in silence (`runner.table` refuses it). A header with no rows is a table of no objects. When
-numpy refuses a row, the cell is found again with Python's csv module (its field size limit
-raised to the text's length for that reading, so a long cell is read like any other): a row of the
-wrong length, or a number numpy does not read (`NUMBER_RE`: decimal, exponent, `inf`, `nan`; not
-`1_000`, not `0x10`, not full-width digits). A quote that opens a field and is never closed would
-take the rest of the file into that field, rows and all: it is refused where it opens (looked for
-only when fewer rows were read than the text has lines, or when numpy refused the text).
+CSV: UTF-8 text (an initial byte-order mark dropped); lines end in LF, CRLF or CR alone (all read as
+LF first, so the row count and every line number mean what an editor shows). The header names the
+columns; the rows are read by `numpy.loadtxt` in one pass, numbers as float64 and each text column
+as text of its TEXT_CHARS width and one character more, so a longer cell is seen, never cut short in
+silence (`runner.scenario.table` refuses it). A header with no rows is a table of no objects. When
+numpy refuses a row, the cell is found again with Python's csv module (its field size limit raised
+to the text's length for that reading, so a long cell is read like any other): a row of the wrong
+length, or a number numpy does not read (`NUMBER_RE`: decimal, exponent, `inf`, `nan`; not `1_000`,
+not `0x10`, not full-width digits). A quote that opens a field and is never closed would take the
+rest of the file into that field, rows and all: it is refused where it opens (looked for only when
+fewer rows were read than the text has lines, or when numpy refused the text).
 
 `.npy`: the header is read from the bytes first; a one-dimensional structured array of numbers
 and text (no objects, so no pickles), whose rows at their item size must fill the rest of the file
@@ -33,15 +33,15 @@ import threading
 
 import numpy as np
 
-from collide2d.runner.limits import Limits
-from collide2d.runner.objects import MAX_OBJECT_NAME_CHARS
-from collide2d.runner.yamlsafe import ScenarioError
+from collide2d.runner.scenario.limits import Limits
+from collide2d.runner.scenario.objects import MAX_OBJECT_NAME_CHARS
+from collide2d.runner.scenario.parse import ScenarioError
 
 COLUMNS = ("id", "shape", "w", "h", "x", "y", "vx", "vy", "mass", "color", "name", "static", "fill")
 REQUIRED = ("id", "shape", "w", "h", "x", "y")
 NUMBERS = ("id", "w", "h", "x", "y", "vx", "vy")
 # Longest text a cell may hold, per text column (characters, as written); wider columns would cost
-# memory for every row. A name's bound is the one every object name has (runner.objects).
+# memory for every row. A name's bound is the one every object name has (runner.scenario.objects).
 TEXT_CHARS = {
     "shape": 16,
     "color": 40,

@@ -1,11 +1,11 @@
 """The run viewer's page: one HTML file with its data, styles and script inline, no network.
 
-`page(data)` takes `runner.viewer.Recorder.data()` and returns `viewer.html`. The script inflates
-the positions with the browser's `DecompressionStream`, then draws each frame the way
+`page(data)` takes `runner.output.viewerdata.Recorder.data()` and returns `viewer.html`. The script
+inflates the positions with the browser's `DecompressionStream`, then draws each frame the way
 `engine.raster` does: the background, then every object's sprite pixels in id order at its rounded
-position, clipped to the world, into an ImageData at the world's size; that picture is scaled by
-the zoom (whole factors, no smoothing) onto the canvas and the overlays are drawn over it. At zoom
-1 with every overlay off, the canvas holds exactly the PNG frame's pixels.
+position, clipped to the world, into an ImageData at the world's size; that picture is scaled by the
+zoom (whole factors, no smoothing) onto the canvas and the overlays are drawn over it. At zoom 1
+with every overlay off, the canvas holds exactly the PNG frame's pixels.
 
 Controls: play / pause (space), one frame back and forward (left and right arrow keys, or the
 buttons), the frame slider (Home / End), the speed, the zoom (also the mouse wheel) and panning
@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import html
 
-from collide2d.runner.viewer import data_json
+from collide2d.runner.output.viewerdata import data_json
 
 FLASH_FRAMES = 4
 ZOOMS = (1, 2, 3, 4, 6, 8, 12, 16)

@@ -14,7 +14,7 @@ from __future__ import annotations
 import argparse
 
 from collide2d.engine.models import MAX_EVENTS_PER_TICK, MODEL_NAMES
-from collide2d.runner.limits import Limits
+from collide2d.runner.scenario.limits import Limits
 
 _LIMIT_OPTIONS = (
     ("--max-objects", "max_objects", "objects in a scenario"),
@@ -64,7 +64,7 @@ def add_limit_arguments(parser: argparse.ArgumentParser, *, output: bool = False
 
 def limits_from_args(args: argparse.Namespace, project=None) -> Limits:
     """The Limits asked for on the command line, over the project's `[tool.collide2d.limits]`
-    (a runner.config.Config) when given, over the defaults."""
+    (a runner.command.settings.Config) when given, over the defaults."""
     fields = [f for _, f, _ in _LIMIT_OPTIONS + _OUTPUT_OPTIONS]
     given = {f: getattr(args, f) for f in fields if getattr(args, f, None)}
     return project.limits(given) if project is not None else Limits(**given)
@@ -135,8 +135,8 @@ def apply_jit(args: argparse.Namespace, project=None) -> None:
 
 def apply_threads(args: argparse.Namespace, project=None) -> None:
     """Put the command line's `--threads`, else the project's `[tool.collide2d] threads` (a
-    runner.config.Config), else all cores, in force for the compiled kernels (from when numba
-    loads: engine.threads.request)."""
+    runner.command.settings.Config), else all cores, in force for the compiled kernels (from when
+    numba loads: engine.threads.request)."""
     from collide2d.engine.threads import request
 
     given = getattr(args, "threads", None)

@@ -8,14 +8,14 @@ model settings, every object as `engine.world.Bodies` arrays (listed objects fir
 offending YAML node. Nothing large is allocated before every count has been checked against
 `Limits`.
 
-Reading goes in two steps: `runner.yamlsafe` turns the text into a node tree within the bounds of
-`Limits` (`runner.limits`: safe tags only, depth, aliases, size, value count); then the tree is
-walked by hand, so every value is checked where it stands and every error carries its node's place.
-`runner.nodes` reads single nodes (typed, located); this module reads the top level, the world, the
-model, the tick count and the overrides; `runner.objects` reads the objects and generate blocks
-under the model's `ModelRules`; `runner.outputspec` reads `output` and `golden`; `runner.assemble`
-builds the `Bodies` and the palette and checks the placement. Every name the format defines is
-importable from here (`__all__`), wherever it is defined.
+Reading goes in two steps: `runner.scenario.parse` turns the text into a node tree within the bounds
+of `Limits` (`runner.scenario.limits`: safe tags only, depth, aliases, size, value count); then the
+tree is walked by hand, so every value is checked where it stands and every error carries its node's
+place. `runner.scenario.nodes` reads single nodes (typed, located); this module reads the top level,
+the world, the model, the tick count and the overrides; `runner.scenario.objects` reads the objects
+and generate blocks under the model's `ModelRules`; `runner.scenario.sections` reads `output` and
+`golden`; `runner.scenario.assemble` builds the `Bodies` and the palette and checks the placement.
+Every name the format defines is importable from here (`__all__`), wherever it is defined.
 
 Values follow YAML 1.1 as PyYAML reads it (`yes` is a boolean, `0x1f` an integer), with one
 addition: an unquoted number in exponent form such as `1e3` or `1.5E-7`, a string to YAML 1.1, is
@@ -28,18 +28,17 @@ rounded to the nearest whole tick with halves up and computed exactly from the d
 (`0.05` s at 10 fps is 1 tick); with neither, `DEFAULT_DURATION` seconds. A scenario without a
 `name` takes its file's stem (text read by `loads` without a path is named `NAME_FOR_TEXT`).
 
-Numbers: a number is at most `runner.yamlsafe.MAX_NUMBER_CHARS` characters as written, so it is
-read at a cost linear in its text whatever its form (decimal, `0x`, `0b`, octal, sexagesimal `1:30`,
-underscores); a whole number is at most MAX_INTEGER unless its field says less (a generate seed at
-most MAX_SEED), and a number in a float field must be finite (`.inf`, `.nan` and `1e999` are
+Numbers: a number is at most `runner.scenario.parse.MAX_NUMBER_CHARS` characters as written, so it
+is read at a cost linear in its text whatever its form (decimal, `0x`, `0b`, octal, sexagesimal
+`1:30`, underscores); a whole number is at most MAX_INTEGER unless its field says less (a generate
+seed at most MAX_SEED), and a number in a float field must be finite (`.inf`, `.nan` and `1e999` are
 refused). `-0.0` is read as `0.0`. Masses lie in [MIN_MASS, MAX_MASS] and velocity components in
 [-MAX_SPEED, MAX_SPEED], so every object starts with |m v| <= sqrt(2) * 1e24, m |v|^2 / 2 <= 1e33
 and 1/m <= 1e15, and n objects with a kinetic energy E <= n * 1e33. The models keep kinetic energy
-(up to rounding) or lose it, never gain it, so no object ever moves faster than
-sqrt(2 E / MIN_MASS) <= sqrt(n) * 1.5e24 px/s: for any n a machine can hold, every velocity, energy,
-momentum and inverse mass of a run stays many orders of magnitude inside float64's range (about
-1.8e308). Denormal masses such as `5e-324` are refused by the same bound; `static: true` is the way
-to an immovable object.
+(up to rounding) or lose it, never gain it, so no object ever moves faster than sqrt(2 E / MIN_MASS)
+<= sqrt(n) * 1.5e24 px/s: for any n a machine can hold, every velocity, energy, momentum and inverse
+mass of a run stays many orders of magnitude inside float64's range (about 1.8e308). Denormal masses
+such as `5e-324` are refused by the same bound; `static: true` is the way to an immovable object.
 
 Every value in the file must be valid on its own. The overrides then replace values (`model`
 replaces the file's whole `model` entry unless it names the same kind, whose settings are kept;
@@ -68,12 +67,14 @@ from collide2d.engine.models import MAX_EVENTS_PER_TICK, MODEL_NAMES
 from collide2d.engine.noroom import no_room, no_room_message
 from collide2d.engine.shapes import GEOMETRIES
 from collide2d.engine.world import Bodies, WorldSpec
-from collide2d.runner import assemble, lanes, yamlfast
-from collide2d.runner import yamlsafe as ys
-from collide2d.runner.assemble import PALETTE_SIZE
-from collide2d.runner.limits import Limits
-from collide2d.runner.nodes import FAILED, MAX_INTEGER, Errors, Nodes, fmt, is_number
-from collide2d.runner.objects import (
+from collide2d.runner import lanes
+from collide2d.runner.scenario import assemble
+from collide2d.runner.scenario import fastlane as yamlfast
+from collide2d.runner.scenario import parse as ys
+from collide2d.runner.scenario.assemble import PALETTE_SIZE
+from collide2d.runner.scenario.limits import Limits
+from collide2d.runner.scenario.nodes import FAILED, MAX_INTEGER, Errors, Nodes, fmt, is_number
+from collide2d.runner.scenario.objects import (
     BLOCK_KEYS,
     BLOCK_SHAPES,
     DEFAULT_COLOR,
@@ -91,7 +92,8 @@ from collide2d.runner.objects import (
     ObjectReader,
     polygon_problem,
 )
-from collide2d.runner.outputspec import (
+from collide2d.runner.scenario.parse import ScenarioError
+from collide2d.runner.scenario.sections import (
     EVERY_KEYS,
     FRAME_WORDS,
     GOLDEN_KEYS,
@@ -100,8 +102,7 @@ from collide2d.runner.outputspec import (
     Output,
     OutputReader,
 )
-from collide2d.runner.table import table_of
-from collide2d.runner.yamlsafe import ScenarioError
+from collide2d.runner.scenario.table import table_of
 
 __all__ = [
     "BLOCK_KEYS",
@@ -165,7 +166,7 @@ MAX_SUBSTEPS = 10_000  # substeps per tick of the stepped model
 DEFAULT_MAX_EVENTS_PER_TICK = MAX_EVENTS_PER_TICK
 MAX_EVENT_CAP = 2**53
 # The whole-number model settings and their (lowest, highest): of a scenario's `model`, and of a
-# project's [tool.collide2d.model] alike (runner.config).
+# project's [tool.collide2d.model] alike (runner.command.settings).
 MODEL_BOUNDS = {"substeps": (1, MAX_SUBSTEPS), "max_events_per_tick": (1, MAX_EVENT_CAP)}
 MAX_NAME_LENGTH = 100  # characters in a scenario name (it names a folder)
 NAME_PATTERN = r"[a-z0-9_-][a-z0-9._-]*"  # scenario names; never "." or "..", never a path
@@ -211,8 +212,8 @@ class Scenario:
     text_sha256: str  # of the file's bytes; with a table, of both (`with_table`)
     # the exact model's cap: --max-events-per-tick, else the model option, else the default
     max_events_per_tick: int = DEFAULT_MAX_EVENTS_PER_TICK
-    # each generate block as drawn (runner.generate.BlockSpec), its objects the last of `bodies`:
-    # what a sweep draws again for another seed (runner.sweep.reseed)
+    # each generate block as drawn (runner.scenario.generate.BlockSpec), its objects the last of
+    # `bodies`: what a sweep draws again for another seed (runner.sweep.reseed)
     generated: tuple = ()
 
 
@@ -227,7 +228,7 @@ def load(
     """Read and check the scenario file at `path` (str or os.PathLike); ScenarioError if bad.
 
     `defaults`: model settings a project gives where the file gives none (`kind`, `substeps`,
-    `geometry`, `max_events_per_tick`; runner.config), below the file and the overrides.
+    `geometry`, `max_events_per_tick`; runner.command.settings), below the file and the overrides.
     `edit(root) -> root`, when given, changes the composed YAML node tree before it is read (a
     sweep's dotted keys, `runner.sweep.matrix`); the result is checked like the file itself."""
     shown = os.fspath(path)
@@ -279,8 +280,8 @@ class _Reader(Nodes):
 
     def scenario(self, text: str, digest: str, edit=None) -> Scenario:
         """The scenario of `text`, with `edit` (a sweep's dotted keys) applied to its node tree; a
-        long object list one flow mapping per line takes the fast lane (runner.yamlfast) when
-        nothing is edited, and anything it declines or any error it meets is read again through
+        long object list one flow mapping per line takes the fast lane (runner.scenario.fastlane)
+        when nothing is edited, and anything it declines or any error it meets is read again through
         the general path, which alone decides what a file means or why it is refused."""
         fast = yamlfast.split(text) if edit is None else None
         if fast is not None and yamlfast.bound(fast) <= self.limits.max_yaml_nodes:
@@ -294,7 +295,7 @@ class _Reader(Nodes):
         """Read the whole document, collecting the errors of its parts (up to MAX_ERRORS, in
         line order: a part that depends on a refused one is not read, so that no error follows
         from another); raise them all, or return the Scenario. `fast`: the fast lane's object
-        rows (runner.yamlfast), read in place of the empty list the text then holds."""
+        rows (runner.scenario.fastlane), read in place of the empty list the text then holds."""
         root = ys.compose(text, self.path, self.limits)
         if edit is not None:
             root = edit(root)
@@ -509,8 +510,8 @@ class _Reader(Nodes):
         return kind, substeps, geometry, cap
 
     def model_defaults(self, kind, sub_node, geometry, cap_node, substeps, cap):
-        """The project's model defaults (runner.config) where neither the file nor the command
-        line set a value and the model takes it."""
+        """The project's model defaults (runner.command.settings) where neither the file nor the
+        command line set a value and the model takes it."""
         d = self.defaults
         if kind == "stepped" and sub_node is None and "substeps" in d:
             substeps = d["substeps"]
@@ -528,7 +529,7 @@ class _Reader(Nodes):
     def table(self, top, fast, world, rules):
         """The objects given as a table: the fast lane's rows when `fast` (the text's object list
         must then be the empty list it left, else the lane declines), else the `objects: {file}`
-        table (runner.table), or None."""
+        table (runner.scenario.table), or None."""
         if fast is None:
             return table_of(self, top, self.file_path, self.limits, world, rules.paper_rates)
         node = top["objects"][1] if "objects" in top else None

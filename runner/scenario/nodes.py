@@ -1,12 +1,13 @@
 """Typed, located reading of YAML nodes: a value of the expected kind, or a ScenarioError at it.
 
-`runner.yamlsafe` turns text into a node tree within bounds; `Nodes` reads that tree one node at a
-time and knows nothing of scenarios: a mapping (unknown keys refused with a did-you-mean, repeated
-keys refused, `<<` merge keys as in YAML 1.1), a list, a single value, text, a boolean, a number
-(finite; `-0.0` read as `0.0`), a whole number (a float with no fraction counts, as in JSON Schema;
-at most MAX_INTEGER unless the field says less), a colour, an [x, y] pair and a choice among names.
-Each refusal is `FILE:LINE:COL: error: MESSAGE` at the node it is about. The scenario's section
-readers (`runner.scenario`, `runner.objects`, `runner.outputspec`) extend `Nodes`.
+`runner.scenario.parse` turns text into a node tree within bounds; `Nodes` reads that tree one node
+at a time and knows nothing of scenarios: a mapping (unknown keys refused with a did-you-mean,
+repeated keys refused, `<<` merge keys as in YAML 1.1), a list, a single value, text, a boolean, a
+number (finite; `-0.0` read as `0.0`), a whole number (a float with no fraction counts, as in JSON
+Schema; at most MAX_INTEGER unless the field says less), a colour, an [x, y] pair and a choice among
+names. Each refusal is `FILE:LINE:COL: error: MESSAGE` at the node it is about. The scenario's
+section readers (`runner.scenario.load`, `runner.scenario.objects`, `runner.scenario.sections`)
+extend `Nodes`.
 """
 
 from __future__ import annotations
@@ -17,9 +18,9 @@ import math
 import numpy as np
 import yaml
 
-from collide2d.runner import colors
-from collide2d.runner import yamlsafe as ys
-from collide2d.runner.yamlsafe import ScenarioError
+from collide2d.runner.scenario import colors
+from collide2d.runner.scenario import parse as ys
+from collide2d.runner.scenario.parse import ScenarioError
 
 MAX_INTEGER = 2**63 - 1  # the largest whole number a field takes unless it has its own bound
 MAX_ERRORS = 20  # errors of one file reported at once

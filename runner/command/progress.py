@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import sys
 
-from collide2d.runner import escape
+from collide2d.runner.output import escape
 
 # Seconds between redraws; runs shorter than SHOW_AFTER_S never show a bar.
 REDRAW_S = 0.2

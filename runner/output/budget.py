@@ -29,10 +29,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from collide2d.runner.frames import FrameRule
-from collide2d.runner.limits import Limits
-from collide2d.runner.outputs import GifSchedule
-from collide2d.runner.scenario import Scenario, ScenarioError
+from collide2d.runner.output.files import GifSchedule
+from collide2d.runner.scenario.frames import FrameRule
+from collide2d.runner.scenario.limits import Limits
+from collide2d.runner.scenario.load import Scenario, ScenarioError
 
 # PNG file: 8-byte signature, IHDR (13 data + 12), IEND (12), room for one ancillary chunk.
 PNG_FIXED_BYTES = 8 + 25 + 12 + 64

@@ -1,7 +1,7 @@
 """The run viewer's data: every frame's positions, the sprites and the events, packed compactly.
 
 `collide2d run --viewer` (or `output: {viewer: true}`) writes `viewer.html` beside the GIF: one
-self-contained file (`runner.viewerpage` holds its page and script) that plays the run on a
+self-contained file (`runner.output.viewerpage` holds its page and script) that plays the run on a
 canvas. A `Recorder` is handed each tick's model by the driver loop (`runner.run.drive`'s
 `on_tick`) and the event chunks as they come; `page()` returns the HTML.
 
@@ -16,7 +16,8 @@ What the file holds, as JSON in the page:
 - velocities (px/s, float32, the same layout, not differenced), for the velocity arrows;
 - the events (tick, type, ids, side or axis), at most `MAX_EVENTS` of them (the count of the rest
   is shown);
-- for the `paper` model, each pair event's overlap before the take-back (`runner.overlay`), as
+- for the `paper` model, each pair event's overlap before the take-back (`runner.output.overlay`),
+as
   int32 rows of OVERLAP_COLUMNS, packed like the positions.
 
 A run of more than `MAX_POSITIONS` object-frames (ticks + 1 times objects) is refused before the
@@ -33,8 +34,8 @@ import numpy as np
 from collide2d.engine.events import EV_WALL, event_dict
 from collide2d.engine.raster import round_positions
 from collide2d.engine.sprites import sprites
-from collide2d.runner import escape
-from collide2d.runner.scenario import ScenarioError
+from collide2d.runner.output import escape
+from collide2d.runner.scenario.load import ScenarioError
 
 VIEWER_FILE = "viewer.html"
 # The most object-frames a viewer holds ((ticks + 1) x objects): 8 bytes each while recording.
@@ -84,7 +85,8 @@ class Recorder:
         self.count = 0
         self.event_rows: list = []
         self.n_events = 0
-        self.layer = layer  # a runner.overlay.Overlay noting the paper model's overlaps, or None
+        # a runner.output.overlay.Overlay noting the paper model's overlaps, or None
+        self.layer = layer
         self.overlap_rows: list = []
         self._last = None
 
@@ -149,7 +151,7 @@ class Recorder:
 
     def page(self) -> bytes:
         """viewer.html bytes."""
-        from collide2d.runner.viewerpage import page
+        from collide2d.runner.output.viewerpage import page
 
         return page(self.data())
 

@@ -16,22 +16,22 @@ parsed. Columns, by name (any order; only id, shape, w, h, x, y are required):
     static true | false (default false)
     fill   true | false (default false)
 
-The file is read once (`runner.readfile`: a regular file within `--max-file-bytes`) and its bytes
-go to `runner.tableread`, which makes one structured array of them: a CSV file (a header row of
-column names, then one row per object, fields separated by commas, a field holding a comma quoted
-with ", blank lines skipped, lines ending in LF, CRLF or CR) by `numpy.loadtxt` in a single pass, a
-`.npy` file (a structured array whose field names are the columns, numbers as any numeric type, text
-as unicode or bytes) over the same bytes once its header's claim has been held against the file's
-size. The table's SHA-256 is kept (`Table.sha256`): it counts in the scenario's hash, so goldens and
-reports see an edited table as an edited scenario.
+The file is read once (`runner.scenario.readfile`: a regular file within `--max-file-bytes`) and its
+bytes go to `runner.scenario.tableread`, which makes one structured array of them: a CSV file (a
+header row of column names, then one row per object, fields separated by commas, a field holding a
+comma quoted with ", blank lines skipped, lines ending in LF, CRLF or CR) by `numpy.loadtxt` in a
+single pass, a `.npy` file (a structured array whose field names are the columns, numbers as any
+numeric type, text as unicode or bytes) over the same bytes once its header's claim has been held
+against the file's size. The table's SHA-256 is kept (`Table.sha256`): it counts in the scenario's
+hash, so goldens and reports see an edited table as an edited scenario.
 
 Every check runs over whole columns at once (numpy), and the first failing cell, in row order and
 then column order, is reported as `FILE:ROW:COLUMN: error: ...`: the CSV's line and the character
 column where the field starts (for `.npy` the row counted from 1 and the field's number). Finding
 that place reads the CSV again with Python's csv module, on the error path only. A text cell longer
 than its column's bound (TEXT_CHARS) is refused, never cut short; names follow the one rule for
-object names (`runner.objects.object_names`), and two rows of one name are refused at the second
-(`runner.assemble.check_names`).
+object names (`runner.scenario.objects.object_names`), and two rows of one name are refused at the
+second (`runner.scenario.assemble.check_names`).
 """
 
 from __future__ import annotations
@@ -46,10 +46,17 @@ import numpy as np
 
 from collide2d.engine import motion
 from collide2d.engine.world import KIND_BOX, KIND_CIRCLE
-from collide2d.runner import colors
-from collide2d.runner.limits import Limits
-from collide2d.runner.readfile import read_regular
-from collide2d.runner.tableread import COLUMNS, NUMBERS, REQUIRED, TEXT_CHARS, read_csv, read_npy
+from collide2d.runner.scenario import colors
+from collide2d.runner.scenario.limits import Limits
+from collide2d.runner.scenario.readfile import read_regular
+from collide2d.runner.scenario.tableread import (
+    COLUMNS,
+    NUMBERS,
+    REQUIRED,
+    TEXT_CHARS,
+    read_csv,
+    read_npy,
+)
 
 __all__ = ["COLUMNS", "NUMBERS", "REQUIRED", "TEXT_CHARS", "Table", "read_table", "table_of"]
 
@@ -74,7 +81,7 @@ class Table:
     colors: list
     color_of: np.ndarray
     names: tuple
-    where: object  # where(row, column) -> ScenarioError maker, see runner.tableread.Place
+    where: object  # where(row, column) -> ScenarioError maker, see runner.scenario.tableread.Place
     lines: tuple | None = None  # each object's line in the scenario, when it has its own
     sha256: str | None = None  # of the table file's bytes (None: the rows are the scenario's text)
 
@@ -294,10 +301,10 @@ def _shown(v) -> str:
 
 
 def _names(data, refuse) -> tuple:
-    """Each row's name under the one rule for object names (runner.objects.object_names), a cell
-    past TEXT_CHARS as written refused first (a CSV's is read one character longer, never cut
+    """Each row's name under the one rule for object names (runner.scenario.objects.object_names), a
+    cell past TEXT_CHARS as written refused first (a CSV's is read one character longer, never cut
     short unseen); a number in a .npy name column is its text."""
-    from collide2d.runner.objects import NameRefused, object_names
+    from collide2d.runner.scenario.objects import NameRefused, object_names
 
     n = data.shape[0]
     if "name" not in data.dtype.names:
@@ -335,7 +342,7 @@ def _flag(data, column: str, refuse) -> np.ndarray:
 
 
 def _mass(data, static, refuse) -> np.ndarray:
-    from collide2d.runner.objects import DEFAULT_MASS, MAX_MASS, MIN_MASS
+    from collide2d.runner.scenario.objects import DEFAULT_MASS, MAX_MASS, MIN_MASS
 
     n = static.shape[0]
     if "mass" not in data.dtype.names:
@@ -372,7 +379,7 @@ def _mass(data, static, refuse) -> np.ndarray:
 
 def _colors(data, refuse) -> tuple[list, np.ndarray]:
     """The distinct colours in order of first use, and each row's index into them."""
-    from collide2d.runner.objects import DEFAULT_COLOR
+    from collide2d.runner.scenario.objects import DEFAULT_COLOR
 
     n = data.shape[0]
     if n == 0:
@@ -395,7 +402,7 @@ TABLE_KEYS = ("file",)
 
 def table_of(reader, top: dict, scenario_path: str | None, limits: Limits, world, paper: bool):
     """The Table the scenario's `objects: {file: NAME}` names, or None when `objects` is a list
-    (or absent). `reader` (a runner.nodes.Nodes) locates errors in the scenario itself."""
+    (or absent). `reader` (a runner.scenario.nodes.Nodes) locates errors in the scenario itself."""
     import yaml
 
     if "objects" not in top or not isinstance(top["objects"][1], yaml.MappingNode):
