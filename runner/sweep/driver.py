@@ -13,6 +13,7 @@ finished so far with `complete` False.
 from __future__ import annotations
 
 import math
+import time
 
 from collide2d.runner.sweep import cluster
 from collide2d.runner.sweep.runs import error_figures, run_batch
@@ -33,10 +34,11 @@ def run_sweep(client, runs, *, progress=None, on_row=None, batch=None) -> tuple[
     batches = [runs[k : k + batch] for k in range(0, len(runs), batch)]
     figures: dict[int, dict] = {}
     positions: dict = {}
+    started = time.time()
 
     def take(i: int, value, error) -> None:
-        if error is not None:
-            value = [(error_figures(error), None)] * len(batches[i])
+        if error is not None:  # a worker's death says why (runs.error_figures)
+            value = [(error_figures(error, since=started), None)] * len(batches[i])
         for run, (row, pos) in zip(batches[i], value, strict=True):
             figures[run.index], positions[run.index] = row, pos
             if on_row is not None:

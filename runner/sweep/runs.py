@@ -61,7 +61,11 @@ def _checked(scenario) -> tuple[float, int]:
 
 def run_batch(scenarios) -> list[tuple[dict, np.ndarray | None]]:
     """run_one of each scenario, in order; a run that raises (a bug) is a row with status
-    `error` and the exception in its note, and the others still run."""
+    `error` and the exception in its note, and the others still run. A fatal signal (a crash in a
+    kernel) leaves its traceback where the sweep finds it (runner.crashwatch)."""
+    from collide2d.runner import crashwatch
+
+    crashwatch.record_in_worker()
     out = []
     for scenario in scenarios:
         try:
@@ -71,8 +75,14 @@ def run_batch(scenarios) -> list[tuple[dict, np.ndarray | None]]:
     return out
 
 
-def error_figures(exc: BaseException) -> dict:
-    """The figures of a run that failed unexpectedly: status `error`, the exception as note."""
+def error_figures(exc: BaseException, since: float | None = None) -> dict:
+    """The figures of a run that failed unexpectedly: status `error`, the exception as note; for
+    a task whose workers all died (Dask's KilledWorker), why they died, as the traceback one of
+    them left after `since` (time.time()) tells (runner.crashwatch)."""
+    if type(exc).__name__ == "KilledWorker":
+        from collide2d.runner import crashwatch
+
+        return {"status": STATUS_ERROR, "note": crashwatch.worker_death(since or 0.0)}
     detail = " ".join(str(exc).split())[:300]
     return {"status": STATUS_ERROR, "note": f"{type(exc).__name__}: {detail}"}
 
