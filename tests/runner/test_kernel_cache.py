@@ -72,26 +72,22 @@ def test_runs_of_a_dense_then_a_sparse_scene_leave_a_cache_later_commands_load(t
     assert done.stdout.splitlines()[-1] == "1 passed, 0 failed"
 
 
-CRASHING_KERNEL = """
+# `collide2d run` whose run calls a kernel that writes far past its array's end
+CRASHING_RUN = """
 import sys
 import numpy as np
 from collide2d.engine.jit import njit
-from collide2d.runner import cli
+from collide2d.runner import cli, run
 
 @njit
 def poke(a, i):
-    a[i] = 1.0  # far past the array's end: the process dies of SIGSEGV
+    a[i] = 1.0
 
-def crash(args):
+def crash(*args, **kwargs):
     poke(np.zeros(1), 1 << 40)
 
-original = cli.build_parser
-def build_parser(command=None):
-    parser = original(command)
-    parser._subparsers._group_actions[0].choices["validate"].set_defaults(func=crash)
-    return parser
-cli.build_parser = build_parser
-sys.argv = ["collide2d", "validate", "x.yaml"]
+run.run_to_dir = crash
+sys.argv = ["collide2d", "run", "--out", "out"]
 sys.exit(cli.main())
 """
 
@@ -103,7 +99,7 @@ def test_a_command_that_dies_in_a_kernel_names_the_signal_and_the_cache_to_clear
     env = dict(os.environ, NUMBA_CACHE_DIR=str(cache))
     env.pop("PYTHONFAULTHANDLER", None)
     done = subprocess.run(
-        [sys.executable, "-c", CRASHING_KERNEL], cwd=tmp_path, env=env, capture_output=True,
+        [sys.executable, "-c", CRASHING_RUN], cwd=tmp_path, env=env, capture_output=True,
         text=True, timeout=300,
     )  # fmt: skip
     assert done.returncode == -signal.SIGSEGV
@@ -118,9 +114,11 @@ def test_a_command_that_ends_normally_or_by_an_error_says_nothing_more(tmp_path)
     env = dict(os.environ)
     env.pop("PYTHONFAULTHANDLER", None)
     (tmp_path / "bad.yaml").write_text("version: 1\nworld: {width: -1}\n")
-    done = _collide2d("validate", str(tmp_path / "bad.yaml"), cwd=tmp_path, env=env)
-    assert done.returncode == 2
-    assert "died of" not in done.stderr and "Fatal Python error" not in done.stderr
+    bad = _collide2d("validate", str(tmp_path / "bad.yaml"), cwd=tmp_path, env=env)
+    assert bad.returncode == 2 and bad.stderr.startswith(f"{tmp_path / 'bad.yaml'}:2:")
+    assert "died of" not in bad.stderr and "Fatal Python error" not in bad.stderr
+    good = _collide2d("run", "--out", str(tmp_path / "out"), "--quiet", cwd=tmp_path, env=env)
+    assert (good.returncode, good.stderr) == (0, "")
 
 
 WORKER = """
