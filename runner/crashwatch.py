@@ -5,13 +5,14 @@ cache can cause, kills the process before any Python code of it runs again: the 
 explain itself. Python's faulthandler can still write the dying thread's traceback to a file
 descriptor, so:
 
-- `watch()` (the command line, before a command runs) forks a small watcher that holds the read
-  end of a pipe, and points faulthandler at the write end. A command that ends in any ordinary way
-  writes nothing there, and the watcher leaves without a word when the pipe closes. After a fatal
-  signal the watcher prints, on the command's stderr, one `collide2d: error:` line naming the
-  signal and the kernel cache with the command that clears it (`message`), then the traceback.
-  The exit status stays the shell's 128 + signal (139 for SIGSEGV). Without fork (Windows),
-  faulthandler writes the traceback to stderr directly.
+- `watch()` (the command line, before a command runs) starts a small watcher, a POSIX shell that
+  holds the read end of a pipe, and points faulthandler at the write end. A command that ends in
+  any ordinary way writes nothing there, and the watcher leaves without a word when the pipe
+  closes. After a fatal signal the watcher has Python (`tell`) print, on the command's stderr, one
+  `collide2d: error:` line naming the signal and the kernel cache with the command that clears it
+  (`message`), then the traceback. The exit status stays the shell's 128 + signal (139 for
+  SIGSEGV). Where there is no POSIX shell (Windows), faulthandler writes the traceback to stderr
+  directly.
 - `record_in_worker()` (a sweep's worker, before its runs) points faulthandler at a file of its
   own in `crash_folder()`; the sweep, told that a task's workers died, reads the newest such file
   (`worker_death`) to say why in the rows of that task.
@@ -22,8 +23,6 @@ from __future__ import annotations
 import faulthandler
 import os
 import re
-import select
-import signal
 import stat
 import sys
 import time
@@ -41,9 +40,6 @@ _SIGNALS = {
     "Floating point exception": "SIGFPE",
     "Aborted": "SIGABRT",
 }
-# Seconds the watcher waits for more of a traceback once one began, when the pipe stays open (a
-# child process that inherited it outlives the command).
-_QUIET_S = 1.0
 # Bytes of a traceback kept (faulthandler writes at most 100 frames per thread).
 _MAX_REPORT = 1 << 16
 # Seconds a worker's record is kept at most.
@@ -93,71 +89,57 @@ def _in_kernel(report: bytes) -> bool:
     return kernel_call or b"/numba/" in path
 
 
+# The watcher: a POSIX shell (started without copying this process, unlike a fork) that reads
+# the pipe to its end; only when a traceback came does it start Python to say what happened
+# (`tell`), else it leaves at once. Ctrl-C, which reaches the whole process group, it ignores.
+_WATCHER = """trap '' INT
+report=''
+while IFS= read -r line || [ -n "$line" ]; do report="$report$line
+"; done
+[ -n "$report" ] || exit 0
+printf '%s' "$report" | "$1" -m collide2d.runner.crashwatch || printf '%s' "$report" >&2
+"""
+_SHELL = "/bin/sh"
+
+
 def watch() -> None:
-    """Report a fatal signal of this process on its stderr (module docstring). Call once, early,
-    while the process runs a single thread."""
+    """Report a fatal signal of this process on its stderr (module docstring). Call once, early."""
     global _sink
     if _sink is not None:
         return
-    if not hasattr(os, "fork"):
-        faulthandler.enable(file=sys.stderr)
+    if not (hasattr(os, "posix_spawn") and os.path.exists(_SHELL)):
+        faulthandler.enable(file=sys.stderr)  # the traceback alone, as Python gives it
         _sink = sys.stderr
         return
     read_end, write_end = os.pipe()
-    for stream in (sys.stdout, sys.stderr):
-        stream.flush()
-    pid = os.fork()
-    if pid == 0:  # the watcher
-        try:
-            os.close(write_end)
-            signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C reaches the whole group
-            # hold nothing of the command's but its stderr: a pipe or socket it was given closes
-            # when the command ends, as if there were no watcher
-            null = os.open(os.devnull, os.O_RDWR)
-            os.dup2(null, 0)
-            os.dup2(null, 1)
-            os.closerange(3, read_end)
-            os.closerange(read_end + 1, _max_fd())
-            _wait_and_tell(read_end)
-        finally:
-            os._exit(0)
-    os.close(read_end)
+    try:
+        os.posix_spawn(
+            _SHELL,
+            ["sh", "-c", _WATCHER, "sh", sys.executable],
+            os.environ,
+            file_actions=[
+                (os.POSIX_SPAWN_DUP2, read_end, 0),
+                (os.POSIX_SPAWN_OPEN, 1, os.devnull, os.O_WRONLY, 0),
+            ],
+        )
+    except OSError:
+        os.close(write_end)
+        faulthandler.enable(file=sys.stderr)
+        _sink = sys.stderr
+        return
+    finally:
+        os.close(read_end)
     _sink = os.fdopen(write_end, "wb", buffering=0)
     faulthandler.enable(file=_sink, all_threads=False)
 
 
-def _max_fd() -> int:
-    try:
-        return os.sysconf("SC_OPEN_MAX")
-    except (AttributeError, ValueError, OSError):
-        return 1024
-
-
-def _wait_and_tell(read_end: int) -> None:
-    report = b""
-    while True:
-        if report:
-            ready, _, _ = select.select([read_end], [], [], _QUIET_S)
-            if not ready:
-                break
-        try:
-            chunk = os.read(read_end, 4096)
-        except InterruptedError:
-            continue
-        if not chunk:
-            break
-        report = (report + chunk)[:_MAX_REPORT]
+def tell(report: bytes) -> bytes:
+    """What the watcher prints of `report` (what faulthandler wrote): the line naming the signal
+    and the cache to clear, then the report; the report alone when it names no signal."""
     name = signal_name(report)
     if name is None:
-        return
-    text = message(name, _in_kernel(report)).encode() + b"\n" + report
-    while text:
-        try:
-            text = text[os.write(2, text) :]
-        except InterruptedError:
-            continue
-        except OSError:
-            return
+        return report
+    return message(name, _in_kernel(report)).encode() + b"\n" + report
 
 
 def crash_folder() -> str:
@@ -252,3 +234,9 @@ def _alive(pid: int) -> bool:
     except OSError:
         return True
     return True
+
+
+if __name__ == "__main__":  # the watcher's Python, given the report on stdin
+    sys.stdout.flush()
+    sys.stderr.buffer.write(tell(sys.stdin.buffer.read(_MAX_REPORT)))
+    sys.stderr.flush()
