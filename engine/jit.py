@@ -27,6 +27,16 @@ numba is loaded (interpreted, `func` runs itself). `prange` is `range` until a k
 compiles, when the module's `prange` becomes numba's. `parallel=True` takes effect from numba
 PARALLEL_FROM_NUMBA on (older versions crashed loading parallel kernels that cached kernels call,
 numba issue 8578); below it the same source compiles serially, with the same results.
+
+Compiled code that holds a parallel loop calls numba's threading layer, which numba starts only
+when told to: compiling such code starts it, and so does loading it from the cache, through the
+"reload hooks" numba stores with each cached kernel. But numba leaves a loaded kernel's hooks off
+its code, from where a kernel compiled afterwards in the same process takes its own: a kernel's
+second specialisation, compiled in a process that loaded the parallel kernels it calls from the
+cache (a run of a sparse scene after one of a dense scene: a new broad phase in the signature),
+was cached without them, and a later process that loaded it first crashed calling address 0. So
+`_package_cache` puts a loaded kernel's hooks back on its code, and `numba_module` starts the
+threading layer as numba loads, before any kernel is loaded: no cache can leave it unstarted.
 """
 
 from __future__ import annotations
@@ -72,7 +82,8 @@ def lane(compiled: bool):
 
 
 def numba_module():
-    """numba, imported on first use; registers the overloads declared so far."""
+    """numba, imported on first use; registers the overloads declared so far and, where kernels
+    compile parallel, starts numba's threading layer."""
     global _numba
     if _numba is None:
         import numba
@@ -81,6 +92,10 @@ def numba_module():
         for func, impl, options in _overloads:
             numba_overload(func, **options)(impl)
         _numba = numba
+        if parallel_supported():
+            # numba's threading layer before any kernel loads (module docstring): a cached kernel
+            # holding parallel code that finds it missing calls address 0
+            numba.get_num_threads()  # starts the layer (as set_num_threads does) and reads
         for call in _on_load:
             call()
     return _numba
@@ -207,12 +222,50 @@ def _package_cache():
         return Locator
 
     base = FunctionCache._impl_class
+
+    def rebuild(self, target_context, payload):
+        # numba runs a loaded kernel's reload hooks (a parallel kernel's: start the threading
+        # layer) but leaves them off its code library, from where a caller compiled later in this
+        # process takes its own: that caller would be cached without them (module docstring)
+        result = base.rebuild(self, target_context, payload)
+        hooks = getattr(result, "reload_init", None)
+        kept = getattr(getattr(result, "library", None), "_reload_init", None)
+        if hooks and isinstance(kept, set):
+            kept.update(hooks)
+        return result
+
     impl = type(
         "PackageCacheImpl",
         (base,),
-        {"_locator_classes": [package_wide(cls) for cls in base._locator_classes]},
+        {
+            "_locator_classes": [package_wide(cls) for cls in base._locator_classes],
+            "rebuild": rebuild,
+        },
     )
     return type("PackageCache", (FunctionCache,), {"_impl_class": impl})
+
+
+def cache_clear_hint() -> str:
+    """Where numba keeps the compiled kernels and the command that clears them, for a message
+    (numba is not imported: a process that has just crashed in it may say this)."""
+    folder = os.environ.get("NUMBA_CACHE_DIR", "")
+    if folder:
+        return f"delete its folder NUMBA_CACHE_DIR ({folder}): rm -rf {_quoted(folder)}"
+    # the kernels live in the engine package and the runner package beside it
+    engine = os.path.dirname(os.path.abspath(__file__))
+    folders = [engine, os.path.join(os.path.dirname(engine), "runner")]
+    folders = [f for f in folders if os.path.isdir(f)]
+    return (
+        f"delete numba's files in the __pycache__ folders under {' and '.join(folders)} (or in "
+        "numba's user cache folder where those are read-only): "
+        f"find {' '.join(_quoted(f) for f in folders)} -name '*.nb[ci]' -delete"
+    )
+
+
+def _quoted(path: str) -> str:
+    import shlex
+
+    return shlex.quote(path)
 
 
 def _kernel_named(module: str, qualname: str) -> Kernel:

@@ -261,6 +261,10 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    if argv is None:  # the `collide2d` command itself (not a call from Python)
+        from collide2d.runner.command import crashwatch
+
+        crashwatch.watch()  # a fatal signal (a crash in a kernel) is told, never silent
     argv = sys.argv[1:] if argv is None else list(argv)
     command = command_of(argv)
     known = any(command in commands for _m, _f, commands in REGISTRARS)

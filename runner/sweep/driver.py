@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import time
 
 from collide2d.runner.sweep import cluster
 from collide2d.runner.sweep.results import Table
@@ -39,6 +40,7 @@ def run_sweep(client, plan, *, progress=None, on_row=None, batch=None) -> tuple[
         batch = batch_size(len(plan), threads)
     table = Table(plan)
     sent: dict[int, list] = {}  # task number -> its runs, until its result is taken
+    started = time.time()
 
     def batches():
         runs = plan.runs()
@@ -51,8 +53,8 @@ def run_sweep(client, plan, *, progress=None, on_row=None, batch=None) -> tuple[
 
     def take(i: int, value, error) -> None:
         runs = sent.pop(i)
-        if error is not None:
-            value = [(error_figures(error), None)] * len(runs)
+        if error is not None:  # a worker's death says why (runs.error_figures)
+            value = [(error_figures(error, since=started), None)] * len(runs)
         for run, (row, pos) in zip(runs, value, strict=True):
             table.take(run, row, pos)
             if on_row is not None:

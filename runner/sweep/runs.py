@@ -64,9 +64,12 @@ def _checked(scenario) -> tuple[float, int]:
 def run_batch(runs) -> list[tuple[dict, np.ndarray | None]]:
     """run_one of each run, in order, given as (its combination's scenario, its seed or None:
     `runner.sweep.plan.scenario_of` draws the run's objects); a run that raises (a bug) is a row
-    with status `error` and the exception in its note, and the others still run."""
+    with status `error` and the exception in its note, and the others still run. A fatal signal
+    (a crash in a kernel) leaves its traceback where the sweep finds it (runner.command.crashwatch)."""
+    from collide2d.runner.command import crashwatch
     from collide2d.runner.sweep.plan import scenario_of
 
+    crashwatch.record_in_worker()
     out = []
     with lanes.loads(len(runs)):
         for base, seed in runs:
@@ -77,8 +80,14 @@ def run_batch(runs) -> list[tuple[dict, np.ndarray | None]]:
     return out
 
 
-def error_figures(exc: BaseException) -> dict:
-    """The figures of a run that failed unexpectedly: status `error`, the exception as note."""
+def error_figures(exc: BaseException, since: float | None = None) -> dict:
+    """The figures of a run that failed unexpectedly: status `error`, the exception as note; for
+    a task whose workers all died (Dask's KilledWorker), why they died, as the traceback one of
+    them left after `since` (time.time()) tells (runner.command.crashwatch)."""
+    if type(exc).__name__ == "KilledWorker":
+        from collide2d.runner.command import crashwatch
+
+        return {"status": STATUS_ERROR, "note": crashwatch.worker_death(since or 0.0)}
     detail = " ".join(str(exc).split())[:300]
     return {"status": STATUS_ERROR, "note": f"{type(exc).__name__}: {detail}"}
 
