@@ -64,8 +64,8 @@ def _checked(scenario) -> tuple[float, int]:
 def run_batch(runs) -> list[tuple[dict, np.ndarray | None]]:
     """run_one of each run, in order, given as (its combination's scenario, its seed or None:
     `runner.sweep.plan.scenario_of` draws the run's objects); a run that raises (a bug) is a row
-    with status `error` and the exception in its note, and the others still run. A fatal signal
-    (a crash in a kernel) leaves its traceback where the sweep finds it (runner.command.crashwatch)."""
+    with status `error` and the exception in its note, and the others still run. A fatal signal (a
+    crash in a kernel) leaves its traceback where the sweep finds it (runner.command.crashwatch)."""
     from collide2d.runner.command import crashwatch
     from collide2d.runner.sweep.plan import scenario_of
 
