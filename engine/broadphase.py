@@ -1,9 +1,9 @@
 """Broad phase: which pairs could touch, so that exact tests run only on near neighbours.
 
 Input everywhere: boxes as corners `lo`, `hi` (n, 2) px (each box is [lo, hi) on both axes) and
-which objects can move. Output: candidate pairs (a, b), a < b, as keys `a << KEY_SHIFT | b`
-(int64), the pairs whose boxes overlap with positive area and that hold at least one movable
-object: two static objects never become a pair (SPEC 3: static objects never move).
+which objects can move. Output: candidate pairs (a, b), a < b, as keys `a << KEY_SHIFT | b` (int64),
+the pairs whose boxes overlap with positive area and that hold at least one movable object: two
+static objects never become a pair (static objects never move: docs/models.md#common-rules).
 
 - `sweep_candidates` sorts the boxes on x (an order kept from call to call and mended by
   insertion sort, since objects move little between calls) and sweeps: cheap when few boxes share

@@ -1,4 +1,5 @@
-"""Pixels of one object: DDA lines, boxes, midpoint circles, polygons, fills (SPEC section 4).
+"""Pixels of one object: DDA lines, boxes, midpoint circles, polygons, fills
+(docs/drawing.md#shapes).
 
 The drawing primitives `engine.raster` paints frames with, each a numba kernel writing palette
 indices into a `(H, W) uint8` buffer within an inclusive clip rectangle (cx0, cy0, cx1, cy1) that

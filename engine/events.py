@@ -1,9 +1,9 @@
 """Events as data: one fixed record type for every model, and its one fixed text form.
 
 A model's `advance()` returns a numpy array of `EVENT_DTYPE` records in the order the events
-happened. `format_event` turns one record into the `events.jsonl` line of SPEC section 5, with
-floats written one fixed way (`format_number`) so that logs diff line by line and the same run gives
-the same bytes.
+happened. `format_event` turns one record into the `events.jsonl` line of docs/outputs.md#event-log,
+with floats written one fixed way (`format_number`) so that logs diff line by line and the same run
+gives the same bytes.
 
 The event log the models write while they run is one layout for all three: rows (k, 7) int64
 (columns ROW_TICK ... ROW_YDIFF: tick, type, a, b, code, xdiff, ydiff; xdiff/ydiff -1 but in the

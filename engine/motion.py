@@ -1,4 +1,5 @@
-"""Moving objects: the paper's integer counters (SPEC 3.1, paper section II.D) and float drift.
+"""Moving objects: the paper's integer counters (docs/models.md#paper-motion, paper section II.D)
+and float drift.
 
 The paper moves an object by a whole step of `V` pixels every `P` ticks. `paper_rate` finds that
 step for a velocity v (px/s) at `fps` ticks per second: `V/P = v/fps` in lowest terms, computed

@@ -1,6 +1,6 @@
 """Frames from positions: every object drawn in id order, and redrawing only what moved.
 
-This is the picture stage (SPEC section 4). Input: the world (`WorldSpec`), the objects' drawing
+This is the picture stage (docs/drawing.md). Input: the world (`WorldSpec`), the objects' drawing
 data (`Bodies`: kind, size, colour index, fill flag, polygon vertices) and, per frame, the float
 top-left corners `pos (n, 2)` in pixels. Output: a palette-index frame `(H, W) uint8`, index 0 the
 background and `Bodies.looks.color[i]` the colour of object i; the RGB picture is `palette[frame]`

@@ -110,7 +110,8 @@ def separate(pos, size, a, b, wa, wb, code, nx, ny, depth, depth_y, width, heigh
 
 @njit(cache=True)
 def fold(x, v, span):
-    """Reflect a coordinate into [0, span] as walls would (SPEC 3.2), folding while outside.
+    """Reflect a coordinate into [0, span] as walls would (docs/models.md#stepped-walls), folding
+    while outside.
 
     x px (top-left corner), v px/s, span = world side - box side. Returns (x', v', folds_low,
     folds_high, first_low): x -> -x at the low wall, x -> 2 span - x at the high wall, v reversed

@@ -3,10 +3,10 @@
 `drive` is the one loop: it builds the model named by the scenario, advances it in chunks that end
 at every frame someone needs (and often enough to show progress and stream events), rasterises only
 those frames, and calls back with events and frames as they come. Two front ends sit on it:
-`simulate` keeps everything in memory (goldens, tests), `run_to_dir` streams the files of SPEC
-section 5 into a staging folder that replaces `OUT/NAME/` whole when the run is done, under a lock
-(`runner.output.folder`), after `runner.output.budget` has checked what its frames will cost; the
-event log is counted as it is written, and a run whose log would pass what the frames leave of
+`simulate` keeps everything in memory (goldens, tests), `run_to_dir` streams the files of
+docs/outputs.md into a staging folder that replaces `OUT/NAME/` whole when the run is done, under a
+lock (`runner.output.folder`), after `runner.output.budget` has checked what its frames will cost;
+the event log is counted as it is written, and a run whose log would pass what the frames leave of
 `--max-output-bytes` stops there with an error, its staging folder removed (the previous run stays).
 Frames are a `FrameRule`, so nothing sized by the number of ticks is built. A model that stops a run
 as a runaway (an `engine.errors.Runaway`: the exact model's event cap or an object with no room to
@@ -326,7 +326,7 @@ def run_to_dir(
     options: RunOptions,
     limits: Limits | None = None,
 ) -> tuple[Path, dict]:
-    """Run and write SPEC section 5's files as OUT/NAME; returns (that folder, the summary).
+    """Run and write the files of docs/outputs.md as OUT/NAME; returns (that folder, the summary).
 
     The frames are planned and checked against the limits first; then, holding OUT/NAME's lock,
     everything is written into a staging folder that replaces OUT/NAME whole at the end (see

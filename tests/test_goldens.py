@@ -1,4 +1,4 @@
-"""The golden tests: every scenario in scenarios/ against its golden in goldens/ (SPEC section 7).
+"""The golden tests: every scenario in scenarios/ against its golden in goldens/ (docs/goldens.md).
 
 One test per scenario file, `test_golden[fig2_case1]`, parametrised by the golden plugin
 (`runner.golden.plugin`), and the same again with the kernels compiled and interpreted

@@ -1,4 +1,4 @@
-"""The models: rule sets that move objects and resolve collisions (SPEC section 3).
+"""The models: rule sets that move objects and resolve collisions (docs/models.md).
 
 Every model is a class built as `Model(world, bodies, **options)` with the same surface:
 
@@ -28,7 +28,8 @@ from collide2d.engine.world import Bodies, WorldSpec
 MODEL_NAMES = ("paper", "stepped", "exact")
 # The exact model's default cap of wall and pair events in one tick (a runaway past it).
 MAX_EVENTS_PER_TICK = 1_000_000
-# The settings a scenario gives each model (SPEC 2 and 3): the paper model takes none.
+# The settings a scenario gives each model (docs/scenario-format.md#model): the paper model takes
+# none.
 SCENARIO_OPTIONS = {
     "paper": (),
     "stepped": ("substeps", "geometry"),

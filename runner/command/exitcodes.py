@@ -1,4 +1,5 @@
-"""The exit statuses of every `collide2d` command (SPEC section 6), one copy for all of them."""
+"""The exit statuses of every `collide2d` command (docs/command-line.md#exit-statuses), one copy for
+all of them."""
 
 EXIT_OK = 0  # fine
 EXIT_DIFFERENCE = 1  # a check found a difference (goldens), or stress found a broken invariant

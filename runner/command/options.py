@@ -1,6 +1,6 @@
 """Command-line options shared by the commands that read scenarios (run, validate, check, bless).
 
-`add_limit_arguments` / `limits_from_args` carry SPEC section 8's bounds (`--max-objects`,
+`add_limit_arguments` / `limits_from_args` carry the bounds of docs/limits.md (`--max-objects`,
 `--max-ticks`, `--max-side`, `--max-frames`, `--max-file-bytes`, `--max-yaml-nodes`, and
 `--max-output-bytes` and `--max-frame-bytes` where frames are written);
 `add_override_arguments` / `overrides_from_args` carry `--model`, `--fps`, `--ticks`, which override

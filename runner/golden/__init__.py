@@ -1,4 +1,4 @@
-"""Golden regression (SPEC section 7): keep a scenario's events, final state and frames honest.
+"""Golden regression (docs/goldens.md): keep a scenario's events, final state and frames honest.
 
 The harness has four roles, one module each: `serialize` (a run's results as the files of a golden
 folder), `store` (read a golden folder whole, swap one in whole), `compare` (pure rules: events,

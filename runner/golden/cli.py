@@ -1,4 +1,4 @@
-"""The `check` and `bless` commands (SPEC sections 6 and 7).
+"""The `check` and `bless` commands (docs/command-line.md, docs/goldens.md).
 
 Inputs: command-line arguments — scenario files or names (none: every file in `scenarios/`), the
 project root (`--root`, default the nearest folder upward with `scenarios/`), `--report DIR`,

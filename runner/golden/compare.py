@@ -1,4 +1,5 @@
-"""Golden comparison: pure functions that decide whether a run still matches its golden (SPEC §7).
+"""Golden comparison: pure functions that decide whether a run still matches its golden
+(docs/goldens.md#comparison-rules).
 
 Inputs are plain data: event objects (the dicts of `engine.events.event_dict`, as events.jsonl holds
 them), final states as (n, 4) float64 rows x, y, vx, vy, and frames as (H, W, 3) uint8 RGB. Outputs

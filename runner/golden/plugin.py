@@ -1,4 +1,5 @@
-"""The pytest plugin of the goldens: every scenario a test, `test_golden[fig2_case1]` (SPEC §7).
+"""The pytest plugin of the goldens: every scenario a test, `test_golden[fig2_case1]`
+(docs/goldens.md#pytest).
 
 Registered through the `pytest11` entry point of the distribution, so it loads in the pytest run of
 any project that installs collide2d. Inputs: the scenario files of the project (`ROOT/scenarios/`,

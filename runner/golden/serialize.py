@@ -1,4 +1,5 @@
-"""Golden serialisation: a run's results as the bytes of a golden folder, and back (SPEC section 7).
+"""Golden serialisation: a run's results as the bytes of a golden folder, and back
+(docs/goldens.md).
 
 Inputs are what a run hands over: the event records (`engine.events.EVENT_DTYPE`), the final
 positions and velocities ((n, 2) float64 each) and the golden frames ((H, W, 3) uint8 RGB). Outputs

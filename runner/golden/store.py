@@ -1,4 +1,5 @@
-"""Golden storage: find the project, read a golden folder whole, swap one in whole (SPEC §7, §8).
+"""Golden storage: find the project, read a golden folder whole, swap one in whole
+(docs/goldens.md).
 
 Inputs: the project root (the nearest folder upward that has `scenarios/`) and, for a write, the
 files of one golden as relative path -> bytes (from `serialize`). Outputs: `Golden` records read
@@ -49,7 +50,7 @@ NEW, OLD = "new", swapdir.OLD
 _NAME_RE = re.compile(NAME_PATTERN)
 # Values of CI that mean "not in CI".
 _CI_OFF = ("", "0", "false", "no")
-# The largest golden file read, in bytes (a golden folder stays within a few MB, SPEC §7).
+# The largest golden file read, in bytes (a golden folder stays within a few MB, docs/goldens.md).
 MAX_FILE_BYTES = 64 * 1024 * 1024
 # The most pixels a golden frame may have when the run's own frames are smaller: a PNG header
 # past this (or past the run's largest frame) is refused before anything is decoded.

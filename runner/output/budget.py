@@ -2,7 +2,7 @@
 
 `plan_frames` turns a scenario and the run's options into the frames to draw (`FrameRule`s for the
 PNG files and for the drawing loop) and refuses, with the option to change, a run whose frames
-would pass a limit of SPEC section 8: more frame files than `--max-frames`, more bytes on disk than
+would pass a limit of docs/limits.md: more frame files than `--max-frames`, more bytes on disk than
 `--max-output-bytes`, a frame larger in memory than `--max-frame-bytes`, or a GIF larger than the
 format allows. Everything is arithmetic on the rules, so a billion-tick run is judged without a
 list of its frames.

@@ -1,4 +1,4 @@
-"""The files a run writes (SPEC section 5): PNG frames, GIF, events.jsonl, final.csv, summary.json.
+"""The files a run writes (docs/outputs.md): PNG frames, GIF, events.jsonl, final.csv, summary.json.
 
 Input: RGB pictures `(H, W, 3) uint8`, palette-index frames `(H, W) uint8` with the scenario's
 palette `(k, 3) uint8`, event records (`engine.events.EVENT_DTYPE`), final positions and

@@ -1,4 +1,4 @@
-"""The bounds on what a scenario may ask for (SPEC section 8), each one a command-line option.
+"""The bounds on what a scenario may ask for (docs/limits.md), each one a command-line option.
 
 `Limits` is read by the safe YAML reader (`runner.scenario.parse`: file size, YAML values, aliases),
 by the scenario readers (objects, ticks, world sides, frames) and by the run

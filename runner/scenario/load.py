@@ -1,4 +1,5 @@
-"""Scenario files: YAML text in, a validated `Scenario` out (SPEC sections 2 and 8), and its schema.
+"""Scenario files: YAML text in, a validated `Scenario` out (docs/scenario-format.md,
+docs/limits.md), and its schema.
 
 `load(path)` and `loads(text)` read a scenario, apply the command line's overrides (`model`, `fps`,
 `ticks`, `max_events_per_tick`), check everything, and return a frozen `Scenario`: the world, the

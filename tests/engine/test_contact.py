@@ -136,8 +136,9 @@ def test_box_penetration_is_the_smallest_push_apart():
 
 
 def test_stepped_axis_follows_the_smaller_overlap_width_when_the_motion_cannot_tell():
-    # B (2 x 20) sits inside A's x-range: overlap widths 2 (x) and 8 (y) -> axis x (SPEC 3.2),
-    # and the push along x that parts them is the distance to A's nearer side face.
+    # B (2 x 20) sits inside A's x-range: overlap widths 2 (x) and 8 (y) -> axis x
+    # (docs/models.md#stepped-contact-normal-and-push), and the push along x that parts them is the
+    # distance to A's nearer side face.
     depth, depth_y, code, nx, ny = box_overlap_axis(40.0, 2.0, 100.0, 10.0, 2.0, 20.0)
     assert (code, nx, depth) == (AXIS_X, -1.0, 42.0)
     assert box_overlap_axis(10.0, 0.0, 10.0, 10.0, 10.0, 10.0)[0] == 0.0

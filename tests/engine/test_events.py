@@ -1,4 +1,4 @@
-"""Event records and their one fixed text form (SPEC section 5)."""
+"""Event records and their one fixed text form (docs/outputs.md#event-log)."""
 
 import json
 

@@ -1,5 +1,5 @@
-"""The exact model (SPEC 3.3): analytic outcomes, exact collision counts, invariants, a brute-force
-rational checker, no overlap, no tunnelling, ordering, the event cap and determinism."""
+"""The exact model (docs/models.md#exact): analytic outcomes, exact collision counts, invariants, a
+brute-force rational checker, no overlap, no tunnelling, ordering, the event cap and determinism."""
 
 import hashlib
 import math

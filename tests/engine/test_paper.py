@@ -1,5 +1,5 @@
-"""The paper model (SPEC 3.1): counters, walls, the flip rule, undo once, and exactness of the
-broad phase against a plain all-pairs reference written straight from the SPEC."""
+"""The paper model (docs/models.md#paper): counters, walls, the flip rule, undo once, and exactness
+of the broad phase against a plain all-pairs reference written straight from docs/models.md."""
 
 from __future__ import annotations
 
@@ -28,7 +28,7 @@ def pairs_of(events):
     ]
 
 
-# --- a reference written from SPEC 3.1 with Fractions and a plain all-pairs loop
+# --- a reference written from docs/models.md#paper with Fractions and a plain all-pairs loop
 
 
 def reference(pos, size, vel, fps, world, ticks, static=None):

@@ -1,5 +1,6 @@
-"""The stepped model (SPEC 3.2): analytic outcomes, invariants, walls, statics, determinism, and
-the broad phase and skips changing nothing against a plain all-pairs version of the model."""
+"""The stepped model (docs/models.md#stepped): analytic outcomes, invariants, walls, statics,
+determinism, and the broad phase and skips changing nothing against a plain all-pairs version of the
+model."""
 
 import numpy as np
 import pytest
@@ -561,7 +562,8 @@ def test_profile_runs_the_same_ticks_as_advance():
     assert a.advance(20).tobytes() == b.advance(20).tobytes()
 
 
-# --- the normal sees the motion: no tunnelling below one box size per step (SPEC 3.2)
+# --- the normal sees the motion: no tunnelling below one box size per step
+# (docs/models.md#stepped-pairs)
 
 
 @settings(max_examples=60, deadline=None)

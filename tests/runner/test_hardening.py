@@ -1,6 +1,7 @@
-"""Bad input and hard stops (SPEC section 8): the safe loader, bounded aliases, sizes refused before
-anything is allocated, names that cannot leave the output folder, nothing written on a refusal,
-whole files after a killed run, runaways as clear errors, and the same bytes in another process."""
+"""Bad input and hard stops (docs/limits.md#reading-yaml-safely): the safe loader, bounded aliases,
+sizes refused before anything is allocated, names that cannot leave the output folder, nothing
+written on a refusal, whole files after a killed run, runaways as clear errors, and the same bytes
+in another process."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
-"""Every number in a scenario is in range or refused at its place (SPEC section 8), and every run
-ends in finite figures.
+"""Every number in a scenario is in range or refused at its place (docs/limits.md#numbers), and
+every run ends in finite figures.
 
 Numbers of any length and YAML form are refused past `MAX_NUMBER_CHARS` characters at a cost
 linear in the text (time and memory measured here, with libyaml's parser and with the pure Python

@@ -1,4 +1,5 @@
-"""Scenario loading: every refusal of SPEC sections 2 and 8 at its FILE:LINE:COL, and what loads."""
+"""Scenario loading: every refusal of docs/scenario-format.md and docs/limits.md at its
+FILE:LINE:COL, and what loads."""
 
 from __future__ import annotations
 

@@ -1,4 +1,5 @@
-"""The `exact` model (SPEC 3.3): event-driven elastic collisions, the reference for every result.
+"""The `exact` model (docs/models.md#exact): event-driven elastic collisions, the reference for
+every result.
 
 Input: the world, the `Bodies` (copied) and the options `geometry` ("exact", the default, also
 for None: circles and polygons by their real shapes; "box": every object as its box),

@@ -1,4 +1,5 @@
-"""The paper's model, reproduced exactly in integers (SPEC 3.1; paper sections II.D-II.F).
+"""The paper's model, reproduced exactly in integers (docs/models.md#paper; paper sections
+II.D-II.F).
 
 Inputs: a WorldSpec and Bodies whose positions, sizes and velocities the scenario loader has already
 checked (whole pixels; every velocity a whole number of pixels per whole number of ticks). Output:
@@ -132,10 +133,10 @@ _kernel = njit(cache=True, _nrt=False)
 
 @njit(cache=True, inline="always")
 def _move(pos, step, period, count, disp, fence, room, first, last, tick, log, ev, n_ev):
-    """Move and walls for objects first ... last-1, object by object in id order (SPEC 3.1):
-    counters rise by one and a component whose counter reaches its period moves by its step; one
-    that left the world moving outward reverses and takes that step back (a wall event, logged
-    from row n_ev on).
+    """Move and walls for objects first ... last-1, object by object in id order
+    (docs/models.md#paper-walls): counters rise by one and a component whose counter reaches its
+    period moves by its step; one that left the world moving outward reverses and takes that step
+    back (a wall event, logged from row n_ev on).
 
     room (n, 2) = world side - box side; fence (n, 4) = [x lo, x hi, y lo, y hi], the positions
     each object may hold while the candidate list lasts. Returns (event rows, whether any object is
@@ -305,7 +306,8 @@ def _near_split(keys, n_keys, near, reach, found):
 
 @njit(cache=True, inline="always")
 def _pairs(pos, size, step, disp, near, n_near, tick, log, ev, n_ev, st):
-    """The flip rule on every overlapping pair of `near`, in (a, b) order (SPEC 3.1)."""
+    """The flip rule on every overlapping pair of `near`, in (a, b) order
+    (docs/models.md#paper-pairs)."""
     for c in range(n_near):
         a = near[c] >> KEY_SHIFT
         b = near[c] & KEY_MASK

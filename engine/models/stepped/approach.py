@@ -1,4 +1,5 @@
-"""The stepped model's contact after a step (SPEC 3.2): its normal from the direction of approach.
+"""The stepped model's contact after a step (docs/models.md#stepped-contact-normal-and-push): its
+normal from the direction of approach.
 
 A step of dt seconds ends with B's corner at offset q from A's, moving at u relative to A. The pair
 is swept back along u to where it was dt ago (`contact.box_sweep`, `contact.sweep`): when its
@@ -22,7 +23,7 @@ def box_clip(qx, qy, ux, uy, wa, ha, wb, hb, dt):
     cut a corner of each other within the step: their overlap (of positive length, beyond TIE_PX
     of travel) began and ended within it, and it left by the other axis than it came in by. A
     pair that passes wholly through the other along one axis within a step is no clip: that is
-    tunnelling, the stepped model's own (SPEC 3.2)."""
+    tunnelling, the stepped model's own (docs/models.md#stepped-pairs)."""
     x0, x1 = _slab(qx - ux * dt, ux, -wb, wa)
     y0, y1 = _slab(qy - uy * dt, uy, -hb, ha)
     t_enter = max(x0, y0)
@@ -36,8 +37,9 @@ def box_clip(qx, qy, ux, uy, wa, ha, wb, hb, dt):
 
 @njit(cache=True)
 def box_overlap_axis(qx, qy, wa, ha, wb, hb):
-    """The stepped model's box contact when the motion cannot tell (SPEC 3.2; box_step_contact):
-    (depth, depth_y, code, nx, ny).
+    """The stepped model's box contact when the motion cannot tell
+    (docs/models.md#stepped-contact-normal-and-push; box_step_contact): (depth, depth_y, code, nx,
+    ny).
 
     The axis is that of the smaller overlap width (the paper's xdiff/ydiff; both on a tie, AXIS_XY).
     depth is the push along the normal that parts the boxes (for AXIS_XY the push along x, and
@@ -62,8 +64,9 @@ def box_overlap_axis(qx, qy, wa, ha, wb, hb):
 
 @njit(cache=True)
 def box_step_contact(qx, qy, ux, uy, wa, ha, wb, hb, dt):
-    """The stepped model's box contact over a step of dt seconds that ends at offset q (SPEC
-    3.2): (push, push_y, code, nx, ny); push 0 when there is none.
+    """The stepped model's box contact over a step of dt seconds that ends at offset q
+    (docs/models.md#stepped-contact-normal-and-push): (push, push_y, code, nx, ny); push 0 when
+    there is none.
 
     The pair is swept back along its relative velocity u to where it was dt ago (box_sweep). When
     its boxes started overlapping during this step or the one before (they overlap now, or cut a
@@ -100,8 +103,9 @@ def box_step_contact(qx, qy, ux, uy, wa, ha, wb, hb, dt):
 
 @njit(cache=True)
 def step_contact(qx, qy, ux, uy, dt, ka, wa, ha, ra, va, na, kb, wb, hb, rb, vb, nb):
-    """The stepped model's contact of two exact shapes over a step of dt seconds that ends at
-    offset q (SPEC 3.2): (push, push_y, code, nx, ny); push 0 when there is none.
+    """The stepped model's contact of two exact shapes over a step of dt seconds that ends at offset
+    q (docs/models.md#stepped-contact-normal-and-push): (push, push_y, code, nx, ny); push 0 when
+    there is none.
 
     As box_step_contact: when the line q + u t swept back dt seconds enters M during the step
     (sweep), the normal is that of the direction of approach where it enters, and push is twice

@@ -1,4 +1,4 @@
-"""The `stepped` model (SPEC 3.2): fixed-step elastic collisions with float state.
+"""The `stepped` model (docs/models.md#stepped): fixed-step elastic collisions with float state.
 
 Input: the world, the `Bodies` (copied: the model owns its state) and the options `substeps`
 (each tick split into that many equal steps of 1/(fps·substeps) s) and `geometry` ("box", the

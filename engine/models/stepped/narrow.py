@@ -57,7 +57,7 @@ from collide2d.engine.threads import join_shares, shares_total
 def _swept_back(body, i, dt, sides):
     """Whether object i, moved back dt seconds on a straight line, is where it started the step:
     inside the world of `sides` (width, height) px (an object that folded at a wall this step is
-    not, SPEC 3.2)."""
+    not, docs/models.md#stepped-pairs)."""
     x = body[i, B_X] - body[i, B_VX] * dt
     y = body[i, B_Y] - body[i, B_VY] * dt
     span_x = max(sides[0] - body[i, B_W], 0.0)

@@ -1,5 +1,5 @@
 """runner.bench.error: the error measures against the exact model, the Pareto front, and the
-stepped model converging on exact as substeps grow (SPEC 3.2)."""
+stepped model converging on exact as substeps grow (docs/models.md#stepped)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,5 @@
-"""Tests of the goldens against a hostile tree (SPEC section 8): links, escaping paths, bombs.
+"""Tests of the goldens against a hostile tree (docs/goldens.md#confinement-and-hostile-goldens):
+links, escaping paths, bombs.
 
 `check`, `bless` and `check --report` on a project of synthetic scenarios whose goldens/ or report
 folder hold symbolic links, manifests naming paths outside the golden, and golden files built to
