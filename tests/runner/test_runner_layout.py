@@ -63,12 +63,14 @@ KNOWN = set(RUNNER_MODULES) | set(sources(ROOT / "engine", "collide2d.engine"))
 
 def imported(path: Path) -> set[str]:
     """The project's modules an import statement of the file names: `from a import b` names a.b
-    when that is a module, else a."""
+    when that is a module, else a. (`main` loads the commands' packages by name, with importlib:
+    not an import statement.)"""
     names = set()
     for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
         if isinstance(node, ast.Import):
             names.update(alias.name for alias in node.names)
-        elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
+        elif isinstance(node, ast.ImportFrom):
+            assert not node.level, f"{path}:{node.lineno}: a relative import, unchecked here"
             for alias in node.names:
                 full = f"{node.module}.{alias.name}"
                 names.add(full if full in KNOWN else node.module)
