@@ -4,7 +4,7 @@ local `dask scheduler`, against the runs done one after another in this process.
     python benchmarks/sweep_scaling.py [--runs 200] [--ticks 1000] [--repeats 3]
 
 The sweep is RUNS runs of scenarios/paper_fifty_boxes.yaml at TICKS ticks (seeds 1..RUNS), each
-run as a sweep worker does it (`runner.sweep.runs.run_one`: the per-tick checked run, then the
+run as a sweep worker does it (`runner.sweep.worker.run_one`: the per-tick checked run, then the
 timed run). Figures, medians of REPEATS, clusters started and warmed up (every kernel loaded in
 every worker) before timing, one cluster at a time, the serial runs timed between them,
 reported as medians and as the fastest of the repeats:
@@ -43,7 +43,7 @@ def _runs(n: int, ticks: int):
 
 
 def _first_run_s(scenario) -> float:
-    from collide2d.runner.sweep.runs import run_one
+    from collide2d.runner.sweep.worker import run_one
 
     began = time.perf_counter()
     run_one(scenario)
@@ -119,7 +119,7 @@ def main() -> int:
     from distributed import Client
 
     from collide2d.runner.sweep import cluster
-    from collide2d.runner.sweep.runs import run_one
+    from collide2d.runner.sweep.worker import run_one
 
     began = time.perf_counter()
     runs = _runs(args.runs, args.ticks)

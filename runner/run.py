@@ -42,12 +42,12 @@ from collide2d.engine.events import empty_events
 from collide2d.engine.invariants import kinetic_energy, momentum
 from collide2d.engine.raster import Renderer
 from collide2d.runner import compiling, lanes
-from collide2d.runner.command.progress import Progress
 from collide2d.runner.output import budget
 from collide2d.runner.output import files as outputs
 from collide2d.runner.output import folder as rundir
 from collide2d.runner.output import viewerdata as viewer
 from collide2d.runner.output.overlay import Overlay
+from collide2d.runner.output.progress import Progress
 from collide2d.runner.scenario.frames import FrameRule
 from collide2d.runner.scenario.limits import Limits
 from collide2d.runner.scenario.load import Scenario, ScenarioError

@@ -45,4 +45,8 @@ that each measure lasts at least 0.5 s, medians of 5 interleaved repeats (A/B/A)
 noisy past a 20 % spread; the headline rows give each target and whether it was met. Quote ratios
 from one run: absolute times move with the machine and its load. `--quick` shrinks every part
 (small N, short runs and measures, in-process timing) to seconds, for tests.
+
+It may import what the command line may (`collide2d.engine`, `runner.lanes`, `runner.compiling`,
+`runner.scenario`, `runner.output`, `runner.run`) and the command line's shared parts
+(`runner.command`: options, exit statuses); the command line loads it by name.
 """

@@ -1,5 +1,14 @@
-"""The command line and the project's settings: parsing and dispatch, the shared options,
-`[tool.collide2d]`, `init`, `config`, `validate`, the exit statuses and progress bars.
+"""The command line and the project's settings: parsing, dispatch and the exit statuses.
 
-It may import everything else of the runner; nothing under `scenario` or `output` imports it,
-except for the exit statuses and the progress bar, which are leaves."""
+`main` parses the command line, runs a command and maps its errors to exit statuses
+(`exitcodes`); `options` holds the options shared by the commands that read scenarios, `settings`
+a project's `[tool.collide2d]` table; `validate` (`validate`, `schema`), `newproject` (`init`) and
+`showconfig` (`config`) are commands; `crashwatch` makes a process killed by a fatal signal say so.
+The commands with a package of their own (`runner.golden`, `runner.stress`, `runner.bench`,
+`runner.sweep`) are loaded by name, only when their command runs.
+
+It may import `collide2d.engine`, `runner.lanes`, `runner.compiling`, `runner.scenario`,
+`runner.output` and `runner.run`: everything below the command line. Only `python -m collide2d`
+and the commands with a package of their own import it (the exit statuses, the shared options,
+the settings).
+"""

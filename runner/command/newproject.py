@@ -14,7 +14,7 @@ table, an array of tables or a value. Refused too (`FILE: error: ...`): a file r
 symbolic link (of the file or of a folder on its way) that leads outside the project folder (one
 that stays inside is written at the link's target, the link kept), and a folder, FIFO or device in
 place of a file (never opened). Every refusal comes before anything is written, and the files are
-written all or nothing (`runner.command.filebatch`): when one cannot be written (a full disk), none
+written all or nothing (`runner.output.filebatch`): when one cannot be written (a full disk), none
 is changed and the error names it (exit 2).
 """
 
@@ -29,7 +29,7 @@ from importlib import resources
 from pathlib import Path
 
 from collide2d.runner.command.exitcodes import EXIT_OK
-from collide2d.runner.command.filebatch import FileBatch
+from collide2d.runner.output.filebatch import FileBatch
 from collide2d.runner.scenario.parse import OptionError
 
 EXAMPLE = "example.yaml"

@@ -2,9 +2,14 @@
 
 The harness has four roles, one module each: `serialize` (a run's results as the files of a golden
 folder), `store` (read a golden folder whole, swap one in whole), `compare` (pure rules: events,
-final state, frames) and `report` (console text, images, JSON and HTML). `session` joins them for
-one scenario (`check_run`, `bless_run`); `cli` (the `check` and `bless` commands) and `plugin`
-(pytest) drive it. This module only re-exports what its users import.
+final state, frames) and `report` (console text, images, JSON; `page`, the HTML page). `session`
+joins them for one scenario (`check_run`, `bless_run`); `cli` (the `check` and `bless` commands) and
+`plugin` (pytest) drive it. This module only re-exports what its users import.
+
+It may import what the command line may (`collide2d.engine`, `runner.lanes`, `runner.compiling`,
+`runner.scenario`, `runner.output`, `runner.run`), the command line's shared parts
+(`runner.command`: options, settings, exit statuses) and `runner.sweep` (`check` on a cluster); the
+command line loads it by name, pytest through `plugin`.
 """
 
 from collide2d.runner.golden.session import (

@@ -10,7 +10,7 @@ texts of events and final state when those differ. Outputs:
   `_diff.png` per differing frame (the diff: differing pixels in magenta, pixels changed within the
   colour threshold in amber, over the run's frame dimmed to grey), the golden and run event logs or
   final states when they differ, `summary.json`, a self-contained `index.html` (see
-  `reportpage`) and `run/`, the golden files this run would bless (`bless --from-report`);
+  `page`) and `run/`, the golden files this run would bless (`bless --from-report`);
 - `write_index(DIR, outcomes, unused)`: `DIR/summary.json` and `DIR/index.html` over all scenarios.
 
 Pages hold their images inline and load nothing from the network, so a page can be mailed, a report
@@ -28,16 +28,13 @@ from pathlib import Path
 
 import numpy as np
 
-from collide2d.runner.golden import reportpage
+from collide2d.runner.golden import page
 from collide2d.runner.golden.compare import FrameDiff
 from collide2d.runner.golden.store import GoldenError, link_message, shown_path
 from collide2d.runner.output.files import atomic_write_bytes, encode_png, write_json
 
 REPORT_FORMAT = 1
 # Diff image colours (RGB) and how bright the grey copy of the frame under them is (0..1).
-DIFF_COLOR = (255, 0, 255)
-WITHIN_THRESHOLD_COLOR = (255, 176, 0)
-DIM_LEVEL = 0.35
 # In a scenario's report folder: the golden files of the run checked (what a bless would write).
 RUN_DIR = "run"
 MANIFEST_FILE = "manifest.json"
@@ -181,20 +178,6 @@ def _frame_summary(fr: FrameReport, base: Path | None) -> dict:
     return d
 
 
-def diff_image(fr: FrameReport) -> np.ndarray | None:
-    """(H, W, 3) uint8: the run's frame in dim grey (its brightest channel times DIM_LEVEL),
-    pixels changed within the colour threshold in WITHIN_THRESHOLD_COLOR, differing pixels in
-    DIFF_COLOR. None when there is nothing to overlay (sizes differ or one side is missing)."""
-    d = fr.diff
-    if d is None or d.size_mismatch or d.mask is None:
-        return None
-    grey = fr.actual.max(axis=2).astype(np.float64) * DIM_LEVEL
-    out = np.repeat(grey.astype(np.uint8)[:, :, None], 3, axis=2)
-    out[d.changed & ~d.mask] = WITHIN_THRESHOLD_COLOR
-    out[d.mask] = DIFF_COLOR
-    return out
-
-
 def write_scenario(report_dir, outcome: Outcome) -> Path:
     """Write `report_dir/NAME/` for a failed outcome (images, texts, summary.json, index.html);
     sets `outcome.report` and each frame's `paths`; returns the index.html path."""
@@ -202,7 +185,7 @@ def write_scenario(report_dir, outcome: Outcome) -> Path:
     folder = _real_folder(Path(report_dir) / outcome.name)
     for fr in outcome.frames:
         stem = f"frame_{fr.frame:06d}"
-        images = {"expected": fr.expected, "actual": fr.actual, "diff": diff_image(fr)}
+        images = {"expected": fr.expected, "actual": fr.actual, "diff": page.diff_image(fr)}
         for kind, rgb in images.items():
             if rgb is not None:
                 path = folder / f"{stem}_{kind}.png"
@@ -215,8 +198,7 @@ def write_scenario(report_dir, outcome: Outcome) -> Path:
     write_json(folder / SUMMARY_FILE, outcome.summary(folder))
     if outcome.run_files:
         _write_run_files(folder / RUN_DIR, outcome.run_files)
-    page = reportpage.page(f"collide2d golden: {outcome.name}", [outcome])
-    _write(outcome.report, page)
+    _write(outcome.report, page.page(f"collide2d golden: {outcome.name}", [outcome]))
     return outcome.report
 
 
@@ -238,7 +220,7 @@ def summary_dict(outcomes, unused=(), base: Path | None = None, errors=()) -> di
     outcomes = sorted(outcomes, key=lambda o: o.name)
     out = {
         "format": REPORT_FORMAT,
-        "summary": reportpage.summary_line(outcomes),
+        "summary": page.summary_line(outcomes),
         "passed": sum(o.ok for o in outcomes),
         "failed": sum(not o.ok for o in outcomes),
         "scenarios": [o.summary(base) for o in outcomes],
@@ -270,7 +252,7 @@ def write_index(report_dir, outcomes, unused=(), errors=()) -> Path:
     _refuse_link(folder / SUMMARY_FILE)
     write_json(folder / SUMMARY_FILE, summary)
     index = folder / INDEX_FILE
-    _write(index, reportpage.page("collide2d golden check", outcomes, list(unused)))
+    _write(index, page.page("collide2d golden check", outcomes, list(unused)))
     return index
 
 

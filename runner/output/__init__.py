@@ -1,5 +1,13 @@
-"""What a run writes and where: the files, the run folder and its swap, overlays, the viewer
-and the output budget.
+"""What the runner writes and shows, and where: files written whole, folders swapped in whole.
 
-It may import `collide2d.engine` (drawing) and `collide2d.runner.scenario.load` (the settings a
-scenario gives its outputs); the command line and the run import it, never the other way."""
+`files` writes a run's files (PNG frames, GIF, event log, final state, summary), each whole through
+a temporary name; `filebatch` writes a few files all or nothing; `folder` keeps one run per output
+folder (the lock, the staging folder) and `swap` swaps a staged folder in whole; `budget` decides
+before the first tick what a run's frames will cost; `overlay` draws the debug overlays into
+frames; `viewerdata` and `viewerpage` make the run viewer; `progress` is the bar on a terminal;
+`escape` makes text safe for a terminal, a page, an XML file or a spreadsheet cell.
+
+It may import `collide2d.engine` (drawing) and `runner.scenario` (what a scenario asks of its
+outputs) and nothing else of the runner: the run, the command line and the commands under it
+import it, never the other way.
+"""

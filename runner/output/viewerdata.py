@@ -34,7 +34,6 @@ import numpy as np
 from collide2d.engine.events import EV_WALL, event_dict
 from collide2d.engine.raster import round_positions
 from collide2d.engine.sprites import sprites
-from collide2d.runner.output import escape
 from collide2d.runner.scenario.load import ScenarioError
 
 VIEWER_FILE = "viewer.html"
@@ -151,12 +150,6 @@ class Recorder:
 
     def page(self) -> bytes:
         """viewer.html bytes."""
-        from collide2d.runner.output.viewerpage import page
+        from collide2d.runner.output.viewerpage import page  # its text loads only when asked for
 
         return page(self.data())
-
-
-def data_json(data: dict) -> str:
-    """JSON of the viewer's data safe inside a <script> element (`escape.script_json`: no name
-    can end the element or open a comment in it)."""
-    return escape.script_json(data)

@@ -1,7 +1,8 @@
 """The run viewer's page: one HTML file with its data, styles and script inline, no network.
 
-`page(data)` takes `runner.output.viewerdata.Recorder.data()` and returns `viewer.html`. The script
-inflates the positions with the browser's `DecompressionStream`, then draws each frame the way
+`page(data)` takes `runner.output.viewerdata.Recorder.data()` and returns `viewer.html`, the data
+inline as JSON that cannot end its `<script>` element (`escape.script_json`). The script inflates
+the positions with the browser's `DecompressionStream`, then draws each frame the way
 `engine.raster` does: the background, then every object's sprite pixels in id order at its rounded
 position, clipped to the world, into an ImageData at the world's size; that picture is scaled by the
 zoom (whole factors, no smoothing) onto the canvas and the overlays are drawn over it. At zoom 1
@@ -20,7 +21,7 @@ from __future__ import annotations
 
 import html
 
-from collide2d.runner.output.viewerdata import data_json
+from collide2d.runner.output import escape
 
 FLASH_FRAMES = 4
 ZOOMS = (1, 2, 3, 4, 6, 8, 12, 16)
@@ -63,7 +64,7 @@ def page(data: dict) -> bytes:
 <div id="side"><div id="hover" class="dim">hover an object to name it</div>
 <h3>Events <span class="dim" id="event-count"></span></h3><ol id="events"></ol></div></div>
 <p id="status" class="dim">loading…</p>
-<script id="data" type="application/json">{data_json(data)}</script>
+<script id="data" type="application/json">{escape.script_json(data)}</script>
 <script>{_JS.replace("FLASH_FRAMES", str(FLASH_FRAMES))}</script>
 </body></html>
 """

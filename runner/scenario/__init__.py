@@ -1,6 +1,14 @@
-"""Reading and checking a scenario file: safe YAML, the fast lane, typed nodes, objects,
-generate blocks, tables, the output and golden sections, frame rules, colours, limits, the
-JSON Schema, and the assembly into arrays.
+"""Reading and checking a scenario file, from its bytes to the arrays a model runs.
 
-It may import `collide2d.engine` (the world's arrays, the models' rules) and nothing else of the
-runner: the command line, the run and the writers read scenarios, never the other way."""
+`load` joins the rest: a file in, a checked `Scenario` out. The file is read safely and its YAML
+composed into a located node tree (`parse`), or a long object list read by column (`fastlane`);
+`nodes` reads typed, located values; `objects` checks listed objects and `generate` blocks,
+`generate` places generated boxes and checks overlap at the start, `table` and `tableread` read
+objects from CSV or `.npy` tables; `sections` reads the output and golden sections, `frames` the
+rule of which frames a run draws, `colors` the colours; `limits` holds the bounds on what a file
+may ask for, `schema` the JSON Schema, and `assemble` turns the checked objects into arrays.
+
+It may import `collide2d.engine` (the world's arrays, the models' rules) and `runner.lanes` (the
+lane of the kernels a load runs) and nothing else of the runner: the run, the writers and the
+command line read scenarios, never the other way.
+"""

@@ -16,7 +16,7 @@ parsed. Columns, by name (any order; only id, shape, w, h, x, y are required):
     static true | false (default false)
     fill   true | false (default false)
 
-The file is read once (`runner.scenario.readfile`: a regular file within `--max-file-bytes`) and its
+The file is read once (`parse.read_regular`: a regular file within `--max-file-bytes`) and its
 bytes go to `runner.scenario.tableread`, which makes one structured array of them: a CSV file (a
 header row of column names, then one row per object, fields separated by commas, a field holding a
 comma quoted with ", blank lines skipped, lines ending in LF, CRLF or CR) by `numpy.loadtxt` in a
@@ -48,7 +48,7 @@ from collide2d.engine import motion
 from collide2d.engine.world import KIND_BOX, KIND_CIRCLE
 from collide2d.runner.scenario import colors
 from collide2d.runner.scenario.limits import Limits
-from collide2d.runner.scenario.readfile import read_regular
+from collide2d.runner.scenario.parse import read_regular
 from collide2d.runner.scenario.tableread import (
     COLUMNS,
     NUMBERS,

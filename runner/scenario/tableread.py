@@ -1,9 +1,9 @@
 """A table's bytes to one structured array: the CSV and `.npy` readers of `runner.scenario.table`.
 
-Both take the file's bytes, read once (`runner.scenario.readfile`), and give a numpy structured
-array whose field names are the columns, with a `Place` that turns (row, column) into the cell's
-place for a message. Nothing is parsed before the header has been checked and the row count held
-against `--max-objects`.
+Both take the file's bytes, read once (`runner.scenario.parse.read_regular`), and give a numpy
+structured array whose field names are the columns, with a `Place` that turns (row, column) into the
+cell's place for a message. Nothing is parsed before the header has been checked and the row count
+held against `--max-objects`.
 
 CSV: UTF-8 text (an initial byte-order mark dropped); lines end in LF, CRLF or CR alone (all read as
 LF first, so the row count and every line number mean what an editor shows). The header names the

@@ -33,4 +33,8 @@ kernel (`checks.tick_figures`) and the sort-and-sweep kernel `engine.invariants.
   positions, velocities and event records, byte for byte.
 
 `--quick` runs the same scenes shorter and smaller; it fits in well under a minute.
+
+It may import what the command line may (`collide2d.engine`, `runner.lanes`, `runner.compiling`,
+`runner.scenario`, `runner.output`, `runner.run`) and the command line's shared parts
+(`runner.command`: exit statuses); the command line loads it by name.
 """

@@ -27,7 +27,7 @@ import sys
 import threading
 import uuid
 
-from collide2d.runner.command.progress import Progress
+from collide2d.runner.output.progress import Progress
 
 INSTALL = 'pip install "collide2d[dask]"'
 # Seconds a scheduler has to answer: a live one answers in milliseconds, and a typo should not

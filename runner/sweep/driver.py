@@ -3,7 +3,7 @@
 `run_sweep(client, plan)` sends the plan's runs in their sorted order (`plan.Plan.runs`) in batches
 (`batch_size`: about eight tasks per worker thread, so that a run of a few milliseconds does not
 pay the scheduler's few milliseconds per task, while the work stays spread), each task
-`runs.run_batch` on the batch's runs as (their combination's scenario, their seed), and at most
+`worker.run_batch` on the batch's runs as (their combination's scenario, their seed), and at most
 WINDOW_PER_THREAD tasks per worker thread in flight: the scenarios are loaded as their batch is
 sent (`plan.Plan.base`) and dropped when it is done, so memory does not grow with the runs. What
 comes back is kept by run number in a `results.Table`, so each row exists once however many times
@@ -21,7 +21,7 @@ import time
 
 from collide2d.runner.sweep import cluster
 from collide2d.runner.sweep.results import Table
-from collide2d.runner.sweep.runs import error_figures, run_batch
+from collide2d.runner.sweep.worker import error_figures, run_batch
 
 TASKS_PER_THREAD = 8
 MAX_BATCH = 32  # runs in one task
@@ -53,7 +53,7 @@ def run_sweep(client, plan, *, progress=None, on_row=None, batch=None) -> tuple[
 
     def take(i: int, value, error) -> None:
         runs = sent.pop(i)
-        if error is not None:  # a worker's death says why (runs.error_figures)
+        if error is not None:  # a worker's death says why (worker.error_figures)
             value = [(error_figures(error, since=started), None)] * len(runs)
         for run, (row, pos) in zip(runs, value, strict=True):
             table.take(run, row, pos)

@@ -118,7 +118,7 @@ def check(
     progress=None,
 ) -> Plan:
     """Check every run of the matrix (see the module docstring); `progress(total)` gives a bar
-    (runner.command.progress.Progress) or None."""
+    (runner.output.progress.Progress) or None."""
     limits = limits or Limits()
     count = matrix.check_axes(scenarios, axes, seeds)
     dotted = [a for a in axes if a.key not in RUN_KEYS]

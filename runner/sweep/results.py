@@ -1,6 +1,6 @@
 """The results of a sweep: one row per run, sorted by its parameters, and the files OUT/sweep/.
 
-A `Table` keeps the figures each worker measured (`runs.run_one`) by run number, a few numbers a
+A `Table` keeps the figures each worker measured (`worker.run_one`) by run number, a few numbers a
 row in arrays sized to the plan (no run's scenario, no dict per row), so its memory is a small
 fixed cost per run. The rows come out in the plan's sorted order (`plan.Plan.runs`: each run's
 parameters, `plan.Run.params`, then its figures), the same whatever the worker count or the order

@@ -15,9 +15,9 @@ import pytest
 
 from collide2d.runner.bench import report
 from collide2d.runner.command import main as cli
-from collide2d.runner.command.progress import Progress
 from collide2d.runner.output import files as outputs
 from collide2d.runner.output.escape import VisibleStream, visible_streams
+from collide2d.runner.output.progress import Progress
 from collide2d.runner.sweep import results
 
 SCENE = "version: 1\nworld: {width: 20, height: 20}\nticks: 2\nobjects: []\n"

@@ -25,8 +25,8 @@ import pytest
 import collide2d
 from collide2d.engine import jit
 from collide2d.runner import compiling
-from collide2d.runner.command import progress
 from collide2d.runner.command.main import compile_notice, main
+from collide2d.runner.output import progress
 
 ROOT = Path(__file__).resolve().parents[2]
 SMALL = """version: 1

@@ -132,7 +132,7 @@ if sys.argv[1] == "crash":
 ROWS = """
 import sys
 from distributed import KilledWorker
-from collide2d.runner.sweep.runs import error_figures
+from collide2d.runner.sweep.worker import error_figures
 for since in sys.argv[1:]:
     died = KilledWorker("collide2d-sweep-0", "tcp://127.0.0.1:1", 3)  # (task, last worker, tries)
     print(error_figures(died, since=float(since))["note"])

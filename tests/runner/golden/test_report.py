@@ -1,4 +1,4 @@
-"""Tests of runner/golden/report.py: diff images, report folders, self-contained pages."""
+"""Tests of runner/golden/report.py and page.py: diff images, report folders, whole pages."""
 
 from __future__ import annotations
 
@@ -9,7 +9,8 @@ import re
 
 import numpy as np
 
-from collide2d.runner.golden import report, reportpage
+from collide2d.runner.golden import page as golden_page
+from collide2d.runner.golden import report
 from collide2d.runner.golden.compare import compare_frame
 from collide2d.runner.golden.serialize import decode_png
 
@@ -39,15 +40,15 @@ def _failed_outcome(texts=None):
 
 def test_diff_image_highlights_exactly_the_differing_pixels():
     out = _failed_outcome()
-    img = report.diff_image(out.frames[0])
+    img = golden_page.diff_image(out.frames[0])
     assert img.shape == (4, 6, 3) and img.dtype == np.uint8
-    assert tuple(img[1, 2]) == report.DIFF_COLOR
-    assert tuple(img[3, 5]) == report.WITHIN_THRESHOLD_COLOR
-    grey = int(100 * report.DIM_LEVEL)
+    assert tuple(img[1, 2]) == golden_page.DIFF_COLOR
+    assert tuple(img[3, 5]) == golden_page.WITHIN_THRESHOLD_COLOR
+    grey = int(100 * golden_page.DIM_LEVEL)
     rest = np.ones((4, 6), bool)
     rest[1, 2] = rest[3, 5] = False
     assert (img[rest] == grey).all()
-    assert report.diff_image(out.frames[1]) is None
+    assert golden_page.diff_image(out.frames[1]) is None
 
 
 def test_scenario_report_folder(tmp_path):
@@ -59,7 +60,7 @@ def test_scenario_report_folder(tmp_path):
     assert np.array_equal(decode_png((folder / "frame_000006_expected.png").read_bytes()), e)
     assert np.array_equal(decode_png((folder / "frame_000006_actual.png").read_bytes()), a)
     diff = decode_png((folder / "frame_000006_diff.png").read_bytes())
-    assert tuple(diff[1, 2]) == report.DIFF_COLOR
+    assert tuple(diff[1, 2]) == golden_page.DIFF_COLOR
     assert sorted(out.frames[1].paths) == ["actual"]  # nothing to compare it with
     assert (folder / "events_expected.jsonl").read_bytes() == b"{}\n"
     summary = json.loads((folder / "summary.json").read_text())
@@ -98,10 +99,10 @@ def test_pages_are_self_contained_with_crops_views_and_full_frames(tmp_path):
     # frame 6: the crop (the whole 6x4 frame: smaller than the least crop) enlarged 40x as
     # golden, run and diff side by side, golden and run stacked for blink and slider, the diff
     # alone, then the full run frame; frame 9: its run frame only
-    zoom = reportpage.crop_zoom((0, 0, 6, 4))
+    zoom = golden_page.crop_zoom((0, 0, 6, 4))
     assert zoom == 16  # CROP_TARGET // 6 = 40, at most CROP_MAX_ZOOM
     big = lambda rgb: rgb.repeat(zoom, axis=0).repeat(zoom, axis=1)  # noqa: E731
-    diff = report.diff_image(out.frames[0])
+    diff = golden_page.diff_image(out.frames[0])
     expected = [big(e), big(a), big(diff), big(e), big(a), big(diff), a, a]
     assert len(images) == len(expected)
     for got, want in zip(images, expected, strict=True):
@@ -123,14 +124,14 @@ def test_pages_are_self_contained_with_crops_views_and_full_frames(tmp_path):
 
 def test_crop_surrounds_the_change_within_the_frame():
     # a 3x2 change near the right edge of a 320x240 frame
-    box = reportpage.crop_box((315, 100, 317, 101), 320, 240)
+    box = golden_page.crop_box((315, 100, 317, 101), 320, 240)
     x0, y0, x1, y1 = box
-    assert x1 == 320 and x1 - x0 == reportpage.CROP_MIN  # pushed back inside, at least CROP_MIN
-    assert y0 <= 100 - reportpage.CROP_MARGIN and y1 >= 102 + reportpage.CROP_MARGIN
-    assert y1 - y0 == reportpage.CROP_MIN
+    assert x1 == 320 and x1 - x0 == golden_page.CROP_MIN  # pushed back inside, at least CROP_MIN
+    assert y0 <= 100 - golden_page.CROP_MARGIN and y1 >= 102 + golden_page.CROP_MARGIN
+    assert y1 - y0 == golden_page.CROP_MIN
     # a large change keeps its margin
-    assert reportpage.crop_box((10, 20, 109, 59), 320, 240) == (4, 14, 116, 66)
-    assert reportpage.crop_zoom((4, 14, 116, 66)) == 2
+    assert golden_page.crop_box((10, 20, 109, 59), 320, 240) == (4, 14, 116, 66)
+    assert golden_page.crop_zoom((4, 14, 116, 66)) == 2
 
 
 def test_event_table_marks_the_first_divergence_with_context():
@@ -149,7 +150,7 @@ def test_event_table_marks_the_first_divergence_with_context():
     )
     out.first_event = 6
     assert len(ser.parse_events(out.texts["events_actual.jsonl"])) == 10
-    page = reportpage.page("t", [out]).decode()
+    page = golden_page.page("t", [out]).decode()
     table = page[page.index('<table class="events">') : page.index("</table>")]
     rows = re.findall(r'<tr class="(\w+)"><td>(\d+)</td>', table)
     assert rows == [("same", "4"), ("same", "5"), ("same", "6"), ("first", "7"),

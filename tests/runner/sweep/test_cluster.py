@@ -20,7 +20,7 @@ from interrupt import STARTED, interrupted
 
 from collide2d.runner.sweep import driver, plan, results
 from collide2d.runner.sweep.matrix import parse_set
-from collide2d.runner.sweep.runs import run_one
+from collide2d.runner.sweep.worker import run_one
 
 distributed = pytest.importorskip("distributed")
 

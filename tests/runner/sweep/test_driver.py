@@ -12,12 +12,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from collide2d.runner.command.progress import Progress
+from collide2d.runner.output.progress import Progress
 from collide2d.runner.run import drive
 from collide2d.runner.sweep import driver, plan, results
 from collide2d.runner.sweep.driver import batch_size
 from collide2d.runner.sweep.matrix import parse_set
-from collide2d.runner.sweep.runs import mark_outside, run_batch, run_one
+from collide2d.runner.sweep.worker import mark_outside, run_batch, run_one
 
 from .planned import expand
 

@@ -42,6 +42,11 @@ ZOOM_BELOW_PX = 480
 # Event rows shown before and after the first divergence.
 EVENT_CONTEXT = 3
 VIEWS = ("side", "blink", "slider", "diff")
+# The diff picture: differing pixels, pixels changed within the colour threshold, and the level of
+# the run's frame dimmed to grey beneath them.
+DIFF_COLOR = (255, 0, 255)
+WITHIN_THRESHOLD_COLOR = (255, 176, 0)
+DIM_LEVEL = 0.35
 
 
 def _html(text) -> str:
@@ -193,6 +198,22 @@ def _event_cell(ev) -> str:
     return f"{_html(compare.event_label(ev))} <small>{_html(tail)}</small>"
 
 
+def diff_image(fr) -> np.ndarray | None:
+    """The diff picture of a `report.FrameReport`, (H, W, 3) uint8: the run's frame in dim grey (its
+    brightest channel times DIM_LEVEL), pixels changed within the colour threshold in
+    WITHIN_THRESHOLD_COLOR, differing pixels in DIFF_COLOR; the report writes it as `_diff.png` and
+    the page shows it as the diff view. None when there is nothing to overlay (sizes differ or one
+    side is missing)."""
+    d = fr.diff
+    if d is None or d.size_mismatch or d.mask is None:
+        return None
+    grey = fr.actual.max(axis=2).astype(np.float64) * DIM_LEVEL
+    out = np.repeat(grey.astype(np.uint8)[:, :, None], 3, axis=2)
+    out[d.changed & ~d.mask] = WITHIN_THRESHOLD_COLOR
+    out[d.mask] = DIFF_COLOR
+    return out
+
+
 def _frame_block(name: str, fr) -> str:
     key = _html(f"{name}-{fr.frame}")
     head = f'<div class="frame" id="f-{key}" data-view="side" tabindex="-1">'
@@ -205,8 +226,6 @@ def _frame_block(name: str, fr) -> str:
             if rgb is not None
         ]
         return head + msg + '<div class="fulls">' + "".join(figures) + "</div></div>"
-    from collide2d.runner.golden.report import diff_image
-
     h, w = act.shape[:2]
     box = crop_box(d.bbox, w, h)
     zoom = crop_zoom(box)
