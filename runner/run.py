@@ -40,7 +40,7 @@ from collide2d.engine import jit, models
 from collide2d.engine.errors import Runaway
 from collide2d.engine.events import empty_events
 from collide2d.engine.invariants import kinetic_energy, momentum
-from collide2d.engine.raster import Renderer
+from collide2d.engine.picture.raster import Renderer
 from collide2d.runner import compiling, lanes
 from collide2d.runner.output import budget
 from collide2d.runner.output import files as outputs

@@ -62,7 +62,7 @@ def _frames_per_second(renderer, path: np.ndarray, full: bool, repeats: int) -> 
 
 def raster(quick: bool, echo, folder: Path = PROJECT_SCENARIOS) -> list[dict]:
     """One row per measure (the demo is read from `folder`)."""
-    from collide2d.engine.raster import Renderer, to_rgb
+    from collide2d.engine.picture.raster import Renderer, to_rgb
     from collide2d.runner.output import files as outputs
     from collide2d.runner.scenario.load import load
 

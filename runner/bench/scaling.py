@@ -60,7 +60,7 @@ def scaling(
 
 
 def _scaling_row(model, n, target, probe_s, repeats, in_process, tmp: Path, echo, peer) -> dict:
-    from collide2d.engine.raster import Renderer
+    from collide2d.engine.picture.raster import Renderer
     from collide2d.runner.scenario.load import loads
 
     text = standard_scene(n, model)

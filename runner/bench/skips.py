@@ -26,7 +26,7 @@ SKIP_STATICS = 4000
 def skips(quick: bool, echo, folder: Path = PROJECT_SCENARIOS) -> list[dict]:
     """Each skip's work with and without it (see the module docstring); the scenario files are
     read from `folder`."""
-    from collide2d.engine.raster import Renderer
+    from collide2d.engine.picture.raster import Renderer
     from collide2d.engine.world import Bodies
     from collide2d.runner.run import drive
     from collide2d.runner.scenario.load import load

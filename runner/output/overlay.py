@@ -31,10 +31,10 @@ from __future__ import annotations
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
-from collide2d.engine.draw import dda_line, midpoint_circle
 from collide2d.engine.events import EV_PAIR, EV_WALL
-from collide2d.engine.raster import round_positions
-from collide2d.engine.sprites import sprites
+from collide2d.engine.picture.pixels import dda_line, midpoint_circle
+from collide2d.engine.picture.raster import round_positions
+from collide2d.engine.picture.sprites import sprites
 from collide2d.runner.output import escape
 from collide2d.runner.scenario.load import ScenarioError
 from collide2d.runner.scenario.sections import OVERLAY_NAMES

@@ -7,8 +7,10 @@ canvas. A `Recorder` is handed each tick's model by the driver loop (`runner.run
 
 What the file holds, as JSON in the page:
 - the world (size, fps, ticks, background colour) and per object its name, RGB colour and kind;
-- the sprites (`engine.sprites`): each object's pixels relative to its rounded position, exactly
-  the pixels `engine.raster` draws, so the canvas at zoom 1 shows the PNG frames' very pixels;
+- the sprites (`engine.picture.sprites`): each object's pixels relative to its rounded position,
+exactly
+  the pixels `engine.picture.raster` draws, so the canvas at zoom 1 shows the PNG frames' very
+  pixels;
 - positions: the rounded pixel position of every object at every frame (0..ticks), as int32,
   object by object, each series stored as its first value then differences, zlib-compressed and
   base64-encoded (steady motion is a run of equal differences, which deflate squeezes to almost
@@ -32,8 +34,8 @@ import zlib
 import numpy as np
 
 from collide2d.engine.events import EV_WALL, event_dict
-from collide2d.engine.raster import round_positions
-from collide2d.engine.sprites import sprites
+from collide2d.engine.picture.raster import round_positions
+from collide2d.engine.picture.sprites import sprites
 from collide2d.runner.scenario.load import ScenarioError
 
 VIEWER_FILE = "viewer.html"

@@ -3,10 +3,10 @@
 `page(data)` takes `runner.output.viewerdata.Recorder.data()` and returns `viewer.html`, the data
 inline as JSON that cannot end its `<script>` element (`escape.script_json`). The script inflates
 the positions with the browser's `DecompressionStream`, then draws each frame the way
-`engine.raster` does: the background, then every object's sprite pixels in id order at its rounded
-position, clipped to the world, into an ImageData at the world's size; that picture is scaled by the
-zoom (whole factors, no smoothing) onto the canvas and the overlays are drawn over it. At zoom 1
-with every overlay off, the canvas holds exactly the PNG frame's pixels.
+`engine.picture.raster` does: the background, then every object's sprite pixels in id order at its
+rounded position, clipped to the world, into an ImageData at the world's size; that picture is
+scaled by the zoom (whole factors, no smoothing) onto the canvas and the overlays are drawn over it.
+At zoom 1 with every overlay off, the canvas holds exactly the PNG frame's pixels.
 
 Controls: play / pause (space), one frame back and forward (left and right arrow keys, or the
 buttons), the frame slider (Home / End), the speed, the zoom (also the mouse wheel) and panning

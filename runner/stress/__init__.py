@@ -25,7 +25,8 @@ kernel (`checks.tick_figures`) and the sort-and-sweep kernel `engine.invariants.
   component's size exactly (only its sign changes);
 - under `exact`, no two boxes overlap by more than `PENETRATION_TOL_PX` after a tick, and the
   movers of a scene with a `room` (a ring of static walls) stay in it (nothing tunnels);
-- positions round to pixels exactly as `floor(x + 1/2)` (engine.raster.round_positions, checked
+- positions round to pixels exactly as `floor(x + 1/2)` (engine.picture.raster.round_positions,
+checked
   against exact arithmetic);
 - no hang: a runaway stops with a clear error (the exact model's event cap, the stepped model's fold
   limit); a scene that expects one counts it as a pass, any other scene as a failure;

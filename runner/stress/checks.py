@@ -18,7 +18,7 @@ import numpy as np
 from collide2d.engine.events import EV_WALL
 from collide2d.engine.invariants import energy_momentum, max_penetration
 from collide2d.engine.jit import njit
-from collide2d.engine.raster import round_positions
+from collide2d.engine.picture.raster import round_positions
 from collide2d.runner.stress.scenes import Scene
 
 # Bounds of the invariants (dimensionless unless a unit is given).

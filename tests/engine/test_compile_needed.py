@@ -14,8 +14,8 @@ import pytest
 from numba import njit
 
 from collide2d.engine import broadphase as bp
-from collide2d.engine.draw import shapes_marker
-from collide2d.engine.raster import Renderer
+from collide2d.engine.picture.pixels import shapes_marker
+from collide2d.engine.picture.raster import Renderer
 from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON
 from collide2d.runner.scenario.load import loads
 
@@ -187,7 +187,7 @@ def test_the_sweep_compiles_no_other_pair_finder(tmp_path):
 
 
 SPRITES = LISTEN + """
-from collide2d.engine.sprites import sprites
+from collide2d.engine.picture.sprites import sprites
 from collide2d.runner.scenario.load import loads
 scene = loads(
     "version: 1\\nworld: {width: 40, height: 30}\\nticks: 1\\nobjects:\\n"
@@ -201,8 +201,8 @@ print(*sorted(name for name in ("_circle", "_polygon") if name in compiled) or [
 
 @pytest.mark.skipif(os.environ.get("NUMBA_DISABLE_JIT") == "1", reason="nothing compiles")
 def test_the_sprites_of_boxes_compile_no_circle_or_polygon_drawing(tmp_path):
-    """The viewer's sprites (engine.sprites) draw through the shapes marker, as the renderer does:
-    a scene of boxes compiles no circle or polygon rasteriser for them."""
+    """The viewer's sprites (engine.picture.sprites) draw through the shapes marker, as the renderer
+    does: a scene of boxes compiles no circle or polygon rasteriser for them."""
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
     got = subprocess.run(
         [sys.executable, "-c", SPRITES], capture_output=True, text=True, env=env, check=True

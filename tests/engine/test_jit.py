@@ -17,7 +17,7 @@ import pytest
 
 from collide2d.engine import jit
 from collide2d.engine.broadphase import METHODS, find_pairs, sweep_pairs
-from collide2d.engine.raster import _round_into, round_positions
+from collide2d.engine.picture.raster import _round_into, round_positions
 
 COMPILING = os.environ.get("NUMBA_DISABLE_JIT", "0") in ("", "0")
 

@@ -1,4 +1,5 @@
-"""Tests for engine.raster: exact DDA, midpoint circles, fills, clipping, id order, dirty redraw."""
+"""Tests for engine.picture.raster: exact DDA, midpoint circles, fills, clipping, id order, dirty
+redraw."""
 
 from __future__ import annotations
 
@@ -13,7 +14,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from collide2d.engine import draw, raster
+from collide2d.engine.picture import pixels as draw
+from collide2d.engine.picture import raster
 from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies, Looks, WorldSpec
 
 FAST = settings(max_examples=30, deadline=None)
@@ -454,7 +456,7 @@ def test_same_pixels_without_jit():
 import numpy as np, sys
 sys.path.insert(0, TESTS_DIR)
 from test_raster import random_scene
-from collide2d.engine import raster
+from collide2d.engine.picture import raster
 from collide2d.engine.world import WorldSpec
 rng = np.random.default_rng(11)
 bodies = random_scene(rng, 12)

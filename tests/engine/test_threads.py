@@ -7,9 +7,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from collide2d.engine import raster, threads
+from collide2d.engine import threads
 from collide2d.engine.models import make
 from collide2d.engine.models.stepped import model as stepped_model
+from collide2d.engine.picture import raster
 from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies, Looks, WorldSpec
 from collide2d.runner.command.main import main
 

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from collide2d.engine.raster import Renderer
+from collide2d.engine.picture.raster import Renderer
 from collide2d.runner.run import drive, simulate
 from collide2d.runner.scenario.load import load
 

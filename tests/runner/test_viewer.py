@@ -1,6 +1,6 @@
-"""Tests of runner/output/viewerdata.py and engine/sprites.py: the viewer's data is the run's state,
-packed; its sprites paint what engine/raster.py draws; long runs are refused before they start; the
-file stays small."""
+"""Tests of runner/output/viewerdata.py and engine/picture/sprites.py: the viewer's data is the
+run's state, packed; its sprites paint what engine/picture/raster.py draws; long runs are refused
+before they start; the file stays small."""
 
 from __future__ import annotations
 
@@ -13,8 +13,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from collide2d.engine.raster import render, round_positions
-from collide2d.engine.sprites import paint, sprites
+from collide2d.engine.picture.raster import render, round_positions
+from collide2d.engine.picture.sprites import paint, sprites
 from collide2d.runner.command import main as cli
 from collide2d.runner.output import viewerdata as viewer
 from collide2d.runner.run import drive

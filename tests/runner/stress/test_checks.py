@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from collide2d.engine.raster import round_positions
+from collide2d.engine.picture.raster import round_positions
 from collide2d.runner.stress.checks import exact_round, tick_figures
 
 

@@ -1,9 +1,9 @@
 """Pixels of one object: DDA lines, boxes, midpoint circles, polygons, fills
 (docs/drawing.md#shapes).
 
-The drawing primitives `engine.raster` paints frames with, each a numba kernel writing palette
-indices into a `(H, W) uint8` buffer within an inclusive clip rectangle (cx0, cy0, cx1, cy1) that
-the caller has already intersected with the frame. All in exact integer arithmetic on rounded
+The drawing primitives `engine.picture.raster` paints frames with, each a numba kernel writing
+palette indices into a `(H, W) uint8` buffer within an inclusive clip rectangle (cx0, cy0, cx1, cy1)
+that the caller has already intersected with the frame. All in exact integer arithmetic on rounded
 positions:
 - outlines are the paper's DDA lines (section II.B) with exact rounding (`_dda_start`): from
   (x0, y0) to (x1, y1), n = max(|dx|, |dy|), points k = 0..n at x0 + floor((2 k dx + n) / (2 n));

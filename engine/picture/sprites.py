@@ -1,10 +1,10 @@
-"""Each object's pixels relative to its position: what `engine.raster` draws, as sprites.
+"""Each object's pixels relative to its position: what `engine.picture.raster` draws, as sprites.
 
-A frame is every object drawn in id order at its rounded position, and what an object draws does
-not depend on where it is (its pixels move with it; the frame's edge only clips them). So the
-pixels of object i drawn once at its own origin, by the same `engine.draw` kernels the renderer
-uses, give any frame: for each object in id order, its sprite's pixels at the rounded position
-plus their offsets, inside the world, in its colour, over the background. The run viewer
+A frame is every object drawn in id order at its rounded position, and what an object draws does not
+depend on where it is (its pixels move with it; the frame's edge only clips them). So the pixels of
+object i drawn once at its own origin, by the same `engine.picture.pixels` kernels the renderer
+uses, give any frame: for each object in id order, its sprite's pixels at the rounded position plus
+their offsets, inside the world, in its colour, over the background. The run viewer
 (`runner.output.viewerdata`) draws its canvas this way, so it shows exactly the PNG frames' pixels.
 """
 
@@ -12,9 +12,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from collide2d.engine.draw import draw_shape, shapes_marker
 from collide2d.engine.jit import njit
-from collide2d.engine.raster import _extents, round_positions
+from collide2d.engine.picture.pixels import draw_shape, shapes_marker
+from collide2d.engine.picture.raster import _extents, round_positions
 from collide2d.engine.world import KIND_CIRCLE, Bodies
 
 
@@ -53,7 +53,7 @@ def sprites(bodies: Bodies) -> tuple[np.ndarray, np.ndarray]:
 
 def paint(world_w: int, world_h: int, color, start, offsets, ipos) -> np.ndarray:
     """(H, W) palette-index frame from sprites at integer positions ipos (n, 2): the reference
-    the viewer's canvas follows (and a check of the sprites against `engine.raster`)."""
+    the viewer's canvas follows (and a check of the sprites against `engine.picture.raster`)."""
     out = np.zeros((world_h, world_w), np.uint8)
     for i in range(len(start) - 1):
         pts = offsets[start[i] : start[i + 1]].astype(np.int64) + ipos[i]
@@ -67,8 +67,8 @@ def paint(world_w: int, world_h: int, color, start, offsets, ipos) -> np.ndarray
 def _draw_sprite(
     shapes, buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, cx0, cy0, cx1, cy1
 ):
-    """`engine.draw.draw_shape`: compiles only the drawing code of the kinds `shapes` names (a
-    scene of boxes never compiles the circle and polygon rasterisers for its sprites)."""
+    """`engine.picture.pixels.draw_shape`: compiles only the drawing code of the kinds `shapes`
+    names (a scene of boxes never compiles the circle and polygon rasterisers for its sprites)."""
     draw_shape(
         shapes, buf, i, x, y, kind, wh, color, fill, vert_start, verts, scratch, cx0, cy0, cx1, cy1
     )

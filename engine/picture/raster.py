@@ -5,8 +5,8 @@ data (`Bodies`: kind, size, colour index, fill flag, polygon vertices) and, per 
 top-left corners `pos (n, 2)` in pixels. Output: a palette-index frame `(H, W) uint8`, index 0 the
 background and `Bodies.looks.color[i]` the colour of object i; the RGB picture is `palette[frame]`
 (`to_rgb`). Positions are rounded as `floor(x + 0.5)`; each object is drawn by the primitives of
-`engine.draw` (DDA outlines, midpoint circles, fills), later ids on top, pixels outside the world
-dropped.
+`engine.picture.pixels` (DDA outlines, midpoint circles, fills), later ids on top, pixels outside
+the world dropped.
 
 A full redraw of a scene of engine.threads.PARALLEL_MIN_OBJECTS objects or more is split among
 threads by bands of rows (each band cleared and drawn clipped to itself, every object in id
@@ -22,8 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from collide2d.engine.draw import _fill_rect, draw_shape, shapes_marker
 from collide2d.engine.jit import njit, prange
+from collide2d.engine.picture.pixels import _fill_rect, draw_shape, shapes_marker
 from collide2d.engine.threads import chunks_for
 from collide2d.engine.world import KIND_CIRCLE, KIND_POLYGON, Bodies, WorldSpec
 
