@@ -209,7 +209,7 @@ class ObjectReader(Nodes):
             raise self.error(
                 node, f"{what} must be a whole number of pixels, not {ys.describe(node)}"
             )
-        return float(self.number(node, what))
+        return float(v) + 0.0  # a number is at most MAX_NUMBER_CHARS long, so within float range
 
     def size_of(self, shape: str, node, what: str, at: dict) -> tuple[float, float]:
         if shape == "circle":
