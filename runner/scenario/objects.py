@@ -77,8 +77,8 @@ RANGE_KEYS = ("min", "max")
 class ModelRules:
     """What objects must satisfy under the scenario's model and geometry."""
 
-    whole_positions: bool = False  # positions are whole pixels (paper)
-    paper_rates: bool = False  # a moving object's velocity is a paper rate at the fps (paper)
+    # positions are whole pixels and a moving object's velocity is a paper rate at the fps (paper)
+    paper_rates: bool = False
     whole_velocities: bool = False  # generated velocities are whole numbers (paper)
     convex_polygons: bool = False  # polygons are convex with some area (geometry exact)
     origin: str | None = None  # "--model M" when the model came from the command line
@@ -87,7 +87,6 @@ class ModelRules:
     def of(cls, model: str, geometry: str, origin: str | None = None) -> ModelRules:
         paper = model == "paper"
         return cls(
-            whole_positions=paper,
             paper_rates=paper,
             whole_velocities=paper,
             convex_polygons=geometry == "exact",
