@@ -2,7 +2,7 @@
 collide2d.
 
 A golden's manifest keeps the SHA-256 of the scenario (its file's bytes, and its table's when its
-objects come from one: `runner.scenario.load.with_table`) and the collide2d version that blessed it
+objects come from one: `runner.scenario.table.with_table`) and the collide2d version that blessed it
 (`serialize.manifest`). `cause(scenario, manifest)` compares them with the scenario checked now and
 this collide2d, and returns a `Cause`: a `kind` for tools and a sentence for the reviewer, shown at
 the top of the report, in the console text and in the JSON and JUnit outputs.

@@ -1,8 +1,9 @@
 """Objects to arrays: the checked objects and blocks of a scenario become `Bodies` and a palette.
 
-Listed objects are checked first (each inside the world, no two overlapping; touching is fine; under
-`geometry: exact` overlap is judged by the real shapes, so circles racked tightly in touching boxes
-are legal), then each generate block is drawn by `runner.scenario.generate` around them; the
+The objects come checked but for their overlap (`runner.scenario.rules`): no two listed objects
+or table rows may overlap at the start (touching is fine; under `geometry: exact` overlap is judged
+by the real shapes, so circles racked tightly in touching boxes are legal); then each generate
+block is drawn by `runner.scenario.generate` around them; the
 per-object arrays hold the listed objects first, then each block's objects, in id order. Colours are
 indexed into a palette of at most PALETTE_SIZE rows: row 0 the background, then each distinct object
 colour in order of first use.
@@ -10,15 +11,15 @@ colour in order of first use.
 
 from __future__ import annotations
 
-from types import SimpleNamespace
-
 import numpy as np
 
+from collide2d.engine.noroom import no_room, no_room_message
 from collide2d.engine.world import Bodies, Looks, WorldSpec
 from collide2d.runner import lanes
 from collide2d.runner.scenario import generate as gen
-from collide2d.runner.scenario.nodes import Nodes, fmt
-from collide2d.runner.scenario.objects import Block, Listed
+from collide2d.runner.scenario import rules
+from collide2d.runner.scenario.nodes import Nodes
+from collide2d.runner.scenario.objects import Block, Listed, fault_error
 from collide2d.runner.scenario.parse import ScenarioError
 
 PALETTE_SIZE = 256  # palette rows: the background and up to 255 object colours
@@ -41,11 +42,11 @@ def bodies(
     n_listed = len(listed)
     if table is not None:
         pos, size = table.pos, table.size
-        check_table_placement(table)
+        check_table_placement(table, geometry)
     else:
         pos = np.array([o.pos for o in listed], np.float64).reshape(-1, 2)
         size = np.array([o.size for o in listed], np.float64).reshape(-1, 2)
-        check_placement(reader, listed, pos, size, world, geometry)
+        check_placement(reader, listed, pos, size, geometry)
 
     palette = [background]
     index: dict[tuple[int, int, int], int] = {}
@@ -151,80 +152,42 @@ def bodies(
     return bodies, tuple(names), tuple(lines), np.array(palette, np.uint8).reshape(-1, 3)
 
 
-def check_placement(
-    reader: Nodes, listed: list[Listed], pos, size, world: WorldSpec, geometry: str = "box"
-) -> None:
-    """Every listed box inside the world, no two overlapping (touching is fine): no two boxes,
-    or under `geometry` "exact" no two real shapes."""
+def check_placement(reader: Nodes, listed: list[Listed], pos, size, geometry: str = "box") -> None:
+    """No two listed objects overlapping at the start (runner.scenario.rules.first_overlap):
+    boxes, or under `geometry` "exact" the real shapes; inside the world was checked with the
+    other rules (runner.scenario.objects.ObjectReader.check)."""
     if not listed:
         return
-    end = pos + size
-    outside = np.any((pos < 0) | (end > np.array([world.width, world.height])), axis=1)
-    if outside.any():
-        i = int(np.argmax(outside))
-        raise reader.error(
-            listed[i].node,
-            f"objects[{i}] lies outside the world: its box "
-            f"{_box_text(pos[i], size[i])} must fit in [0, {world.width}) x "
-            f"[0, {world.height})",
-        )
-    found = gen.first_overlap(pos, size)
-    if found is not None and geometry == "exact":
-        found = _first_shape_overlap(listed, pos, size)
+    shapes = None
+    if geometry == "exact":
+        polys = [o.verts for o in listed if o.verts is not None]
+        nverts = [0 if o.verts is None else o.verts.shape[0] for o in listed]
+        shapes = {
+            "kind": np.array([o.kind for o in listed], np.int8),
+            "vert_start": np.concatenate([[0], np.cumsum(nverts)]).astype(np.int64),
+            "verts": np.concatenate(polys).astype(np.int64)
+            if polys
+            else np.zeros((0, 2), np.int64),
+        }
+    found = rules.first_overlap(pos, size, shapes)
     if found is not None:
-        a, b = found
-        la = listed[a].node.start_mark.line + 1
-        lb = listed[b].node.start_mark.line + 1
-        raise reader.error(
-            listed[b].node,
-            f"objects[{b}] (line {lb}) overlaps objects[{a}] "
-            f"(line {la}) at the start: "
-            f"{'shapes in boxes' if geometry == 'exact' else 'boxes'} "
-            f"{_box_text(pos[b], size[b])} and "
-            f"{_box_text(pos[a], size[a])}",
-        )
+        raise fault_error(reader, listed, found, "objects")
 
 
-def _first_shape_overlap(listed: list[Listed], pos, size) -> tuple[int, int] | None:
-    """The first pair (a, b) in (b, a) order whose exact shapes overlap with positive area."""
-    n = len(listed)
-    with lanes.objects(n):
-        return _shape_overlap(listed, pos, size)
-
-
-def _shape_overlap(listed: list[Listed], pos, size) -> tuple[int, int] | None:
-    from collide2d.engine.broadphase import METHOD_SWEEP, find_pairs
-    from collide2d.engine.contact import penetration
-    from collide2d.engine.shapes import build_cores
-
-    n = len(listed)
-    polys = [o.verts for o in listed if o.verts is not None]
-    nverts = [0 if o.verts is None else o.verts.shape[0] for o in listed]
-    shapes = SimpleNamespace(
-        kind=np.array([o.kind for o in listed], np.int8),
-        size=size,
-        vert_start=np.concatenate([[0], np.cumsum(nverts)]).astype(np.int64),
-        verts=np.concatenate(polys).astype(np.int64) if polys else np.zeros((0, 2), np.int64),
-    )
-    cores = build_cores(shapes, "exact")
-    pairs = find_pairs(METHOD_SWEEP, pos, pos + size, np.ones(n, bool))
-
-    def shape(i):
-        core = slice(cores.start[i], cores.start[i + 1])
-        return (
-            cores.shape[i],
-            size[i, 0],
-            size[i, 1],
-            cores.radius[i],
-            cores.verts[core],
-            cores.normals[core],
-        )
-
-    for a, b in sorted(pairs.tolist(), key=lambda p: (p[1], p[0])):
-        q = pos[b] - pos[a]
-        if penetration(q[0], q[1], *shape(a), *shape(b))[0] > 0:
-            return a, b
-    return None
+def check_room(reader, world, bodies, geometry, names, listed, lines, table=None) -> None:
+    """Refuse, at the object, a moving object with no room on an axis it moves on (the exact
+    model would collide it again and again with no time passing; engine.models.exact)."""
+    with lanes.objects(bodies.n):
+        found = no_room(world, bodies, geometry)
+    if not found:
+        return
+    i = found[0].obj
+    message = reader.prefix(reader.model_from) + no_room_message(found, bodies, names)
+    if i < len(listed):
+        raise reader.error(listed[i].node, message)
+    if table is not None and i < table.n:
+        raise table.error(i, "x", message)
+    raise ScenarioError(reader.path, lines[i], 1, message)
 
 
 def check_names(reader: Nodes, names, listed, blocks, lines) -> None:
@@ -253,13 +216,6 @@ def check_names(reader: Nodes, names, listed, blocks, lines) -> None:
         seen[name] = i
 
 
-def _box_text(p, s) -> str:
-    """The half-open box [x, x+w) x [y, y+h) as text."""
-    x0, x1 = fmt(float(p[0])), fmt(float(p[0] + s[0]))
-    y0, y1 = fmt(float(p[1])), fmt(float(p[1] + s[1]))
-    return f"[{x0}, {x1}) x [{y0}, {y1})"
-
-
 class _TableRows:
     """A table standing where the list of objects would be: its length, for the counts."""
 
@@ -277,16 +233,16 @@ class _RowNode:
         self.table, self.row = table, row
 
 
-def check_table_placement(table) -> None:
-    """No two boxes of a table overlapping (touching is fine); inside the world was checked by
-    column when the table was read."""
-    found = gen.first_overlap(table.pos, table.size)
+def check_table_placement(table, geometry: str = "box") -> None:
+    """No two objects of a table overlapping at the start (runner.scenario.rules.first_overlap),
+    refused at the later one's x cell; inside the world was checked with the other rules
+    (runner.scenario.table.checked)."""
+    shapes = None
+    if geometry == "exact":
+        shapes = {"kind": table.kind, "vert_start": np.zeros(table.n + 1, np.int64)}
+        shapes["verts"] = np.zeros((0, 2), np.int64)
+    found = rules.first_overlap(table.pos, table.size, shapes)
     if found is not None:
-        a, b = found
-        raise table.error(
-            b,
-            "x",
-            f"object {b} overlaps object {a} at the start: boxes "
-            f"{_box_text(table.pos[b], table.size[b])} and "
-            f"{_box_text(table.pos[a], table.size[a])}",
-        )
+        a = found.other
+        other = f"object {a} (row {a + 1})"
+        raise table.error(found.row, "x", found.text.format(other=other))

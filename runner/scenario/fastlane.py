@@ -34,22 +34,20 @@ flow mappings, quoted or tagged values, anchors and aliases, comments or blank l
 list, polygons, numbers with leading zeros (YAML 1.1 octal), exponents, underscores, or other YAML
 1.1 forms, words YAML reads as booleans or null where a text is asked for, two objects of one name,
 and lists shorter than FAST_MIN_OBJECTS. Names pass the one rule for object names
-(`runner.scenario.objects.object_names`) as the general path's do.
+(`runner.scenario.rules.object_names`) as the general path's do.
 """
 
 from __future__ import annotations
 
 import functools
-import math
 import re
 from dataclasses import dataclass
 
 import numpy as np
 
-from collide2d.engine import motion
 from collide2d.engine.world import KIND_BOX, KIND_CIRCLE
-from collide2d.runner.scenario import colors
-from collide2d.runner.scenario import generate as gen
+from collide2d.runner.scenario import colors, rules
+from collide2d.runner.scenario.rules import DEFAULT_MASS, NameRefused, object_names
 
 FAST_MIN_OBJECTS = 1000  # shorter lists take the general path (it is fast enough there)
 
@@ -333,15 +331,7 @@ def _number(values: list[str]) -> np.ndarray:
 def table(split_: Split, world, paper: bool, max_objects: int):
     """The objects of the list as a runner.scenario.table.Table, every check of the general path run
     by column; FallBack when anything would make the general path refuse or read it otherwise."""
-    from collide2d.runner.scenario.objects import (
-        DEFAULT_COLOR,
-        DEFAULT_MASS,
-        MAX_MASS,
-        MAX_SPEED,
-        MIN_MASS,
-        NameRefused,
-        object_names,
-    )
+    from collide2d.runner.scenario.objects import DEFAULT_COLOR
     from collide2d.runner.scenario.table import Table
 
     n = split_.n
@@ -386,35 +376,23 @@ def table(split_: Split, world, paper: bool, max_objects: int):
     size[diameter.one] = _number(diameter.ones)[:, None]
     size[box_size.two, 0] = _number(box_size.xs)
     size[box_size.two, 1] = _number(box_size.ys)
-    if not np.all((size >= 1) & (size == np.floor(size)) & (size <= 2.0**53)):
-        raise FallBack
     if not present("position").all():
         raise FallBack
     pos = pairs("position", 0.0)
-    if paper and not np.all(pos == np.floor(pos)):
-        raise FallBack
     vel = pairs("velocity", 0.0)
-    if not np.all(np.abs(vel) <= MAX_SPEED):
-        raise FallBack
     static = _flag(words("static"))
     fill = _flag(words("fill"))
-    if np.any(static[:, None] & (vel != 0)):
-        raise FallBack
-    if paper:
-        for v in np.unique(vel[~static]):
-            try:
-                motion.paper_rate(float(v), world.fps)
-            except ValueError:
-                raise FallBack from None
-    mass = np.full(n, DEFAULT_MASS)
+    mass = np.full(n, np.nan)
     has_mass = present("mass")
     if has_mass.any():
         raw = cols["mass"].ones
         if cols["mass"].two.any() or not all(v[-1:].isdigit() for v in raw):
             raise FallBack
         mass[has_mass] = _number(raw)
-        if np.any(has_mass & static) or not np.all((mass >= MIN_MASS) & (mass <= MAX_MASS)):
-            raise FallBack
+    # every rule of objects (runner.scenario.rules): any fault is the general path's to say
+    found = rules.Columns(size, pos, vel, mass, static)
+    if rules.faults(found, paper, world.fps, (world.width, world.height)):
+        raise FallBack
     color_word = words("color")
     unique, first, of = np.unique(color_word, return_index=True, return_inverse=True)
     order = np.argsort(first, kind="stable")
@@ -450,12 +428,7 @@ def table(split_: Split, world, paper: bool, max_objects: int):
             raise FallBack
     except NameRefused:
         raise FallBack from None
-    # inside the world and apart, as runner.scenario.assemble checks listed objects
-    if np.any((pos < 0) | (pos + size > np.array([world.width, world.height]))):
-        raise FallBack
-    if not np.all(np.isfinite(pos)) or gen.first_overlap(pos, size) is not None:
-        raise FallBack
-    if math.isinf(float(np.max(np.abs(pos), initial=0.0))):
+    if rules.first_overlap(pos, size) is not None:  # boxes: the general path judges shapes
         raise FallBack
     return Table(
         path="",
@@ -463,7 +436,7 @@ def table(split_: Split, world, paper: bool, max_objects: int):
         pos=pos,
         size=size,
         vel=np.where(static[:, None], 0.0, vel),
-        mass=np.where(static, np.inf, mass),
+        mass=np.where(static, np.inf, np.where(has_mass, mass, DEFAULT_MASS)),
         static=static,
         fill=fill,
         colors=rgb,

@@ -14,8 +14,10 @@ of `Limits` (`runner.scenario.limits`: safe tags only, depth, aliases, size, val
 tree is walked by hand, so every value is checked where it stands and every error carries its node's
 place. `runner.scenario.nodes` reads single nodes (typed, located); this module reads the top level,
 the world, the model, the tick count and the overrides; `runner.scenario.objects` reads the objects
-and generate blocks under the model's `ModelRules`; `runner.scenario.sections` reads `output` and
-`golden`; `runner.scenario.assemble` builds the `Bodies` and the palette and checks the placement.
+and generate blocks, and once the world and the model are good checks them under the model's
+`ModelRules` (`runner.scenario.rules`, the rules of every object however it is written);
+`runner.scenario.sections` reads `output` and `golden`; `runner.scenario.assemble` builds the
+`Bodies` and the palette and checks that no two objects overlap at the start.
 Every name the format defines is importable from here (`__all__`), wherever it is defined.
 
 Values follow YAML 1.1 as PyYAML reads it (`yes` is a boolean, `0x1f` an integer), with one
@@ -65,13 +67,12 @@ import numpy as np
 import yaml
 
 from collide2d.engine.models import MAX_EVENTS_PER_TICK, MODEL_NAMES
-from collide2d.engine.noroom import no_room, no_room_message
 from collide2d.engine.shapes import GEOMETRIES
 from collide2d.engine.world import Bodies, WorldSpec
-from collide2d.runner import lanes
 from collide2d.runner.scenario import assemble
 from collide2d.runner.scenario import fastlane as yamlfast
 from collide2d.runner.scenario import parse as ys
+from collide2d.runner.scenario import table as tables
 from collide2d.runner.scenario.assemble import PALETTE_SIZE
 from collide2d.runner.scenario.limits import Limits
 from collide2d.runner.scenario.nodes import FAILED, MAX_INTEGER, Errors, Nodes, fmt, is_number
@@ -79,13 +80,8 @@ from collide2d.runner.scenario.objects import (
     BLOCK_KEYS,
     BLOCK_SHAPES,
     DEFAULT_COLOR,
-    DEFAULT_MASS,
-    MAX_MASS,
-    MAX_OBJECT_NAME_CHARS,
     MAX_POINT_OFFSET,
     MAX_SEED,
-    MAX_SPEED,
-    MIN_MASS,
     OBJECT_KEYS,
     RANGE_KEYS,
     SHAPES,
@@ -94,6 +90,13 @@ from collide2d.runner.scenario.objects import (
     polygon_problem,
 )
 from collide2d.runner.scenario.parse import ScenarioError
+from collide2d.runner.scenario.rules import (
+    DEFAULT_MASS,
+    MAX_MASS,
+    MAX_OBJECT_NAME_CHARS,
+    MAX_SPEED,
+    MIN_MASS,
+)
 from collide2d.runner.scenario.sections import (
     EVERY_KEYS,
     FRAME_WORDS,
@@ -103,7 +106,6 @@ from collide2d.runner.scenario.sections import (
     Output,
     OutputReader,
 )
-from collide2d.runner.scenario.table import table_of
 
 __all__ = [
     "BLOCK_KEYS",
@@ -210,7 +212,7 @@ class Scenario:
     lines: tuple[int, ...]  # per object, the 1-based YAML line it came from
     output: Output
     golden: Golden
-    text_sha256: str  # of the file's bytes; with a table, of both (`with_table`)
+    text_sha256: str  # of the file's bytes; with a table, of both (`table.with_table`)
     # the exact model's cap: --max-events-per-tick, else the model option, else the default
     max_events_per_tick: int = DEFAULT_MAX_EVENTS_PER_TICK
     # each generate block as drawn (runner.scenario.generate.BlockSpec), its objects the last of
@@ -251,13 +253,6 @@ def loads(
     return _Reader(path, None, overrides, limits, defaults).scenario(text, digest)
 
 
-def with_table(text_sha256: str, table_sha256: str) -> str:
-    """The hash of a scenario whose objects come from a table: the file's and the table's hashes
-    hashed together, so that goldens and reports see an edit of the table as an edit of the
-    scenario. A scenario without a table keeps the hash of its file's bytes alone."""
-    return hashlib.sha256(f"{text_sha256} {table_sha256}".encode("ascii")).hexdigest()
-
-
 class _Reader(Nodes):
     """One reading of one scenario: its path, limits and overrides, and the top-level sections."""
 
@@ -294,9 +289,10 @@ class _Reader(Nodes):
 
     def _scenario(self, text: str, digest: str, fast, edit=None) -> Scenario:
         """Read the whole document, collecting the errors of its parts (up to MAX_ERRORS, in
-        line order: a part that depends on a refused one is not read, so that no error follows
-        from another); raise them all, or return the Scenario. `fast`: the fast lane's object
-        rows (runner.scenario.fastlane), read in place of the empty list the text then holds."""
+        line order: a check that depends on a refused part is not made, so that no error follows
+        from another; the objects are read whatever the world and model, their rules wait for
+        both); raise them all, or return the Scenario. `fast`: the fast lane's object rows
+        (runner.scenario.fastlane), read in place of the empty list the text then holds."""
         root = ys.compose(text, self.path, self.limits)
         if edit is not None:
             root = edit(root)
@@ -312,17 +308,23 @@ class _Reader(Nodes):
         if world_background is not FAILED:
             world, background = world_background
             ticks = self.attempt(self.ticks, top, world.fps)
-        if world_background is not FAILED and settings is not FAILED:
+        objects = ObjectReader(self.path, self.limits)
+        objects.errors = self.errors
+        listed = self.attempt(objects.objects, top)
+        table = self.attempt(self.table, top, fast)
+        blocks = FAILED
+        if listed is not FAILED and table is not FAILED:
+            rows = len(listed) + (fast.n if fast else table.n if table else 0)
+            blocks = self.attempt(objects.blocks, top, rows)
+        # the rules of objects; those that need the world (bounds) or the model wait for them
+        world_in = world if world_background is not FAILED else None
+        rules = None
+        if settings is not FAILED:
             model, substeps, geometry, cap = settings
             rules = ModelRules.of(model, geometry, self.model_from)
-            objects = ObjectReader(self.path, self.limits, world, rules, self.fps_from)
-            objects.errors = self.errors
-            listed = self.attempt(objects.objects, top)
-            if listed is not FAILED:
-                table = self.attempt(self.table, top, fast, world, rules)
-                if table is not FAILED:
-                    rows = len(listed) + (table.n if table else 0)
-                    blocks = self.attempt(objects.blocks, top, rows)
+        objects.check(listed, blocks, world_in, rules, self.fps_from)
+        if table is not FAILED:
+            table = self.attempt(self.checked, table, fast, world_in, rules)
         if ticks is not FAILED:
             outputs = OutputReader(self.path, self.limits, self.ticks_from)
             outputs.errors = self.errors
@@ -336,9 +338,9 @@ class _Reader(Nodes):
             self, listed, blocks, world, background, geometry, table
         )
         if table is not None and table.sha256 is not None:
-            digest = with_table(digest, table.sha256)
+            digest = tables.with_table(digest, table.sha256)
         if model == "exact":
-            self.room(world, bodies, geometry, names, listed, lines, table)
+            assemble.check_room(self, world, bodies, geometry, names, listed, lines, table)
         return Scenario(
             path=self.file_path,
             name=name,
@@ -527,33 +529,26 @@ class _Reader(Nodes):
             cap = d["max_events_per_tick"]
         return substeps, geometry, cap
 
-    def table(self, top, fast, world, rules):
-        """The objects given as a table: the fast lane's rows when `fast` (the text's object list
-        must then be the empty list it left, else the lane declines), else the `objects: {file}`
-        table (runner.scenario.table), or None."""
+    def table(self, top, fast):
+        """The `objects: {file}` table read (runner.scenario.table), or None; with `fast` (the
+        lane's rows, taken by `checked`) None once the text's object list is the empty list the
+        lane left, else the lane declines."""
         if fast is None:
-            return table_of(self, top, self.file_path, self.limits, world, rules.paper_rates)
+            return tables.table_of(self, top, self.file_path, self.limits)
         node = top["objects"][1] if "objects" in top else None
-        if not (isinstance(node, yaml.SequenceNode) and not node.value):
+        empty = isinstance(node, yaml.SequenceNode) and not node.value
+        if not empty or node.start_mark.line + 1 != fast.first_line:
             raise yamlfast.FallBack
-        if node.start_mark.line + 1 != fast.first_line:
-            raise yamlfast.FallBack
-        return yamlfast.table(fast, world, rules.paper_rates, self.limits.max_objects)
+        return None
 
-    def room(self, world, bodies, geometry, names, listed, lines, table=None) -> None:
-        """Refuse, at the object, a moving object with no room on an axis it moves on (the exact
-        model would collide it again and again with no time passing; engine.models.exact)."""
-        with lanes.objects(bodies.n):
-            found = no_room(world, bodies, geometry)
-        if not found:
-            return
-        i = found[0].obj
-        message = self.prefix(self.model_from) + no_room_message(found, bodies, names)
-        if i < len(listed):
-            raise self.error(listed[i].node, message)
-        if table is not None and i < table.n:
-            raise table.error(i, "x", message)
-        raise ys.ScenarioError(self.path, lines[i], 1, message)
+    def checked(self, table, fast, world, rules):
+        """The fast lane's rows, or the table read by `table` (or None), every rule held that
+        the world and the model (None when refused) allow to check."""
+        if fast is not None and world is not None and rules is not None:
+            return yamlfast.table(fast, world, rules.paper_rates, self.limits.max_objects)
+        if table is not None:
+            table = tables.checked(table, world, rules is not None and rules.paper_rates)
+        return table
 
     def ticks(self, top: dict, fps: int) -> int:
         """Ticks from `ticks`, `duration` (at the fps in force) or the default, then --ticks."""

@@ -1,47 +1,43 @@
-"""The `objects` and `generate` sections: each listed object and each generate block, checked.
+"""The `objects` and `generate` sections: each listed object and generate block, read and checked.
 
 `ObjectReader` reads every object field at its place (shape and its size key, position, velocity or
-speed, colour, mass, static, fill, name) and returns `Listed` objects and `Block`s, from which
-`runner.scenario.assemble` builds the arrays. What differs between models is one `ModelRules` value
-instead of a flag threaded through each reader: under the paper model positions are whole pixels,
-every velocity component of a moving object is a rate the model can take at the world's fps
-(`engine.motion.paper_rate`) and generated velocities are drawn as whole numbers; under geometry
-`exact` a polygon must be convex with some area (`polygon_problem`).
+speed, colour, mass, static, fill, name) whatever the world and the model, and returns `Listed`
+objects and `Block`s, from which `runner.scenario.assemble` builds the arrays; each remembers the
+node of every value a rule may refuse. Once the world and the model are known, `check` and
+`check_blocks` put those values in columns and ask `runner.scenario.rules`, where every rule of
+objects is written once for lists, blocks, tables and the fast lane alike (sizes, masses within
+[MIN_MASS, MAX_MASS], velocity components within [-MAX_SPEED, MAX_SPEED], static objects, the paper
+model's whole numbers and rates, inside the world), and report each object's first fault at its
+node. What differs between models is one `ModelRules` value: under the paper model positions are
+whole pixels, every velocity component of a moving object is a rate the model can take at the
+world's fps (`engine.motion.paper_rate`) and generated velocities are drawn as whole numbers; under
+geometry `exact` a polygon must be convex with some area (`polygon_problem`). Polygon points lie
+within MAX_POINT_OFFSET px of the object's position.
 
-Masses lie in [MIN_MASS, MAX_MASS] and velocity components in [-MAX_SPEED, MAX_SPEED] (see the
-"Numbers" paragraph of `runner.scenario.load`); polygon points lie within MAX_POINT_OFFSET px of the
-object's position.
-
-An object's name follows one rule wherever it is written (a list here, a table in
-`runner.scenario.table`, the fast lane in `runner.scenario.fastlane`, a generate block's `name`):
-`object_names`. Surrounding whitespace is not part of it, a name left empty is no name, and a name
-holds at most MAX_OBJECT_NAME_CHARS characters of text; that no two objects share one is checked
-once all are known (`runner.scenario.assemble.check_names`).
+An object's name follows the one rule for names wherever it is written
+(`runner.scenario.rules.object_names`).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
 import numpy as np
 import yaml
 
-from collide2d.engine import motion
 from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, WorldSpec
 from collide2d.runner.scenario import generate as gen
 from collide2d.runner.scenario import parse as ys
+from collide2d.runner.scenario import rules as rule
 from collide2d.runner.scenario.limits import Limits
-from collide2d.runner.scenario.nodes import Nodes, fmt
+from collide2d.runner.scenario.nodes import FAILED, Nodes, fmt, is_number
+from collide2d.runner.scenario.rules import DEFAULT_MASS, NameRefused, object_names
 
 DEFAULT_COLOR = (255, 255, 255)
-DEFAULT_MASS = 1.0  # mass units
-MIN_MASS = 1e-15  # mass units, the lightest movable object
-MAX_MASS = 1e15  # mass units, the heaviest movable object (`static: true` is heavier than any)
 MAX_SEED = 2**64 - 1  # the largest generate seed
-MAX_SPEED = 1e9  # px/s, largest velocity component (a larger one crosses any world in a tick)
 MAX_POINT_OFFSET = 2**24  # px, largest |coordinate| of a polygon point relative to its position
-MAX_OBJECT_NAME_CHARS = 100  # characters in an object's name (it labels the object in every output)
 SHAPES = ("box", "circle", "polygon")
 BLOCK_SHAPES = ("box", "circle")
 _KIND_OF_SHAPE = {"box": KIND_BOX, "circle": KIND_CIRCLE, "polygon": KIND_POLYGON}
@@ -81,8 +77,8 @@ RANGE_KEYS = ("min", "max")
 class ModelRules:
     """What objects must satisfy under the scenario's model and geometry."""
 
-    whole_positions: bool = False  # positions are whole pixels (paper)
-    paper_rates: bool = False  # a moving object's velocity is a paper rate at the fps (paper)
+    # positions are whole pixels and a moving object's velocity is a paper rate at the fps (paper)
+    paper_rates: bool = False
     whole_velocities: bool = False  # generated velocities are whole numbers (paper)
     convex_polygons: bool = False  # polygons are convex with some area (geometry exact)
     origin: str | None = None  # "--model M" when the model came from the command line
@@ -91,12 +87,14 @@ class ModelRules:
     def of(cls, model: str, geometry: str, origin: str | None = None) -> ModelRules:
         paper = model == "paper"
         return cls(
-            whole_positions=paper,
             paper_rates=paper,
             whole_velocities=paper,
             convex_polygons=geometry == "exact",
             origin=origin,
         )
+
+
+_NO_MODEL = ModelRules()  # the model was refused: its rules wait
 
 
 def polygon_problem(points: np.ndarray) -> str | None:
@@ -129,46 +127,14 @@ def polygon_problem(points: np.ndarray) -> str | None:
     return None
 
 
-class NameRefused(ValueError):
-    """A name the rule refuses, with the reason; `index` is its place among those given."""
-
-    def __init__(self, index: int, reason: str):
-        super().__init__(reason)
-        self.index = index
-
-
-def object_names(texts) -> list[str | None]:
-    """The names that objects written with `texts` get (a list's `name`, a table's column, the
-    fast lane's names), under the one rule: the text without surrounding whitespace, None when
-    nothing is left; NameRefused at the first longer than MAX_OBJECT_NAME_CHARS characters or
-    holding what is not text (a lone surrogate, which a .npy string may hold: no output could
-    write it)."""
-    names = [t.strip() or None for t in texts]
-    if max(map(len, texts), default=0) > MAX_OBJECT_NAME_CHARS:  # else none can be too long
-        for i, name in enumerate(names):
-            if name is not None and len(name) > MAX_OBJECT_NAME_CHARS:
-                raise NameRefused(
-                    i, f"a name holds at most {MAX_OBJECT_NAME_CHARS} characters, not {len(name):,}"
-                )
-    try:
-        "".join(filter(None, names)).encode("utf-8")
-    except UnicodeEncodeError:
-        for i, name in enumerate(names):
-            try:
-                (name or "").encode("utf-8")
-            except UnicodeEncodeError as exc:
-                code = ord(name[exc.start])
-                raise NameRefused(i, f"a name is text, not a lone surrogate U+{code:04X}") from None
-    return names
-
-
 @dataclass
 class Listed:
-    """One listed object, checked, before the arrays are built."""
+    """One listed object, read; its rules are checked by column (`ObjectReader.check`)."""
 
+    index: int  # its place in the list
     kind: int
-    pos: tuple[float, float]
-    size: tuple[int, int]
+    pos: tuple[float, float]  # the top-left corner of its box
+    size: tuple[float, float]
     vel: tuple[float, float]
     mass: float
     static: bool
@@ -178,11 +144,17 @@ class Listed:
     verts: np.ndarray | None
     name: str | None
     node: object
+    written: tuple[float, float]  # the position as written (a polygon's box starts elsewhere)
+    at: dict  # {(field, axis): (node, what)} of each value a rule may refuse (rules.Fault)
+
+    @property
+    def line(self) -> int:
+        return self.node.start_mark.line + 1
 
 
 @dataclass
 class Block:
-    """One generate block, checked, before its objects are drawn."""
+    """One generate block, read; its rules are checked by column (`ObjectReader.check_blocks`)."""
 
     spec: gen.BlockSpec
     kind: int
@@ -193,45 +165,55 @@ class Block:
     fill: bool
     name: str | None
     node: object
+    at: dict  # {(field, axis): (node, what)}, as Listed.at
+    index: int = 0
+
+    @property
+    def line(self) -> int:
+        return self.node.start_mark.line + 1
+
+    @property
+    def ends(self):
+        """(min, max) of its range of speeds or velocities, or None."""
+        return self.spec.speed_range or self.spec.velocity_range
+
+
+def _columns(items, pos, vel) -> rule.Columns:
+    """The Columns of listed objects or blocks (`pos`, `vel`: (n, 2) arrays of their values)."""
+    n = len(items)
+    return rule.Columns(
+        size=np.array(
+            [o.spec.size if isinstance(o, Block) else o.size for o in items], np.float64
+        ).reshape(n, 2),
+        pos=np.asarray(pos, np.float64).reshape(n, 2),
+        vel=np.asarray(vel, np.float64).reshape(n, 2),
+        mass=np.array([o.mass if ("mass", 0) in o.at else np.nan for o in items], np.float64),
+        static=np.array([o.static for o in items], bool).reshape(n),
+    )
 
 
 class ObjectReader(Nodes):
-    """Reads the objects and generate blocks of one scenario, under its world and model rules."""
+    """Reads the objects and generate blocks of one scenario (what each value is: keys, shapes,
+    types), and checks their rules once the world and the model are known (`check`,
+    `check_blocks`)."""
 
-    def __init__(
-        self, path: str, limits: Limits, world: WorldSpec, rules: ModelRules, fps_from=None
-    ):
+    def __init__(self, path: str, limits: Limits):
         super().__init__(path)
         self.limits = limits
-        self.world = world
-        self.rules = rules
-        self.fps_from = fps_from  # "--fps F" when the fps came from the command line
 
-    def velocity_pair(self, node, what: str, paper_rate: bool) -> tuple[float, float]:
-        """[vx, vy] within MAX_SPEED; with `paper_rate`, each a rate the paper model can take."""
-        items, values = self.pair(node, what)
-        for n, v, axis in zip(items, values, "xy", strict=True):
-            if abs(v) > MAX_SPEED:
-                raise self.error(
-                    n,
-                    f"{what} {axis} must be at most {fmt(MAX_SPEED)} px/s in size, not {fmt(v)}",
-                )
-            if paper_rate:
-                self.paper_rate(n, v)
-        return float(values[0]), float(values[1])
-
-    def paper_rate(self, node, v) -> None:
-        try:
-            motion.paper_rate(v, self.world.fps)
-        except ValueError as exc:
+    def pixels(self, node, what: str) -> float:
+        """A number of pixels as written; that it is whole and at least 1 is a rule."""
+        v = self.scalar(node, what)
+        if not is_number(v) or (isinstance(v, float) and not math.isfinite(v)):
             raise self.error(
-                node, f"{self.prefix(self.rules.origin, self.fps_from)}{exc}"
-            ) from None
+                node, f"{what} must be a whole number of pixels, not {ys.describe(node)}"
+            )
+        return float(v) + 0.0  # a number is at most MAX_NUMBER_CHARS long, so within float range
 
-    def size_of(self, shape: str, node, what: str) -> tuple[int, int]:
-        px = {"of": " of pixels", "unit": " px"}
+    def size_of(self, shape: str, node, what: str, at: dict) -> tuple[float, float]:
         if shape == "circle":
-            d = self.integer(node, f"{what}.diameter", lo=1, **px)
+            at[("size", 0)] = at[("size", 1)] = (node, f"{what}.diameter")
+            d = self.pixels(node, f"{what}.diameter")
             return d, d
         if isinstance(node, yaml.SequenceNode):
             if len(node.value) != 2:
@@ -239,10 +221,13 @@ class ObjectReader(Nodes):
                     node,
                     f"{what}.size must be one number or [w, h], not a list of {len(node.value)}",
                 )
-            w = self.integer(node.value[0], f"{what}.size w", lo=1, **px)
-            h = self.integer(node.value[1], f"{what}.size h", lo=1, **px)
-            return w, h
-        s = self.integer(node, f"{what}.size", lo=1, **px)
+            at[("size", 0)] = (node.value[0], f"{what}.size w")
+            at[("size", 1)] = (node.value[1], f"{what}.size h")
+            return self.pixels(node.value[0], f"{what}.size w"), self.pixels(
+                node.value[1], f"{what}.size h"
+            )
+        at[("size", 0)] = at[("size", 1)] = (node, f"{what}.size")
+        s = self.pixels(node, f"{what}.size")
         return s, s
 
     def shape_of(self, m: dict, node, what: str, shapes: tuple[str, ...]) -> str:
@@ -259,18 +244,15 @@ class ObjectReader(Nodes):
             raise self.error(node, f"{what} ({shape}) is missing '{wanted}'")
         return shape
 
-    def common(self, m: dict, what: str):
+    def common(self, m: dict, what: str, at: dict):
         """color, mass, static, fill, name of an object or a block."""
         color_node = m["color"][1] if "color" in m else None
         color = DEFAULT_COLOR if color_node is None else self.color(color_node, f"{what}.color")
         static = self.boolean(m["static"][1], f"{what}.static") if "static" in m else False
         mass = DEFAULT_MASS
         if "mass" in m:
-            mass = float(self.number(m["mass"][1], f"{what}.mass", lo=MIN_MASS, hi=MAX_MASS))
-            if static:
-                raise self.error(
-                    m["mass"][0], f"{what} is static, so its mass is infinite; remove 'mass'"
-                )
+            mass = float(self.number(m["mass"][1], f"{what}.mass"))
+            at[("mass", 0)] = (m["mass"][1], f"{what}.mass")
         fill = self.boolean(m["fill"][1], f"{what}.fill") if "fill" in m else False
         name = None
         if "name" in m:
@@ -297,6 +279,7 @@ class ObjectReader(Nodes):
 
     def listed(self, i: int, node) -> Listed:
         what = f"objects[{i}]"
+        at: dict = {}
         m = self.mapping(node, "object", OBJECT_KEYS)
         shape = self.shape_of(m, node, what, SHAPES)
         verts = None
@@ -327,57 +310,73 @@ class ObjectReader(Nodes):
             p = np.array(pts, np.int64)
             lo = p.min(axis=0)
             verts = p - lo
-            size = (int(verts[:, 0].max()) + 1, int(verts[:, 1].max()) + 1)
+            size = (float(verts[:, 0].max()) + 1, float(verts[:, 1].max()) + 1)
             offset = (int(lo[0]), int(lo[1]))
-            if self.rules.convex_polygons:
-                problem = polygon_problem(p)
-                if problem is not None:
-                    raise self.error(
-                        pnode,
-                        f"{self.prefix(self.rules.origin)}{what}.points: under geometry "
-                        f"'exact' a polygon must be convex with some area, but {problem}",
-                    )
+            at[("size", 0)] = at[("size", 1)] = (pnode, f"{what}.points")
         else:
-            size = self.size_of(shape, m[_SIZE_KEY[shape]][1], what)
+            size = self.size_of(shape, m[_SIZE_KEY[shape]][1], what, at)
         if "position" not in m:
             raise self.error(node, f"{what} is missing 'position' ([x, y] of its top-left corner)")
         pos_items, xy = self.pair(m["position"][1], f"{what}.position")
-        if self.rules.whole_positions:
-            for n, v, axis in zip(pos_items, xy, "xy", strict=True):
-                if not float(v).is_integer():
-                    raise self.error(
-                        n,
-                        f"{self.prefix(self.rules.origin)}{what}.position {axis} "
-                        f"must be a whole number of pixels under the paper model, "
-                        f"not {fmt(v)}",
-                    )
-        color, color_node, mass, static, fill, name = self.common(m, what)
+        for a, (n, axis) in enumerate(zip(pos_items, "xy", strict=True)):
+            at[("position", a)] = (n, f"{what}.position {axis}")
+        color, color_node, mass, static, fill, name = self.common(m, what, at)
         vel = (0.0, 0.0)
         if "velocity" in m:
-            vnode = m["velocity"][1]
-            vel = self.velocity_pair(
-                vnode, f"{what}.velocity", self.rules.paper_rates and not static
-            )
-            if static and vel != (0.0, 0.0):
-                raise self.error(
-                    vnode,
-                    f"{what} is static, so it cannot move: its velocity must be [0, 0] or absent",
-                )
+            items, values = self.pair(m["velocity"][1], f"{what}.velocity")
+            for a, (n, axis) in enumerate(zip(items, "xy", strict=True)):
+                at[("velocity", a)] = (n, f"{what}.velocity {axis}")
+            vel = (float(values[0]), float(values[1]))
         pos = (float(xy[0]) + offset[0], float(xy[1]) + offset[1])
+        written = (float(xy[0]), float(xy[1]))
+        kind = _KIND_OF_SHAPE[shape]
         return Listed(
-            _KIND_OF_SHAPE[shape],
-            pos,
-            size,
-            vel,
-            mass,
-            static,
-            color,
-            color_node,
-            fill,
-            verts,
-            name,
-            node,
-        )
+            i, kind, pos, size, vel, mass, static, color, color_node, fill, verts, name, node,
+            written, at,
+        )  # fmt: skip
+
+    # -- the rules, once the world and the model are known
+
+    def check(self, listed, blocks, world: WorldSpec | None, model, fps_from=None) -> None:
+        """Every rule of the listed objects and the blocks (each FAILED when refused): those of
+        the rules (None when refused) wait for them."""
+        if listed is not FAILED:
+            self.check_listed(listed, world, model, fps_from)
+        if blocks is not FAILED:
+            self.check_blocks(blocks, world, model, fps_from)
+
+    def check_listed(self, listed: list[Listed], world: WorldSpec | None, model, fps_from=None):
+        """Every rule of the listed objects (runner.scenario.rules), each object's first fault at
+        its value's node; under geometry exact a polygon is convex with some area. The rules
+        that need the world (None when refused) or the `model` (a ModelRules, None when
+        refused) wait for them."""
+        model = model or _NO_MODEL
+        refused = set()
+        for row, o in enumerate(listed):
+            problem = None
+            if model.convex_polygons and o.verts is not None:
+                problem = polygon_problem(o.verts)
+            if problem is not None:
+                refused.add(row)
+                node, what = o.at[("size", 0)]
+                self.attempt(
+                    _raise,
+                    self.error(
+                        node,
+                        f"{self.prefix(model.origin)}{what}: under geometry 'exact' a polygon "
+                        f"must be convex with some area, but {problem}",
+                    ),
+                )
+        cols = _columns(listed, [o.written for o in listed], [o.vel for o in listed])
+        cols.corner = np.array([o.pos for o in listed], np.float64).reshape(-1, 2)
+        fps, bounds = (world.fps, (world.width, world.height)) if world else (None, None)
+        found = rule.faults(cols, model.paper_rates, fps, bounds)
+        for f in rule.first_per_row(found):
+            if f.row not in refused:
+                self.attempt(_raise, self.fault(listed, f, model, fps_from, "objects"))
+
+    def fault(self, items, f: rule.Fault, model: ModelRules, fps_from, kind: str):
+        return fault_error(self, items, f, kind, model.origin, fps_from)
 
     def blocks(self, top: dict, n_listed: int) -> list[Block]:
         if "generate" not in top:
@@ -405,11 +404,12 @@ class ObjectReader(Nodes):
 
     def block(self, k: int, m: dict, node) -> Block:
         what = f"generate[{k}]"
+        at: dict = {}
         shape = self.shape_of(m, node, what, BLOCK_SHAPES)
-        size = self.size_of(shape, m[_SIZE_KEY[shape]][1], what)
+        size = self.size_of(shape, m[_SIZE_KEY[shape]][1], what, at)
         count = self.integer(m["count"][1], f"{what}.count", lo=0)
         seed = self.integer(m["seed"][1], f"{what}.seed", lo=0, hi=MAX_SEED) if "seed" in m else 0
-        color, color_node, mass, static, fill, name = self.common(m, what)
+        color, color_node, mass, static, fill, name = self.common(m, what, at)
         if "speed" in m and "velocity" in m:
             raise self.error(
                 m["velocity"][0], f"{what}: give either 'speed' or 'velocity', not both"
@@ -420,57 +420,19 @@ class ObjectReader(Nodes):
             snode = m["speed"][1]
             if isinstance(snode, yaml.MappingNode):
                 r = self.mapping(snode, "speed", RANGE_KEYS)
-                a, b = self.range_ends(r, snode, f"{what}.speed")
+                a, b = self.range_ends(r, snode, f"{what}.speed", at)
                 if a > b:
                     raise self.error(snode, f"{what}.speed: min {fmt(a)} is more than max {fmt(b)}")
                 speed_range = (float(a), float(b))
                 moving = b > 0
             else:
-                s = self.number(snode, f"{what}.speed", lo=0, hi=MAX_SPEED, unit=" px/s")
-                if self.rules.paper_rates and not static:
-                    self.paper_rate(snode, s)
+                s = self.number(snode, f"{what}.speed", lo=0, unit=" px/s")
+                at[("velocity", 0)] = at[("velocity", 1)] = (snode, f"{what}.speed")
                 speed = float(s)
                 moving = s > 0
         if "velocity" in m:
-            vnode = m["velocity"][1]
-            if not isinstance(vnode, yaml.MappingNode):
-                raise self.error(
-                    vnode,
-                    f"{what}.velocity must be {{min: [vx, vy], max: [vx, vy]}}"
-                    f", not {ys.describe(vnode)}",
-                )
-            r = self.mapping(vnode, "velocity", RANGE_KEYS)
-            ends = []
-            for key in RANGE_KEYS:
-                if key not in r:
-                    raise self.error(vnode, f"{what}.velocity is missing '{key}'")
-                items, v = self.pair(r[key][1], f"{what}.velocity {key}")
-                for n, c, axis in zip(items, v, "xy", strict=True):
-                    if abs(c) > MAX_SPEED:
-                        raise self.error(
-                            n,
-                            f"{what}.velocity {key} {axis} must be at most "
-                            f"{fmt(MAX_SPEED)} px/s in size",
-                        )
-                    if self.rules.whole_velocities and not float(c).is_integer():
-                        raise self.error(
-                            n,
-                            f"{self.prefix(self.rules.origin)}{what}.velocity "
-                            f"{key} {axis} must be a whole number under the paper "
-                            f"model (it draws whole-number velocities), not "
-                            f"{fmt(c)}",
-                        )
-                ends.append((float(v[0]), float(v[1])))
-            for axis in (0, 1):
-                if ends[0][axis] > ends[1][axis]:
-                    raise self.error(
-                        vnode,
-                        f"{what}.velocity: min {'xy'[axis]} "
-                        f"{fmt(ends[0][axis])} is more than max {'xy'[axis]} "
-                        f"{fmt(ends[1][axis])}",
-                    )
-            velocity_range = (ends[0], ends[1])
-            moving = any(c != 0 for end in ends for c in end)
+            velocity_range = self.velocity_range(m["velocity"][1], what, at)
+            moving = any(c != 0 for end in velocity_range for c in end)
         if static and moving:
             key = "speed" if "speed" in m else "velocity"
             raise self.error(
@@ -481,20 +443,129 @@ class ObjectReader(Nodes):
             speed = speed_range = velocity_range = None
         spec = gen.BlockSpec(
             count=count,
-            size=size,
+            size=(int(size[0]), int(size[1])) if all(map(float.is_integer, size)) else size,
             seed=seed,
             speed=speed,
             speed_range=speed_range,
             velocity_range=velocity_range,
-            whole=self.rules.whole_velocities,
         )
-        return Block(spec, _KIND_OF_SHAPE[shape], mass, static, color, color_node, fill, name, node)
+        kind = _KIND_OF_SHAPE[shape]
+        return Block(spec, kind, mass, static, color, color_node, fill, name, node, at, k)
 
-    def range_ends(self, r: dict, node, what: str):
-        """(min, max) of a speed range {min, max}: numbers in [0, MAX_SPEED]."""
+    def velocity_range(self, vnode, what: str, at: dict):
+        """((vx0, vy0), (vx1, vy1)) of `velocity: {min: [vx, vy], max: [vx, vy]}`."""
+        if not isinstance(vnode, yaml.MappingNode):
+            raise self.error(
+                vnode,
+                f"{what}.velocity must be {{min: [vx, vy], max: [vx, vy]}}"
+                f", not {ys.describe(vnode)}",
+            )
+        r = self.mapping(vnode, "velocity", RANGE_KEYS)
+        ends = []
+        for key in RANGE_KEYS:
+            if key not in r:
+                raise self.error(vnode, f"{what}.velocity is missing '{key}'")
+            items, v = self.pair(r[key][1], f"{what}.velocity {key}")
+            for a, (n, axis) in enumerate(zip(items, "xy", strict=True)):
+                at[(f"velocity {key}", a)] = (n, f"{what}.velocity {key} {axis}")
+            ends.append((float(v[0]), float(v[1])))
+        for axis in (0, 1):
+            if ends[0][axis] > ends[1][axis]:
+                raise self.error(
+                    vnode,
+                    f"{what}.velocity: min {'xy'[axis]} "
+                    f"{fmt(ends[0][axis])} is more than max {'xy'[axis]} "
+                    f"{fmt(ends[1][axis])}",
+                )
+        return ends[0], ends[1]
+
+    def range_ends(self, r: dict, node, what: str, at: dict):
+        """(min, max) of a speed range {min, max}: numbers >= 0."""
         for key in RANGE_KEYS:
             if key not in r:
                 raise self.error(node, f"{what} is missing '{key}'")
-        a = self.number(r["min"][1], f"{what} min", lo=0, hi=MAX_SPEED, unit=" px/s")
-        b = self.number(r["max"][1], f"{what} max", lo=0, hi=MAX_SPEED, unit=" px/s")
+        a = self.number(r["min"][1], f"{what} min", lo=0, unit=" px/s")
+        b = self.number(r["max"][1], f"{what} max", lo=0, unit=" px/s")
+        for key in RANGE_KEYS:
+            at[(f"velocity {key}", 0)] = at[(f"velocity {key}", 1)] = (r[key][1], f"{what} {key}")
         return a, b
+
+    def check_blocks(self, blocks: list[Block], world: WorldSpec | None, model, fps_from=None):
+        """The rules of each block's objects (runner.scenario.rules), each block's first fault at
+        its node: its size and mass, its `speed` as each velocity component, and each end of its
+        ranges as a velocity; under the paper model a range of velocities is drawn as whole
+        numbers, so its ends are whole. Those that need the world or the model wait for them."""
+        fps = world.fps if world else None
+        model = model or _NO_MODEL
+        for b in blocks:
+            b.spec = dataclasses.replace(b.spec, whole=model.whole_velocities)
+        speed = [(b.spec.speed or 0.0,) * 2 for b in blocks]
+        cols = _columns(blocks, np.zeros((len(blocks), 2)), speed)
+        found = rule.first_per_row(rule.faults(cols, model.paper_rates, fps))
+        refused = {f.row for f in found}
+        for f in found:
+            self.attempt(_raise, self.fault(blocks, f, model, fps_from, "generate"))
+        ends = [_End(b, key) for b in blocks for key in ("min", "max") if b.ends is not None]
+        n = len(ends)
+        cols = rule.Columns(
+            np.ones((n, 2)), np.zeros((n, 2)), np.array([e.vel for e in ends]).reshape(n, 2),
+            np.full(n, np.nan), np.zeros(n, bool),
+        )  # fmt: skip
+        for f in rule.first_per_row(rule.faults(cols, False, fps)):
+            if ends[f.row].index not in refused:
+                refused.add(ends[f.row].index)
+                self.attempt(_raise, self.fault(ends, f, model, fps_from, "generate"))
+        if not model.whole_velocities:
+            return
+        for e in ends:
+            if e.index in refused or e.speed:
+                continue
+            for a in (0, 1):
+                if not float(e.vel[a]).is_integer():
+                    refused.add(e.index)
+                    node, what = e.at[("velocity", a)]
+                    self.attempt(
+                        _raise,
+                        self.error(
+                            node,
+                            f"{self.prefix(model.origin)}{what} must be a whole number under "
+                            f"the paper model (it draws whole-number velocities), not "
+                            f"{fmt(e.vel[a])}",
+                        ),
+                    )
+                    break
+
+
+class _End:
+    """One end (min or max) of a block's range of speeds or velocities, checked as a velocity."""
+
+    def __init__(self, block: Block, key: str):
+        self.index, self.node, self.line = block.index, block.node, block.line
+        self.speed = block.spec.speed_range is not None
+        end = block.ends[RANGE_KEYS.index(key)]
+        self.vel = (end, 0.0) if self.speed else end
+        self.at = {("velocity", a): block.at[(f"velocity {key}", a)] for a in (0, 1)}
+
+
+def fault_error(reader: Nodes, items, f: rule.Fault, kind: str, origin=None, fps_from=None):
+    """The ScenarioError of Fault `f` of `items` (listed objects or blocks, `kind` "objects" or
+    "generate"), at the node of the value it is about: `--model M: objects[3].size w must be
+    ...`; a fault of the whole object (its box) is at the object, and an object it overlaps is
+    named with its line."""
+    o = items[f.row]
+    if f.field == "box":
+        node, what = o.node, f"{kind}[{o.index}]"
+    else:
+        node, what = o.at[(f.field, f.axis)]
+    text = f.text
+    if f.other is not None:
+        a = items[f.other]
+        text = text.format(other=f"{kind}[{a.index}] (line {a.line})")
+        what = f"{what} (line {o.line})"
+    origins = (origin if "model" in f.by else None, fps_from if "fps" in f.by else None)
+    said = f"{what} {text}" if f.named else text
+    return reader.error(node, f"{reader.prefix(*origins)}{said}")
+
+
+def _raise(exc: Exception):
+    raise exc

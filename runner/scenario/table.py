@@ -23,14 +23,17 @@ comma quoted with ", blank lines skipped, lines ending in LF, CRLF or CR) by `nu
 single pass, a `.npy` file (a structured array whose field names are the columns, numbers as any
 numeric type, text as unicode or bytes) over the same bytes once its header's claim has been held
 against the file's size. The table's SHA-256 is kept (`Table.sha256`): it counts in the scenario's
-hash, so goldens and reports see an edited table as an edited scenario.
+hash (`with_table`), so goldens and reports see an edited table as an edited scenario.
 
-Every check runs over whole columns at once (numpy), and the first failing cell, in row order and
-then column order, is reported as `FILE:ROW:COLUMN: error: ...`: the CSV's line and the character
+Every check runs over whole columns at once (numpy): first what each cell holds (`read_table`: a
+number, a shape, a flag, a colour, a name), then, once the world and the model are known, the
+rules every object meets however it is written (`checked`, by `runner.scenario.rules`; a start
+overlap by `runner.scenario.assemble`). The first failing cell, in row order and then column
+order, is reported as `FILE:ROW:COLUMN: error: ...`: the CSV's line and the character
 column where the field starts (for `.npy` the row counted from 1 and the field's number). Finding
 that place reads the CSV again with Python's csv module, on the error path only. A text cell longer
 than its column's bound (TEXT_CHARS) is refused, never cut short; names follow the one rule for
-object names (`runner.scenario.objects.object_names`), and two rows of one name are refused at the
+object names (`runner.scenario.rules.object_names`), and two rows of one name are refused at the
 second (`runner.scenario.assemble.check_names`).
 """
 
@@ -44,11 +47,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from collide2d.engine import motion
 from collide2d.engine.world import KIND_BOX, KIND_CIRCLE
 from collide2d.runner.scenario import colors
+from collide2d.runner.scenario import rules as rule
 from collide2d.runner.scenario.limits import Limits
 from collide2d.runner.scenario.parse import read_regular
+from collide2d.runner.scenario.rules import DEFAULT_MASS, NameRefused, object_names
 from collide2d.runner.scenario.tableread import (
     COLUMNS,
     NUMBERS,
@@ -67,8 +71,9 @@ FALSE_WORDS = ("false", "no", "off", "0", "")
 
 @dataclass(frozen=True)
 class Table:
-    """The objects of a table, checked, as arrays in id order; `colors` are the distinct colours
-    in order of first use and `color_of` each object's index into them."""
+    """The objects of a table as arrays in id order; `colors` are the distinct colours in order of
+    first use and `color_of` each object's index into them. As read, `mass` is NaN where none is
+    given and `vel` as written; `checked` gives them as the objects have them, every rule held."""
 
     path: str
     kind: np.ndarray
@@ -84,6 +89,7 @@ class Table:
     where: object  # where(row, column) -> ScenarioError maker, see runner.scenario.tableread.Place
     lines: tuple | None = None  # each object's line in the scenario, when it has its own
     sha256: str | None = None  # of the table file's bytes (None: the rows are the scenario's text)
+    problems: tuple = ()  # cells at fault when read: (row, column index, order, column, text)
 
     @property
     def n(self) -> int:
@@ -113,17 +119,16 @@ def table_path(scenario_path: str | None, given: str) -> tuple[str, str]:
     return target, shown
 
 
-def read_table(
-    opened: str, shown: str, limits: Limits, width: int, height: int, fps: int, paper: bool
-) -> Table:
-    """Read and check the table at `opened` (named `shown` in messages) for a world of that size,
-    under the paper model's rules when `paper`; a located ScenarioError when anything is wrong."""
+def read_table(opened: str, shown: str, limits: Limits) -> Table:
+    """Read the table at `opened` (named `shown` in messages): a located ScenarioError when the
+    file cannot be read as a table, else its values, each cell's own faults kept for `refuse` and
+    `checked`."""
     raw = read_regular(opened, limits.max_file_bytes, shown, "table")
     if opened.lower().endswith(".npy"):
         data, place = read_npy(raw, shown, limits)
     else:
         data, place = read_csv(raw, shown, limits)
-    table = _check(data, place, width, height, fps, paper)
+    table = _check(data, place)
     return dataclasses.replace(table, sha256=hashlib.sha256(raw).hexdigest())
 
 
@@ -190,7 +195,10 @@ def _first(bad: np.ndarray) -> int | None:
     return int(np.argmax(bad)) if bad.any() else None
 
 
-def _check(data, place, width: int, height: int, fps: int, paper: bool) -> Table:
+def _check(data, place) -> Table:
+    """The table's values, each cell read as what its column holds (a number, a shape, a flag, a
+    colour, a name); what a cell itself gets wrong is kept in `Table.problems`, and the rules
+    of objects wait for `checked`."""
     n = data.shape[0]
     names = data.dtype.names
     # (row, column index, order found, column, message): the first cell in row and column order,
@@ -209,13 +217,6 @@ def _check(data, place, width: int, height: int, fps: int, paper: bool) -> Table
         refuse(~np.isfinite(v), column, lambda r: f"must be a finite number, not {_shown(v[r])}")
         return np.where(np.isfinite(v), v, default) + 0.0  # -0.0 is 0.0
 
-    def whole(v, column, lo, unit):
-        refuse(
-            (v != np.floor(v)) | (v < lo),
-            column,
-            lambda r: f"must be a whole number {unit}>= {lo}, not {_shown(v[r])}",
-        )
-
     ids = number("id")
     refuse(
         ids != np.arange(n),
@@ -227,8 +228,6 @@ def _check(data, place, width: int, height: int, fps: int, paper: bool) -> Table
     known = ((words == "box") | (words == "circle"))[of]
     refuse(~known, "shape", lambda r: f"must be box or circle, not {str(words[of[r]])!r}")
     w, h = number("w", 1.0), number("h", 1.0)
-    whole(w, "w", 1, "of pixels ")
-    whole(h, "h", 1, "of pixels ")
     refuse(
         (kind == KIND_CIRCLE) & (w != h),
         "h",
@@ -238,60 +237,59 @@ def _check(data, place, width: int, height: int, fps: int, paper: bool) -> Table
         ),
     )
     x, y = number("x"), number("y")
-    if paper:
-        for v, c in ((x, "x"), (y, "y")):
-            refuse(
-                v != np.floor(v),
-                c,
-                lambda r, v=v: (
-                    f"must be a whole number of pixels under the paper model, not {_shown(v[r])}"
-                ),
-            )
-    for v, c, side, size in ((x, "x", width, w), (y, "y", height, h)):
-        refuse(
-            (v < 0) | (v + size > side),
-            c,
-            lambda r, v=v, size=size, side=side: (
-                f"the box [{_shown(v[r])}, {_shown(v[r] + size[r])}) must lie in [0, {side})"
-            ),
-        )
     static = _flag(data, "static", refuse)
     fill = _flag(data, "fill", refuse)
     vx, vy = number("vx"), number("vy")
-    for v, c in ((vx, "vx"), (vy, "vy")):
-        refuse(
-            np.abs(v) > 1e9,
-            c,
-            lambda r, v=v: f"must be at most 1e9 px/s in size, not {_shown(v[r])}",
-        )
-        refuse(static & (v != 0), c, lambda r: "the object is static, so it cannot move")
-        if paper:
-            moving = ~static & np.isfinite(v)
-            for value in np.unique(v[moving]):
-                try:
-                    motion.paper_rate(float(value), fps)
-                except ValueError as exc:
-                    refuse(moving & (v == value), c, lambda r, exc=exc: str(exc))
-                    break
-    mass = _mass(data, static, refuse)
+    mass = _mass(data, refuse)
     rgb, color_of = _colors(data, refuse)
     names_out = _names(data, refuse)
-    if problems:
-        r, _, _, column, message = min(problems)
-        raise place(r, column, message)
     return Table(
         path=place.shown,
         kind=kind,
         pos=np.stack([x, y], 1),
         size=np.stack([w, h], 1),
-        vel=np.where(static[:, None], 0.0, np.stack([vx, vy], 1)),
-        mass=np.where(static, np.inf, mass),
+        vel=np.stack([vx, vy], 1),
+        mass=mass,
         static=static,
         fill=fill,
         colors=rgb,
         color_of=color_of,
         names=names_out,
         where=place,
+        problems=tuple(problems),
+    )
+
+
+# The table's column of each field and axis a rule may refuse (runner.scenario.rules.Fault).
+_COLUMN_OF = {
+    "size": ("w", "h"),
+    "position": ("x", "y"),
+    "box": ("x", "y"),
+    "velocity": ("vx", "vy"),
+    "mass": ("mass", "mass"),
+}
+
+
+def checked(table: Table, world, paper: bool) -> Table:
+    """The table with every rule of objects checked (runner.scenario.rules) in `world` (None:
+    its bounds and rates wait for a good world), under the paper model's rules when `paper`:
+    the first fault of a cell, in row order and then the file's column order, raised at its
+    cell; else the table, static objects still and of infinite mass."""
+    cols = rule.Columns(table.size, table.pos, table.vel, table.mass, table.static)
+    problems = list(table.problems)
+    header = table.where.header
+    fps, bounds = (world.fps, (world.width, world.height)) if world is not None else (None, None)
+    for f in rule.faults(cols, paper, fps, bounds):
+        column = _COLUMN_OF[f.field][f.axis]
+        problems.append((f.row, header.index(column), len(problems), column, f.text))
+    if problems:
+        r, _, _, column, message = min(problems)
+        raise table.where(r, column, message)
+    static = table.static
+    return dataclasses.replace(
+        table,
+        vel=np.where(static[:, None], 0.0, table.vel),
+        mass=np.where(static, np.inf, np.where(np.isnan(table.mass), DEFAULT_MASS, table.mass)),
     )
 
 
@@ -301,11 +299,9 @@ def _shown(v) -> str:
 
 
 def _names(data, refuse) -> tuple:
-    """Each row's name under the one rule for object names (runner.scenario.objects.object_names), a
+    """Each row's name under the one rule for object names (runner.scenario.rules.object_names), a
     cell past TEXT_CHARS as written refused first (a CSV's is read one character longer, never cut
     short unseen); a number in a .npy name column is its text."""
-    from collide2d.runner.scenario.objects import NameRefused, object_names
-
     n = data.shape[0]
     if "name" not in data.dtype.names:
         return (None,) * n
@@ -341,16 +337,15 @@ def _flag(data, column: str, refuse) -> np.ndarray:
     return yes[of] if n else np.zeros(0, bool)
 
 
-def _mass(data, static, refuse) -> np.ndarray:
-    from collide2d.runner.scenario.objects import DEFAULT_MASS, MAX_MASS, MIN_MASS
-
-    n = static.shape[0]
+def _mass(data, refuse) -> np.ndarray:
+    """Each row's mass as written, NaN where the cell is empty or the column absent."""
+    n = data.shape[0]
     if "mass" not in data.dtype.names:
-        return np.full(n, DEFAULT_MASS)
+        return np.full(n, np.nan)
     col = data["mass"]
     if col.dtype.kind in "iuf":
-        given = np.ones(n, bool)
         mass = col.astype(np.float64)
+        given = np.ones(n, bool)
     else:
         words, of = _words(data, "mass", "", refuse)
         values = np.full(words.shape[0], np.nan)
@@ -362,19 +357,11 @@ def _mass(data, static, refuse) -> np.ndarray:
                 except ValueError:
                     bad_word[k] = True
         refuse(bad_word[of], "mass", lambda r: f"must be a number, not {str(words[of[r]])!r}")
-        given = (words != "")[of]
-        mass = np.where(bad_word[of], DEFAULT_MASS, values[of])
-    refuse(
-        given & static,
-        "mass",
-        lambda r: "the object is static, so its mass is infinite; leave the cell empty",
-    )
-    refuse(
-        given & ~static & ~((mass >= MIN_MASS) & (mass <= MAX_MASS)),
-        "mass",
-        lambda r: f"must be from {MIN_MASS:g} to {MAX_MASS:g}, not {_shown(mass[r])}",
-    )
-    return np.where(given, mass, DEFAULT_MASS)
+        given = (words != "")[of] & ~bad_word[of]
+        mass = values[of]
+    bad = given & ~np.isfinite(mass)
+    refuse(bad, "mass", lambda r: f"must be a finite number, not {_shown(mass[r])}")
+    return np.where(bad, DEFAULT_MASS, mass) + 0.0
 
 
 def _colors(data, refuse) -> tuple[list, np.ndarray]:
@@ -397,12 +384,20 @@ def _colors(data, refuse) -> tuple[list, np.ndarray]:
     return rgb, of
 
 
+def with_table(text_sha256: str, table_sha256: str) -> str:
+    """The hash of a scenario whose objects come from a table: the file's and the table's hashes
+    hashed together, so that goldens and reports see an edit of the table as an edit of the
+    scenario. A scenario without a table keeps the hash of its file's bytes alone."""
+    return hashlib.sha256(f"{text_sha256} {table_sha256}".encode("ascii")).hexdigest()
+
+
 TABLE_KEYS = ("file",)
 
 
-def table_of(reader, top: dict, scenario_path: str | None, limits: Limits, world, paper: bool):
-    """The Table the scenario's `objects: {file: NAME}` names, or None when `objects` is a list
-    (or absent). `reader` (a runner.scenario.nodes.Nodes) locates errors in the scenario itself."""
+def table_of(reader, top: dict, scenario_path: str | None, limits: Limits):
+    """The Table the scenario's `objects: {file: NAME}` names, read (`read_table`; its rules
+    wait for `checked`), or None when `objects` is a list (or absent). `reader` (a
+    runner.scenario.nodes.Nodes) locates errors in the scenario itself."""
     import yaml
 
     if "objects" not in top or not isinstance(top["objects"][1], yaml.MappingNode):
@@ -419,4 +414,4 @@ def table_of(reader, top: dict, scenario_path: str | None, limits: Limits, world
         opened, shown = table_path(scenario_path, given)
     except ValueError as exc:
         raise reader.error(node, str(exc)) from None
-    return read_table(opened, shown, limits, world.width, world.height, world.fps, paper)
+    return read_table(opened, shown, limits)

@@ -34,14 +34,14 @@ import threading
 import numpy as np
 
 from collide2d.runner.scenario.limits import Limits
-from collide2d.runner.scenario.objects import MAX_OBJECT_NAME_CHARS
 from collide2d.runner.scenario.parse import ScenarioError
+from collide2d.runner.scenario.rules import MAX_OBJECT_NAME_CHARS
 
 COLUMNS = ("id", "shape", "w", "h", "x", "y", "vx", "vy", "mass", "color", "name", "static", "fill")
 REQUIRED = ("id", "shape", "w", "h", "x", "y")
 NUMBERS = ("id", "w", "h", "x", "y", "vx", "vy")
 # Longest text a cell may hold, per text column (characters, as written); wider columns would cost
-# memory for every row. A name's bound is the one every object name has (runner.scenario.objects).
+# memory for every row. A name's bound is the one every object name has (runner.scenario.rules).
 TEXT_CHARS = {
     "shape": 16,
     "color": 40,

@@ -213,8 +213,8 @@ def test_generate_static_block():
         ),
         (
             "{count: 2, shape: box, size: 3, static: true, mass: 2}",
-            "mass",
-            "generate[0] is static, so its mass is infinite",
+            "2}",
+            "generate[0].mass must not be given: the object is static, so its mass is infinite",
         ),
     ],
 )

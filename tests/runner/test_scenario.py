@@ -484,13 +484,13 @@ def test_ticks_and_duration_together():
         ),
         (
             "{shape: box, size: 3, position: [0, 0], static: true, velocity: [1, 0]}",
-            "[1, 0]",
-            "objects[0] is static, so it cannot move: its velocity must be [0, 0] or absent",
+            "1, 0]",
+            "objects[0].velocity x must be 0: the object is static, so it cannot move",
         ),
         (
             "{shape: box, size: 3, position: [0, 0], static: true, mass: 3}",
-            "mass",
-            "objects[0] is static, so its mass is infinite",
+            "3}",
+            "objects[0].mass must not be given: the object is static, so its mass is infinite",
         ),
     ],
 )

@@ -45,6 +45,27 @@ def test_good_and_bad_files(tmp_path, capsys):
     assert err == f"{bad}:2:9: error: unknown key 'widht' in world; did you mean 'width'?\n"
 
 
+def test_an_error_in_world_hides_no_error_of_the_objects(tmp_path, capsys):
+    """A typo in `world` and two in objects: all three in one run, in line order; a rule that
+    needs the world (an object outside it) waits for a good world."""
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(
+        "version: 1\n"
+        "world: {widht: 100}\n"
+        "objects:\n"
+        "  - {shape: box, size: 3, positon: [0, 0]}\n"
+        "  - {shape: box, size: 3, position: [900, 0]}\n"
+        "  - {shape: crcle, diameter: 3, position: [20, 0]}\n"
+    )
+    status, out, err = run(["validate", str(bad)], capsys)
+    assert (status, out) == (2, "")
+    assert err.splitlines() == [
+        f"{bad}:2:9: error: unknown key 'widht' in world; did you mean 'width'?",
+        f"{bad}:4:27: error: unknown key 'positon' in object; did you mean 'position'?",
+        f"{bad}:6:13: error: unknown shape 'crcle'; did you mean 'circle'?",
+    ]
+
+
 def test_every_file_is_checked_after_a_bad_one(tmp_path, capsys):
     bad = tmp_path / "bad.yaml"
     bad.write_text("version: 3\n")
