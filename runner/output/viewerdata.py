@@ -146,7 +146,8 @@ class Recorder:
             "events": self.event_rows,
             "overlaps": packed(np.array(self.overlap_rows, np.int32).reshape(-1, OVERLAP_COLUMNS)),
             "paper": scn.model == "paper",
-            "overlay": list(scn.output.overlay),
+            # the overlays the run draws into its frames (`run --overlay`, else the scenario's)
+            "overlay": list(self.layer.names if self.layer is not None else scn.output.overlay),
             "eventCount": int(self.n_events),
         }
 
