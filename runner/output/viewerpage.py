@@ -12,9 +12,10 @@ Controls: play / pause (space), one frame back and forward (left and right arrow
 buttons), the frame slider (Home / End), the speed, the zoom (also the mouse wheel) and panning
 (drag the picture). The events list follows the frame (events of the current tick marked and
 scrolled into view); clicking an event jumps to its tick and outlines the objects involved.
-Hovering an object names it. Overlays: velocity arrows (half a second of motion), boxes (each
-object's pixel extent), contact flashes (a ring at each object of a pair or wall event, fading over
-`FLASH_FRAMES` frames) and labels.
+Hovering an object names it and shows its position (the rounded pixel position the frame draws it
+at) and velocity (px/s) at the frame shown, following the frame as it plays. Overlays: velocity
+arrows (half a second of motion), boxes (each object's pixel extent), contact flashes (a ring at
+each object of a pair or wall event, fading over `FLASH_FRAMES` frames) and labels.
 """
 
 from __future__ import annotations
@@ -62,6 +63,7 @@ def page(data: dict) -> bytes:
 </div>
 <div id="main"><div id="stage"><canvas id="view"></canvas></div>
 <div id="side"><div id="hover" class="dim">hover an object to name it</div>
+<div id="hover-state" class="dim"></div>
 <h3>Events <span class="dim" id="event-count"></span></h3><ol id="events"></ol></div></div>
 <p id="status" class="dim">loading…</p>
 <script id="data" type="application/json">{escape.script_json(data)}</script>
@@ -86,7 +88,7 @@ header { height: 20px; overflow: hidden; }
 canvas { display: block; image-rendering: pixelated; }
 #side { width: 320px; }
 #side h3 { font-size: 14px; line-height: 20px; margin: 8px 0; }
-#hover { height: 20px; }
+#hover, #hover-state { height: 20px; overflow: hidden; white-space: nowrap; }
 #events { height: 560px; overflow: auto; margin: 0; padding: 0 0 0 48px; background: #fff;
   border: 1px solid #ccc; font: 12px/16px ui-monospace, monospace; }
 #events li { cursor: pointer; padding: 0 4px; }
@@ -111,6 +113,7 @@ _JS = r"""
   var playBtn = document.getElementById("play"), zoomSel = document.getElementById("zoom");
   var speedSel = document.getElementById("speed"), list = document.getElementById("events");
   var hover = document.getElementById("hover"), stage = document.getElementById("stage");
+  var hoverState = document.getElementById("hover-state"), hovered = -1;
   var ov = {};
   var named = {velocity: "velocity", boxes: "boxes", contacts: "flashes", labels: "labels",
                overlap: "overlap"};
@@ -274,7 +277,21 @@ _JS = r"""
     lit.forEach(function (li) { li.classList.add("now"); });
     if (lit.length) list.scrollTop = lit[0].offsetTop - list.clientHeight / 3;
   }
-  function go(k) { frame = Math.max(0, Math.min(F - 1, k | 0)); draw(); }
+  function go(k) { frame = Math.max(0, Math.min(F - 1, k | 0)); draw(); describe(); }
+  function num(v) { return String(Math.round(v * 100) / 100); }
+  function describe() {
+    // the hovered object's name, rounded position (px) and velocity (px/s) at this frame
+    var i = hovered;
+    if (!pos || i < 0) {
+      hover.textContent = "—"; hoverState.textContent = ""; view.title = "";
+      return;
+    }
+    var q = at(i, frame), p = (i * F + frame) * 2;
+    hover.textContent = D.names[i] + " (object " + i + (D.static[i] ? ", static" : "") + ")";
+    hoverState.textContent = "at (" + q[0] + ", " + q[1] + ") px, velocity (" + num(vel[p]) +
+      ", " + num(vel[p + 1]) + ") px/s";
+    view.title = D.names[i];
+  }
   function setPlaying(on) {
     playing = on && F > 1;
     playBtn.textContent = playing ? "pause" : "play";
@@ -363,11 +380,10 @@ _JS = r"""
   });
   view.addEventListener("mousemove", function (e) {
     if (!pos) return;
-    var i = objectAt(Math.floor(e.offsetX / zoom), Math.floor(e.offsetY / zoom));
-    hover.textContent = i < 0 ? "—"
-      : D.names[i] + " (object " + i + (D.static[i] ? ", static" : "") + ")";
-    view.title = i < 0 ? "" : D.names[i];
+    hovered = objectAt(Math.floor(e.offsetX / zoom), Math.floor(e.offsetY / zoom));
+    describe();
   });
+  view.addEventListener("mouseleave", function () { hovered = -1; describe(); });
   document.addEventListener("keydown", function (e) {
     if (e.ctrlKey || e.metaKey || e.altKey) return;
     var t = e.target && e.target.tagName;
