@@ -12,7 +12,9 @@ Controls: play / pause (space), one frame back and forward (left and right arrow
 buttons), the frame slider (Home / End), the speed, the zoom (also the mouse wheel) and panning
 (drag the picture). The events list follows the frame (events of the current tick marked and
 scrolled into view); clicking an event jumps to its tick and outlines the objects involved.
-Hovering an object names it and shows its position (the rounded pixel position the frame draws it
+In a failing check's report, the golden's frames are a ghost over the run at their frames (on by
+default; where a golden pixel differs from the run's, the mean of the two). Hovering an object
+names it and shows its position (the rounded pixel position the frame draws it
 at) and velocity (px/s) at the frame shown, following the frame as it plays. Overlays: velocity
 arrows (half a second of motion), boxes (each object's pixel extent), contact flashes (a ring at
 each object of a pair or wall event, fading over `FLASH_FRAMES` frames) and labels.
@@ -45,6 +47,17 @@ def page(data: dict) -> bytes:
             *((("overlap", "overlap before undo"),) if data["paper"] else ()),
         )
     )
+    ghost = ""
+    if data["ghostFrames"]:
+        overlays += '<label><input type="checkbox" id="ov-ghost" checked> golden ghost</label> '
+        jumps = " ".join(
+            f'<button type="button" class="ghost-frame" data-tick="{k}">{k}</button>'
+            for k in data["ghostFrames"]
+        )
+        ghost = (
+            '<p id="ghost-note" class="dim">Ghost: the golden\'s frames, at frames '
+            f"{jumps}; where the golden differs from this run, both are shown half and half.</p>"
+        )
     body = f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8">
 <meta name="viewport" content="width=device-width">
@@ -65,7 +78,7 @@ def page(data: dict) -> bytes:
 <div id="side"><div id="hover" class="dim">hover an object to name it</div>
 <div id="hover-state" class="dim"></div>
 <h3>Events <span class="dim" id="event-count"></span></h3><ol id="events"></ol></div></div>
-<p id="status" class="dim">loading…</p>
+{ghost}<p id="status" class="dim">loading…</p>
 <script id="data" type="application/json">{escape.script_json(data)}</script>
 <script>{_JS.replace("FLASH_FRAMES", str(FLASH_FRAMES))}</script>
 </body></html>
@@ -117,7 +130,7 @@ _JS = r"""
   var ov = {};
   var named = {velocity: "velocity", boxes: "boxes", contacts: "flashes", labels: "labels",
                overlap: "overlap"};
-  ["velocity", "boxes", "flashes", "labels", "overlap"].forEach(function (k) {
+  ["velocity", "boxes", "flashes", "labels", "overlap", "ghost"].forEach(function (k) {
     ov[k] = document.getElementById("ov-" + k) ||
       {checked: false, addEventListener: function () {}};
     ov[k].addEventListener("change", function () { draw(); });
@@ -126,7 +139,11 @@ _JS = r"""
   function rgba(c) { return ((255 << 24) | (c[2] << 16) | (c[1] << 8) | c[0]) >>> 0; }
   var bg = rgba(D.background);
   var col = D.colors.map(rgba);
-  var pos = null, vel = null, off = null, ext = null;
+  var pos = null, vel = null, off = null, ext = null, ghost = null, ghostAt = {};
+  D.ghostFrames.forEach(function (k, g) { ghostAt[k] = g; });
+  document.querySelectorAll("button.ghost-frame").forEach(function (b) {
+    b.addEventListener("click", function () { setPlaying(false); go(Number(b.dataset.tick)); });
+  });
   var frame = 0, zoom = 1, playing = false, selected = null;
   var byTick = {}, lit = [];
 
@@ -175,7 +192,19 @@ _JS = r"""
         if (px >= 0 && px < W && py >= 0 && py < H) pix[py * W + px] = c;
       }
     }
+    if (ghost && ov.ghost.checked && ghostAt[k] !== undefined) blendGhost(ghostAt[k]);
     wctx.putImageData(image, 0, 0);
+  }
+  function blendGhost(g) {
+    // the golden's frame g: where its pixel differs from the run's, the mean of the two
+    var base = g * W * H * 3, d = image.data;
+    for (var p = 0; p < W * H; p++) {
+      var q = base + 3 * p, r = ghost[q], gg = ghost[q + 1], b = ghost[q + 2];
+      if (d[4 * p] === r && d[4 * p + 1] === gg && d[4 * p + 2] === b) continue;
+      d[4 * p] = (d[4 * p] + r) >> 1;
+      d[4 * p + 1] = (d[4 * p + 1] + gg) >> 1;
+      d[4 * p + 2] = (d[4 * p + 2] + b) >> 1;
+    }
   }
   function centre(i, k) {
     var q = at(i, k);
@@ -402,11 +431,12 @@ _JS = r"""
   [1, 2, 3, 4, 6, 8, 12, 16].forEach(function (z) { if (W * z <= 960 && H * z <= 720) fit = z; });
   var overlapRows = [];
   var loads = [inflate(D.positions), inflate(D.velocities), inflate(D.sprites),
-               inflate(D.overlaps)];
+               inflate(D.overlaps), inflate(D.ghost)];
   Promise.all(loads).then(function (bufs) {
     pos = undifference(new Int32Array(bufs[0]));
     vel = new Float32Array(bufs[1]);
     off = new Int32Array(bufs[2]);
+    ghost = D.ghostFrames.length ? new Uint8Array(bufs[4]) : null;
     var flat = new Int32Array(bufs[3]);
     for (var r = 0; r + 13 <= flat.length; r += 13) overlapRows.push(flat.subarray(r, r + 13));
     ext = extents();
