@@ -49,14 +49,14 @@ def page(data: dict) -> bytes:
     )
     ghost = ""
     if data["ghostFrames"]:
-        overlays += '<label><input type="checkbox" id="ov-ghost" checked> golden ghost</label> '
         jumps = " ".join(
             f'<button type="button" class="ghost-frame" data-tick="{k}">{k}</button>'
             for k in data["ghostFrames"]
         )
         ghost = (
-            '<p id="ghost-note" class="dim">Ghost: the golden\'s frames, at frames '
-            f"{jumps}; where the golden differs from this run, both are shown half and half.</p>"
+            '<p id="ghost-note"><label><input type="checkbox" id="ov-ghost" checked> golden '
+            f'ghost</label> <span class="dim">at the golden\'s frames {jumps}: where the golden '
+            "differs from this run, both are shown half and half</span></p>"
         )
     body = f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8">
@@ -74,11 +74,11 @@ def page(data: dict) -> bytes:
 <label>zoom <select id="zoom">{zooms}</select></label>
 <span class="overlays">{overlays}</span>
 </div>
-<div id="main"><div id="stage"><canvas id="view"></canvas></div>
+{ghost}<div id="main"><div id="stage"><canvas id="view"></canvas></div>
 <div id="side"><div id="hover" class="dim">hover an object to name it</div>
 <div id="hover-state" class="dim"></div>
 <h3>Events <span class="dim" id="event-count"></span></h3><ol id="events"></ol></div></div>
-{ghost}<p id="status" class="dim">loading…</p>
+<p id="status" class="dim">loading…</p>
 <script id="data" type="application/json">{escape.script_json(data)}</script>
 <script>{_JS.replace("FLASH_FRAMES", str(FLASH_FRAMES))}</script>
 </body></html>
@@ -93,6 +93,7 @@ header { height: 20px; overflow: hidden; }
 #controls { margin: 8px 0; height: 32px; display: flex; gap: 10px; align-items: center;
   white-space: nowrap; overflow: hidden; }
 #controls button { min-width: 44px; height: 26px; }
+#ghost-note { margin: 0 0 8px; } #ghost-note button { min-width: 32px; }
 #seek { width: 300px; }
 #main { display: flex; gap: 16px; align-items: flex-start; }
 #stage { max-width: 960px; max-height: 720px; overflow: auto; border: 1px solid #999;
