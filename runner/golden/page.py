@@ -8,14 +8,16 @@ a golden goes through `_html`.
 What the page shows, top to bottom: a summary line (`1 failed, 18 passed`), a "failures only"
 filter and the keys; then one section per scenario, failures first (each group by name). A failed
 section says why it changed (`why.Cause`: the scenario edited since bless, or the same scenario
-under another collide2d), lists the problems, shows the event log diff as a table (golden and run
-side by side, the first divergence highlighted, `EVENT_CONTEXT` rows around it), and per differing
+under another collide2d), lists the problems, links the files of its report folder when the page
+is written with one (`base`: the full logs, the full frames, the viewer), shows the event log diff
+as a table (`eventdiff`: the logs aligned, objects named, folds that expand), and per differing
 frame a crop around the changed pixels enlarged with nearest-neighbour pixels next to the full
 frame (the crop's place outlined), in four views: side by side, blink (golden and run toggled in
-place), a slider (golden left of the handle, run right of it) and the diff.
+place), a slider (golden left of the handle, run right of it, a divider between) and the diff.
 
 Keys: j / k next / previous frame, n / p next / previous failing scenario, 1-4 or s / b / l / d the
-view of the current frame (b again toggles blink), arrow keys move its slider, f the filter.
+view of the current frame (b again toggles blink), arrow keys move its slider, f the filter. Every
+name, file name and golden text goes through `_html` (links: percent-encoded, then escaped).
 """
 
 from __future__ import annotations
@@ -171,7 +173,8 @@ def _section(o, base=None) -> str:
         out.append('<pre class="problems">' + _html("\n".join(texts)) + "</pre>")
     logs = ""
     if folder is not None:
-        files = [_link(folder / f, base, FILE_LABELS.get(f, f)) for f in sorted(o.texts) if f]
+        shown = [f for f in FILE_LABELS if f in o.texts] + sorted(set(o.texts) - set(FILE_LABELS))
+        files = [_link(folder / f, base, FILE_LABELS.get(f, f)) for f in shown]
         if o.viewer is not None:
             files.insert(0, _link(folder / VIEWER, base, "viewer of this run"))
         if files:
@@ -179,7 +182,7 @@ def _section(o, base=None) -> str:
         logs = " ".join(
             _link(folder / f, base, FILE_LABELS[f])
             for f in ("events_expected.jsonl", "events_actual.jsonl")
-            if f in o.texts
+            if f in o.texts  # the logs again, where a fold too long to expand points to them
         )
     table = _event_table(o, logs)
     if table:
