@@ -80,6 +80,14 @@ def default_simulate(scenario, **kwargs):
     return simulate(scenario, **kwargs)
 
 
+def viewer_of(simulate):
+    """What makes a failing check's viewer: `replay.viewer_page` when the runs are the runner's
+    own (`default_simulate`), else None (a stand-in run cannot be run again)."""
+    from collide2d.runner.golden import replay
+
+    return replay.viewer_page if simulate is default_simulate else None
+
+
 def run_scenario(scenario, simulate, *, progress=False, jit=None):
     """The golden run of `scenario`: events logged, its golden frames kept; `jit`, when given, the
     kernel mode to run it in (runner.lanes: a cluster worker does not share this process's)."""
@@ -210,7 +218,9 @@ def check_command(args, *, load=default_load, simulate=default_simulate) -> int:
                 result = runs[i - 1]()
             else:
                 result = run_scenario(scn, simulate, progress=_show_progress(args))
-            outcome = check_run(scn, result, store, path=path, report_dir=report_dir)
+            outcome = check_run(
+                scn, result, store, path=path, report_dir=report_dir, viewer=viewer_of(simulate)
+            )
         except Exception as exc:  # one scenario never stops the others
             status = max(status, _scenario_failed(args, "checking", path, scn.name, exc))
             errors.append((scn.name, f"{type(exc).__name__}: {exc}"))

@@ -8,28 +8,33 @@ a golden goes through `_html`.
 What the page shows, top to bottom: a summary line (`1 failed, 18 passed`), a "failures only"
 filter and the keys; then one section per scenario, failures first (each group by name). A failed
 section says why it changed (`why.Cause`: the scenario edited since bless, or the same scenario
-under another collide2d), lists the problems, shows the event log diff as a table (golden and run
-side by side, the first divergence highlighted, `EVENT_CONTEXT` rows around it), and per differing
+under another collide2d), lists the problems, links the files of its report folder when the page
+is written with one (`base`: the full logs, the full frames, the viewer), shows the event log diff
+as a table (`eventdiff`: the logs aligned, objects named, folds that expand), and per differing
 frame a crop around the changed pixels enlarged with nearest-neighbour pixels next to the full
 frame (the crop's place outlined), in four views: side by side, blink (golden and run toggled in
-place), a slider (golden left of the handle, run right of it) and the diff.
+place), a slider (golden left of the handle, run right of it, a divider between) and the diff.
 
 Keys: j / k next / previous frame, n / p next / previous failing scenario, 1-4 or s / b / l / d the
-view of the current frame (b again toggles blink), arrow keys move its slider, f the filter.
+view of the current frame (b again toggles blink), arrow keys move its slider, f the filter. Every
+name, file name and golden text goes through `_html` (links: percent-encoded, then escaped).
 """
 
 from __future__ import annotations
 
 import base64
 import html
-import json
+import os
+from pathlib import Path
+from urllib.parse import quote
 
 import numpy as np
 
-from collide2d.runner.golden import compare
+from collide2d.runner.golden import eventdiff
 from collide2d.runner.golden import serialize as ser
 from collide2d.runner.output.escape import visible
 from collide2d.runner.output.files import encode_png
+from collide2d.runner.output.viewerdata import VIEWER_FILE as VIEWER
 
 # Crops: the changed pixels' box grown by CROP_MARGIN px on each side and to at least CROP_MIN px,
 # enlarged by a whole factor to about CROP_TARGET px on its longer side (at most CROP_MAX_ZOOM).
@@ -37,10 +42,16 @@ CROP_MARGIN = 6
 CROP_MIN = 24
 CROP_TARGET = 240
 CROP_MAX_ZOOM = 16
+# What each report file is, as its link on the page says.
+FILE_LABELS = {
+    "events_expected.jsonl": "golden event log",
+    "events_actual.jsonl": "this run's event log",
+    "final_expected.csv": "golden final state",
+    "final_actual.csv": "this run's final state",
+}
+FRAME_LABELS = {"expected": "golden", "actual": "this run", "diff": "diff"}
 # Full frames narrower than this are shown at twice their size.
 ZOOM_BELOW_PX = 480
-# Event rows shown before and after the first divergence.
-EVENT_CONTEXT = 3
 VIEWS = ("side", "blink", "slider", "diff")
 # The diff picture: differing pixels, pixels changed within the colour threshold, and the level of
 # the run's frame dimmed to grey beneath them.
@@ -93,8 +104,10 @@ def _uri(rgb: np.ndarray, zoom: int = 1) -> str:
     return "data:image/png;base64," + base64.b64encode(data).decode("ascii")
 
 
-def page(title: str, outcomes, unused=()) -> bytes:
-    """index.html bytes over `outcomes` (any order; shown failures first)."""
+def page(title: str, outcomes, unused=(), base=None) -> bytes:
+    """index.html bytes over `outcomes` (any order; shown failures first). `base`: the folder the
+    page is written in; a failure whose report folder is written links its files (the full logs,
+    the full frames, the viewer) relative to it."""
     outcomes = ordered(outcomes)
     parts = [
         "<!DOCTYPE html>",
@@ -124,12 +137,24 @@ def page(title: str, outcomes, unused=()) -> bytes:
             f"<p>Goldens no scenario uses: {names} "
             "(remove them with <code>collide2d bless --prune</code>).</p>"
         )
-    parts.extend(_section(o) for o in outcomes)
+    parts.extend(_section(o, base) for o in outcomes)
     parts.append(f"<script>{_JS}</script></body></html>\n")
     return "\n".join(parts).encode("utf-8")
 
 
-def _section(o) -> str:
+def _href(path, base) -> str:
+    """The link to the file `path` from the folder `base`, percent-encoded (any bytes of a file
+    name) and HTML-escaped."""
+    rel = os.path.relpath(path, base)
+    return html.escape(quote(os.fsencode(Path(rel).as_posix())))
+
+
+def _link(path, base, text: str) -> str:
+    return f'<a href="{_href(path, base)}">{_html(text)}</a>'
+
+
+def _section(o, base=None) -> str:
+    folder = Path(o.report).parent if o.report is not None and base is not None else None
     name = _html(o.name)
     out = [
         f'<section class="scenario" id="sc-{name}" data-status="{o.status}">',
@@ -146,18 +171,31 @@ def _section(o) -> str:
     texts = [p for p in o.problems if isinstance(p, str)]
     if texts:
         out.append('<pre class="problems">' + _html("\n".join(texts)) + "</pre>")
-    table = _event_table(o)
+    logs = ""
+    if folder is not None:
+        shown = [f for f in FILE_LABELS if f in o.texts] + sorted(set(o.texts) - set(FILE_LABELS))
+        files = [_link(folder / f, base, FILE_LABELS.get(f, f)) for f in shown]
+        if o.viewer is not None:
+            files.insert(0, _link(folder / VIEWER, base, "viewer of this run"))
+        if files:
+            out.append('<p class="files">Files: ' + " · ".join(files) + "</p>")
+        logs = " ".join(
+            _link(folder / f, base, FILE_LABELS[f])
+            for f in ("events_expected.jsonl", "events_actual.jsonl")
+            if f in o.texts  # the logs again, where a fold too long to expand points to them
+        )
+    table = _event_table(o, logs)
     if table:
         out.append(table)
     for fr in o.frames:
-        out.append(_frame_block(o.name, fr))
+        out.append(_frame_block(o.name, fr, base if folder is not None else None))
     out.append(f"<p>To accept this run: <code>{_html(o.bless)}</code></p>")
     out.append("</section>")
     return "\n".join(out)
 
 
-def _event_table(o) -> str:
-    """Golden and run events side by side around the first divergence."""
+def _event_table(o, links: str = "") -> str:
+    """Golden and run events aligned side by side (`eventdiff`), objects by their names."""
     exp_bytes = o.texts.get("events_expected.jsonl")
     act_bytes = o.texts.get("events_actual.jsonl")
     if exp_bytes is None or act_bytes is None or o.first_event is None:
@@ -166,36 +204,11 @@ def _event_table(o) -> str:
         exp, act = ser.parse_events(exp_bytes), ser.parse_events(act_bytes)
     except ValueError:
         return ""
-    k = o.first_event
-    lo, hi = max(0, k - EVENT_CONTEXT), min(max(len(exp), len(act)), k + EVENT_CONTEXT + 1)
-    rows = [
-        '<table class="events"><caption>Event log: golden vs this run '
-        f"({len(exp)} vs {len(act)} events; first divergence at #{k + 1})</caption>",
-        "<tr><th>#</th><th>golden</th><th>this run</th></tr>",
-    ]
-    if lo > 0:
-        rows.append(f'<tr class="gap"><td colspan="3">… {lo} matching events before</td></tr>')
-    for i in range(lo, hi):
-        e = exp[i] if i < len(exp) else None
-        a = act[i] if i < len(act) else None
-        cls = "first" if i == k else ("differs" if e != a else "same")
-        rows.append(
-            f'<tr class="{cls}"><td>{i + 1}</td><td>{_event_cell(e)}</td>'
-            f"<td>{_event_cell(a)}</td></tr>"
-        )
-    rest = max(len(exp), len(act)) - hi
-    if rest > 0:
-        rows.append(f'<tr class="gap"><td colspan="3">… {rest} more events</td></tr>')
-    rows.append("</table>")
-    return "\n".join(rows)
-
-
-def _event_cell(ev) -> str:
-    if ev is None:
-        return "<i>(none)</i>"
-    extra = {k: v for k, v in ev.items() if k not in ("tick", "type", "a", "b", "id")}
-    tail = " ".join(f"{k}={json.dumps(v)}" for k, v in extra.items())
-    return f"{_html(compare.event_label(ev))} <small>{_html(tail)}</small>"
+    caption = _html(
+        f"Event log: golden vs this run ({len(exp)} vs {len(act)} events; first divergence at "
+        f"#{o.first_event + 1})"
+    )
+    return eventdiff.table(exp, act, o.names, caption, links)
 
 
 def diff_image(fr) -> np.ndarray | None:
@@ -214,10 +227,13 @@ def diff_image(fr) -> np.ndarray | None:
     return out
 
 
-def _frame_block(name: str, fr) -> str:
+def _frame_block(name: str, fr, base=None) -> str:
     key = _html(f"{name}-{fr.frame}")
     head = f'<div class="frame" id="f-{key}" data-view="side" tabindex="-1">'
     msg = f"<p class=msg>{_html(fr.message)}</p>"
+    if base is not None and fr.paths:
+        full = [_link(fr.paths[k], base, v) for k, v in FRAME_LABELS.items() if k in fr.paths]
+        msg += '<p class="files">Full frames: ' + " · ".join(full) + "</p>"
     exp, act, d = fr.expected, fr.actual, fr.diff
     if d is None or d.size_mismatch or d.bbox is None:
         figures = [
@@ -257,7 +273,8 @@ def _frame_block(name: str, fr) -> str:
         + "<figcaption>diff</figcaption></figure></div>"
         + f'<div class="panel stack" style="width:{cw}px;height:{ch}px">'
         + f'<img class="under" {size} src="{crops["expected"]}" alt="golden">'
-        + f'<img class="over" {size} src="{crops["actual"]}" alt="this run"></div>'
+        + f'<img class="over" {size} src="{crops["actual"]}" alt="this run">'
+        + '<span class="divider"></span></div>'
         + '<div class="panel slider"><input type="range" min="0" max="100" value="50" '
         + f'style="width:{cw}px" aria-label="slider"></div>'
         + f'<div class="panel diff"><img {size} src="{crops["diff"]}" alt="diff"></div>'
@@ -323,8 +340,18 @@ table.events { border-collapse: collapse; background: #fff; margin: 8px 0; }
 table.events td, table.events th { border: 1px solid #ddd; padding: 2px 8px;
   font: 12px/16px ui-monospace, monospace; text-align: left; }
 table.events tr.first { background: #ffd8d3; font-weight: bold; }
-table.events tr.differs { background: #fff0ee; }
+table.events tr.changed { background: #fff0ee; }
+table.events tr.dropped { background: #ffe4e0; } table.events tr.inserted { background: #e2f5e5; }
+table.events tr.dropped td:nth-child(4), table.events tr.inserted td:nth-child(2) {
+  color: #999; }
+table.events tr.folded { color: #555; }
 table.events tr.gap td { color: #777; font-style: italic; }
+.unfold { border: 0; background: none; padding: 0; color: #0969da; cursor: pointer;
+  font: italic 12px/16px ui-monospace, monospace; }
+.files { font-size: 13px; }
+.stack .divider { display: none; position: absolute; top: -6px; bottom: -6px; width: 1px;
+  background: #fff; border: 1px solid #0969da; border-width: 0 1px; pointer-events: none; }
+.frame[data-view="slider"] .stack .divider { display: block; }
 kbd { border: 1px solid #bbb; border-radius: 3px; padding: 0 4px; background: #fff; }
 """
 
@@ -353,7 +380,20 @@ _JS = r"""
     r.value = String(value);
     var over = f.querySelector(".stack img.over");
     over.style.clipPath = "inset(0 0 0 " + r.value + "%)";
+    // the divider: 3 px (blue, white, blue) centred on the first column of the run
+    var divider = f.querySelector(".stack .divider");
+    divider.style.left = (Math.round(over.width * Number(r.value) / 100) - 1) + "px";
   }
+  document.querySelectorAll("button.unfold").forEach(function (b) {
+    var rows = b.closest("table").querySelectorAll("tr.fold-" + b.dataset.fold);
+    var text = b.textContent.replace(/ \(show\)$/, "");
+    b.addEventListener("click", function () {
+      var open = b.dataset.open === "1";
+      rows.forEach(function (tr) { tr.hidden = open; });
+      b.dataset.open = open ? "0" : "1";
+      b.textContent = text + (open ? " (show)" : " (hide)");
+    });
+  });
   function select(f) {
     if (frames[current]) frames[current].classList.remove("current");
     current = frames.indexOf(f);

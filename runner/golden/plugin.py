@@ -246,7 +246,7 @@ def check_golden(node, path, project, load, simulate, basetemp) -> None:
     `collide2d check` prints. `basetemp()`: the folder a failure's report goes under when no
     --golden-report is given."""
     from collide2d.runner.golden import bless_run, check_run, shown_path
-    from collide2d.runner.golden.cli import run_scenario, scenario_errors
+    from collide2d.runner.golden.cli import run_scenario, scenario_errors, viewer_of
     from collide2d.runner.golden.store import GoldenError, GoldenStore
 
     config = node.config
@@ -270,7 +270,9 @@ def check_golden(node, path, project, load, simulate, basetemp) -> None:
     given = config.getoption("golden_report")
     report_dir = Path(given) if given else basetemp() / "golden-report"
     try:
-        outcome = check_run(scenario, result, store, path=path, report_dir=report_dir)
+        outcome = check_run(
+            scenario, result, store, path=path, report_dir=report_dir, viewer=viewer_of(simulate)
+        )
     except GoldenError as exc:  # the report folder refused (a symbolic link)
         _fail(str(exc))
     if not outcome.ok:

@@ -10,7 +10,9 @@ texts of events and final state when those differ. Outputs:
   `_diff.png` per differing frame (the diff: differing pixels in magenta, pixels changed within the
   colour threshold in amber, over the run's frame dimmed to grey), the golden and run event logs or
   final states when they differ, `summary.json`, a self-contained `index.html` (see
-  `page`) and `run/`, the golden files this run would bless (`bless --from-report`);
+  `page`; it links the files beside it), `viewer.html`, a viewer of the run with the golden's
+  frames as its ghost (when the session made one), and `run/`, the golden files this run would
+  bless (`bless --from-report`);
 - `write_index(DIR, outcomes, unused)`: `DIR/summary.json` and `DIR/index.html` over all scenarios.
 
 Pages hold their images inline and load nothing from the network, so a page can be mailed, a report
@@ -116,6 +118,8 @@ class Outcome:
     cause: object = None  # why.Cause of a failure: scenario edited or engine changed
     first_event: int | None = None  # index of the first differing event
     run_files: dict = field(default_factory=dict)  # the golden files of this run, for bless
+    names: tuple = ()  # the scenario's object names (None for an object without one)
+    viewer: bytes | None = None  # viewer.html of this run, with the golden as its ghost
 
     @property
     def ok(self) -> bool:
@@ -198,7 +202,10 @@ def write_scenario(report_dir, outcome: Outcome) -> Path:
     write_json(folder / SUMMARY_FILE, outcome.summary(folder))
     if outcome.run_files:
         _write_run_files(folder / RUN_DIR, outcome.run_files)
-    _write(outcome.report, page.page(f"collide2d golden: {outcome.name}", [outcome]))
+    if outcome.viewer is not None:
+        _write(folder / page.VIEWER, outcome.viewer)
+    title = f"collide2d golden: {outcome.name}"
+    _write(outcome.report, page.page(title, [outcome], base=folder))
     return outcome.report
 
 
@@ -252,7 +259,7 @@ def write_index(report_dir, outcomes, unused=(), errors=()) -> Path:
     _refuse_link(folder / SUMMARY_FILE)
     write_json(folder / SUMMARY_FILE, summary)
     index = folder / INDEX_FILE
-    _write(index, page.page("collide2d golden check", outcomes, list(unused)))
+    _write(index, page.page("collide2d golden check", outcomes, list(unused), base=folder))
     return index
 
 

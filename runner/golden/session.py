@@ -48,15 +48,17 @@ def frame_pixel_bound(frames: dict) -> int:
     return max([DEFAULT_MAX_FRAME_PIXELS, *sizes])
 
 
-def check_run(scenario, result, store: GoldenStore, *, path=None, report_dir=None):
+def check_run(scenario, result, store: GoldenStore, *, path=None, report_dir=None, viewer=None):
     """Compare `result` (a RunResult of `scenario`) with the scenario's golden in `store`.
 
     path: the scenario file (default scenario.path), used in messages and the bless command;
-    report_dir: when given and the check fails, write `report_dir/NAME/` (see `report`).
-    Returns a report.Outcome.
+    report_dir: when given and the check fails, write `report_dir/NAME/` (see `report`);
+    viewer: with a report, `viewer(scenario, golden frames)` -> the bytes of the run's viewer.html
+    or None (`replay.viewer_page`, which runs the scenario again). Returns a report.Outcome.
     """
     path = path if path is not None else (scenario.path or f"{scenario.name}.yaml")
     outcome = report.Outcome(scenario.name, shown_path(path), bless_command(path))
+    outcome.names = tuple(getattr(scenario, "names", ()))
     run_frames = {k: result.frames[k] for k in golden_frames(scenario) if k in result.frames}
     try:
         golden = store.read(scenario.name, max_frame_pixels=frame_pixel_bound(run_frames))
@@ -80,6 +82,9 @@ def check_run(scenario, result, store: GoldenStore, *, path=None, report_dir=Non
     if report_dir is not None and not outcome.ok:
         if outcome.status != report.STATUS_UNREADABLE or run_frames:
             outcome.run_files = _run_files(scenario, result)
+        if viewer is not None:
+            ghost = golden.frames if outcome.status == report.STATUS_FAILED else {}
+            outcome.viewer = viewer(scenario, ghost)
         report.write_scenario(report_dir, outcome)
     return outcome
 

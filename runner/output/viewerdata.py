@@ -18,6 +18,8 @@ exactly
 - velocities (px/s, float32, the same layout, not differenced), for the velocity arrows;
 - the events (tick, type, ids, side or axis), at most `MAX_EVENTS` of them (the count of the rest
   is shown);
+- in a failing check's report, the golden's frames (`set_ghost`, RGB bytes packed like the
+  positions, with their frame numbers), drawn as a ghost over the run at those frames;
 - for the `paper` model, each pair event's overlap before the take-back (`runner.output.overlay`),
 as
   int32 rows of OVERLAP_COLUMNS, packed like the positions.
@@ -46,6 +48,8 @@ MAX_EVENTS = 50_000
 # Positions are clamped to this many px from the origin (an int32; such an object is off screen).
 POSITION_CLAMP = 2**30
 ZLIB_LEVEL = 9
+# The most golden frames a viewer shows as its ghost.
+MAX_GHOST_FRAMES = 100
 # An overlap row: tick, a, b, xdiff, ydiff, the overlap x0 y0 x1 y1 (exclusive ends; all 0 when
 # empty), where a and b were (x, y each), as the pair rule saw them.
 OVERLAP_COLUMNS = 13
@@ -90,6 +94,7 @@ class Recorder:
         self.layer = layer
         self.overlap_rows: list = []
         self._last = None
+        self.ghost: dict = {}  # frame -> (H, W, 3) uint8 RGB: the golden's frames (`set_ghost`)
 
     def add(self, model) -> None:
         """Record the model's state as the next frame."""
@@ -120,6 +125,18 @@ class Recorder:
             self.event_rows.append([int(rec["tick"]), kind, int(rec["a"]), b, detail])
         self.n_events += len(events)
 
+    def set_ghost(self, frames: dict) -> None:
+        """Show `frames` (frame number -> (H, W, 3) uint8 RGB, the golden's frames) as a ghost
+        over the run at their frames: those of the world's size within the run, at most
+        MAX_GHOST_FRAMES of them (the first)."""
+        w, h = int(self.scenario.world.width), int(self.scenario.world.height)
+        ticks = [
+            k
+            for k in sorted(frames)
+            if 0 <= k <= self.scenario.ticks and frames[k].shape == (h, w, 3)
+        ]
+        self.ghost = {k: frames[k] for k in ticks[:MAX_GHOST_FRAMES]}
+
     def data(self) -> dict:
         """The JSON-ready data of the page."""
         scn = self.scenario
@@ -146,8 +163,13 @@ class Recorder:
             "events": self.event_rows,
             "overlaps": packed(np.array(self.overlap_rows, np.int32).reshape(-1, OVERLAP_COLUMNS)),
             "paper": scn.model == "paper",
-            "overlay": list(scn.output.overlay),
+            # the overlays the run draws into its frames (`run --overlay`, else the scenario's)
+            "overlay": list(self.layer.names if self.layer is not None else scn.output.overlay),
             "eventCount": int(self.n_events),
+            "ghostFrames": sorted(self.ghost),
+            "ghost": packed(
+                np.array([self.ghost[k] for k in sorted(self.ghost)], np.uint8).reshape(-1)
+            ),
         }
 
     def page(self) -> bytes:

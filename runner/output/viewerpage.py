@@ -12,9 +12,12 @@ Controls: play / pause (space), one frame back and forward (left and right arrow
 buttons), the frame slider (Home / End), the speed, the zoom (also the mouse wheel) and panning
 (drag the picture). The events list follows the frame (events of the current tick marked and
 scrolled into view); clicking an event jumps to its tick and outlines the objects involved.
-Hovering an object names it. Overlays: velocity arrows (half a second of motion), boxes (each
-object's pixel extent), contact flashes (a ring at each object of a pair or wall event, fading over
-`FLASH_FRAMES` frames) and labels.
+In a failing check's report, the golden's frames are a ghost over the run at their frames (on by
+default; where a golden pixel differs from the run's, the mean of the two). Hovering an object
+names it and shows its position (the rounded pixel position the frame draws it
+at) and velocity (px/s) at the frame shown, following the frame as it plays. Overlays: velocity
+arrows (half a second of motion), boxes (each object's pixel extent), contact flashes (a ring at
+each object of a pair or wall event, fading over `FLASH_FRAMES` frames) and labels.
 """
 
 from __future__ import annotations
@@ -44,6 +47,17 @@ def page(data: dict) -> bytes:
             *((("overlap", "overlap before undo"),) if data["paper"] else ()),
         )
     )
+    ghost = ""
+    if data["ghostFrames"]:
+        jumps = " ".join(
+            f'<button type="button" class="ghost-frame" data-tick="{k}">{k}</button>'
+            for k in data["ghostFrames"]
+        )
+        ghost = (
+            '<p id="ghost-note"><label><input type="checkbox" id="ov-ghost" checked> golden '
+            f'ghost</label> <span class="dim">at the golden\'s frames {jumps}: where the golden '
+            "differs from this run, both are shown half and half</span></p>"
+        )
     body = f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8">
 <meta name="viewport" content="width=device-width">
@@ -60,8 +74,9 @@ def page(data: dict) -> bytes:
 <label>zoom <select id="zoom">{zooms}</select></label>
 <span class="overlays">{overlays}</span>
 </div>
-<div id="main"><div id="stage"><canvas id="view"></canvas></div>
+{ghost}<div id="main"><div id="stage"><canvas id="view"></canvas></div>
 <div id="side"><div id="hover" class="dim">hover an object to name it</div>
+<div id="hover-state" class="dim"></div>
 <h3>Events <span class="dim" id="event-count"></span></h3><ol id="events"></ol></div></div>
 <p id="status" class="dim">loading…</p>
 <script id="data" type="application/json">{escape.script_json(data)}</script>
@@ -78,6 +93,7 @@ header { height: 20px; overflow: hidden; }
 #controls { margin: 8px 0; height: 32px; display: flex; gap: 10px; align-items: center;
   white-space: nowrap; overflow: hidden; }
 #controls button { min-width: 44px; height: 26px; }
+#ghost-note { margin: 0 0 8px; } #ghost-note button { min-width: 32px; }
 #seek { width: 300px; }
 #main { display: flex; gap: 16px; align-items: flex-start; }
 #stage { max-width: 960px; max-height: 720px; overflow: auto; border: 1px solid #999;
@@ -86,7 +102,7 @@ header { height: 20px; overflow: hidden; }
 canvas { display: block; image-rendering: pixelated; }
 #side { width: 320px; }
 #side h3 { font-size: 14px; line-height: 20px; margin: 8px 0; }
-#hover { height: 20px; }
+#hover, #hover-state { height: 20px; overflow: hidden; white-space: nowrap; }
 #events { height: 560px; overflow: auto; margin: 0; padding: 0 0 0 48px; background: #fff;
   border: 1px solid #ccc; font: 12px/16px ui-monospace, monospace; }
 #events li { cursor: pointer; padding: 0 4px; }
@@ -111,10 +127,11 @@ _JS = r"""
   var playBtn = document.getElementById("play"), zoomSel = document.getElementById("zoom");
   var speedSel = document.getElementById("speed"), list = document.getElementById("events");
   var hover = document.getElementById("hover"), stage = document.getElementById("stage");
+  var hoverState = document.getElementById("hover-state"), hovered = -1;
   var ov = {};
   var named = {velocity: "velocity", boxes: "boxes", contacts: "flashes", labels: "labels",
                overlap: "overlap"};
-  ["velocity", "boxes", "flashes", "labels", "overlap"].forEach(function (k) {
+  ["velocity", "boxes", "flashes", "labels", "overlap", "ghost"].forEach(function (k) {
     ov[k] = document.getElementById("ov-" + k) ||
       {checked: false, addEventListener: function () {}};
     ov[k].addEventListener("change", function () { draw(); });
@@ -123,7 +140,11 @@ _JS = r"""
   function rgba(c) { return ((255 << 24) | (c[2] << 16) | (c[1] << 8) | c[0]) >>> 0; }
   var bg = rgba(D.background);
   var col = D.colors.map(rgba);
-  var pos = null, vel = null, off = null, ext = null;
+  var pos = null, vel = null, off = null, ext = null, ghost = null, ghostAt = {};
+  D.ghostFrames.forEach(function (k, g) { ghostAt[k] = g; });
+  document.querySelectorAll("button.ghost-frame").forEach(function (b) {
+    b.addEventListener("click", function () { setPlaying(false); go(Number(b.dataset.tick)); });
+  });
   var frame = 0, zoom = 1, playing = false, selected = null;
   var byTick = {}, lit = [];
 
@@ -172,7 +193,19 @@ _JS = r"""
         if (px >= 0 && px < W && py >= 0 && py < H) pix[py * W + px] = c;
       }
     }
+    if (ghost && ov.ghost.checked && ghostAt[k] !== undefined) blendGhost(ghostAt[k]);
     wctx.putImageData(image, 0, 0);
+  }
+  function blendGhost(g) {
+    // the golden's frame g: where its pixel differs from the run's, the mean of the two
+    var base = g * W * H * 3, d = image.data;
+    for (var p = 0; p < W * H; p++) {
+      var q = base + 3 * p, r = ghost[q], gg = ghost[q + 1], b = ghost[q + 2];
+      if (d[4 * p] === r && d[4 * p + 1] === gg && d[4 * p + 2] === b) continue;
+      d[4 * p] = (d[4 * p] + r) >> 1;
+      d[4 * p + 1] = (d[4 * p + 1] + gg) >> 1;
+      d[4 * p + 2] = (d[4 * p + 2] + b) >> 1;
+    }
   }
   function centre(i, k) {
     var q = at(i, k);
@@ -274,7 +307,21 @@ _JS = r"""
     lit.forEach(function (li) { li.classList.add("now"); });
     if (lit.length) list.scrollTop = lit[0].offsetTop - list.clientHeight / 3;
   }
-  function go(k) { frame = Math.max(0, Math.min(F - 1, k | 0)); draw(); }
+  function go(k) { frame = Math.max(0, Math.min(F - 1, k | 0)); draw(); describe(); }
+  function num(v) { return String(Math.round(v * 100) / 100); }
+  function describe() {
+    // the hovered object's name, rounded position (px) and velocity (px/s) at this frame
+    var i = hovered;
+    if (!pos || i < 0) {
+      hover.textContent = "—"; hoverState.textContent = ""; view.title = "";
+      return;
+    }
+    var q = at(i, frame), p = (i * F + frame) * 2;
+    hover.textContent = D.names[i] + " (object " + i + (D.static[i] ? ", static" : "") + ")";
+    hoverState.textContent = "at (" + q[0] + ", " + q[1] + ") px, velocity (" + num(vel[p]) +
+      ", " + num(vel[p + 1]) + ") px/s";
+    view.title = D.names[i];
+  }
   function setPlaying(on) {
     playing = on && F > 1;
     playBtn.textContent = playing ? "pause" : "play";
@@ -363,11 +410,10 @@ _JS = r"""
   });
   view.addEventListener("mousemove", function (e) {
     if (!pos) return;
-    var i = objectAt(Math.floor(e.offsetX / zoom), Math.floor(e.offsetY / zoom));
-    hover.textContent = i < 0 ? "—"
-      : D.names[i] + " (object " + i + (D.static[i] ? ", static" : "") + ")";
-    view.title = i < 0 ? "" : D.names[i];
+    hovered = objectAt(Math.floor(e.offsetX / zoom), Math.floor(e.offsetY / zoom));
+    describe();
   });
+  view.addEventListener("mouseleave", function () { hovered = -1; describe(); });
   document.addEventListener("keydown", function (e) {
     if (e.ctrlKey || e.metaKey || e.altKey) return;
     var t = e.target && e.target.tagName;
@@ -386,11 +432,12 @@ _JS = r"""
   [1, 2, 3, 4, 6, 8, 12, 16].forEach(function (z) { if (W * z <= 960 && H * z <= 720) fit = z; });
   var overlapRows = [];
   var loads = [inflate(D.positions), inflate(D.velocities), inflate(D.sprites),
-               inflate(D.overlaps)];
+               inflate(D.overlaps), inflate(D.ghost)];
   Promise.all(loads).then(function (bufs) {
     pos = undifference(new Int32Array(bufs[0]));
     vel = new Float32Array(bufs[1]);
     off = new Int32Array(bufs[2]);
+    ghost = D.ghostFrames.length ? new Uint8Array(bufs[4]) : null;
     var flat = new Int32Array(bufs[3]);
     for (var r = 0; r + 13 <= flat.length; r += 13) overlapRows.push(flat.subarray(r, r + 13));
     ext = extents();

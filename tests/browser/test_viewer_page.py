@@ -1,7 +1,8 @@
 """The run viewer in Chromium: it draws the PNG frames' very pixels at zoom 1 (and their enlarged
 pixels at zoom 2), plays, steps, seeks to an event's tick and outlines the pair, names objects on
-hover, and its overlays draw over the frame; on a run of the shapes showcase (boxes, circles of
-odd and even diameter, polygons, fills) under the `exact` model, whose positions are fractional."""
+hover with their position and velocity, and its overlays draw over the frame; on a run of the
+shapes showcase (boxes, circles of odd and even diameter, polygons, fills) under the `exact`
+model, whose positions are fractional."""
 
 from __future__ import annotations
 
@@ -11,7 +12,10 @@ import numpy as np
 import pytest
 from PIL import Image
 
+from collide2d.engine.picture.raster import round_positions
 from collide2d.runner.command import main as cli
+from collide2d.runner.run import drive
+from collide2d.runner.scenario.load import load
 
 from .conftest import save_screenshot, shot
 
@@ -94,15 +98,40 @@ def test_clicking_an_event_seeks_to_its_tick_and_outlines_the_pair(clean_page, v
     assert (got[changed] == (255, 0, 255)).all(axis=1).all()  # only the outline, in magenta
 
 
-def test_hover_names_the_object(clean_page, viewer_run):
+def _state(model, i):
+    return round_positions(model.positions())[i], model.velocities()[i]
+
+
+def _js_number(v) -> str:
+    """A velocity as the viewer writes it: rounded to 2 decimals, no trailing `.0`."""
+    text = repr(round(float(v), 2))
+    return text[:-2] if text.endswith(".0") else text
+
+
+def test_hover_names_the_object_and_shows_its_position_and_velocity(clean_page, viewer_run):
     _folder, url = viewer_run
     canvas = _open(clean_page, url)
     box = canvas.bounding_box()
+    state = clean_page.locator("#hover-state")
     # the static post: 6x30 px at (150, 100), never moves
     clean_page.mouse.move(box["x"] + 152.5, box["y"] + 115.5)
     assert clean_page.locator("#hover").inner_text() == "post (object 6, static)"
+    assert state.inner_text() == "at (150, 100) px, velocity (0, 0) px/s"
+    # the orange box: 24x16 px at (10, 10), moving at (10, 5) px/s
+    clean_page.mouse.move(box["x"] + 20.5, box["y"] + 15.5)
+    assert clean_page.locator("#hover").inner_text() == "box (object 0)"
+    assert state.inner_text() == "at (10, 10) px, velocity (10, 5) px/s"
+    # stepping on follows the object: its recorded position and velocity at that frame
+    scn = load(ROOT / "scenarios" / "shapes_showcase.yaml", overrides={"model": "exact"})
+    seen = []
+    drive(scn, on_tick=lambda m: seen.append(_state(m, 0)))
+    clean_page.keyboard.press("ArrowRight")
+    clean_page.keyboard.press("ArrowRight")
+    (x, y), (vx, vy) = seen[2]
+    shown = f"at ({x}, {y}) px, velocity ({_js_number(vx)}, {_js_number(vy)}) px/s"
+    assert (x, y) != (10, 10) and state.inner_text() == shown
     clean_page.mouse.move(box["x"] + 2.5, box["y"] + 140.5)
-    assert clean_page.locator("#hover").inner_text() == "—"
+    assert clean_page.locator("#hover").inner_text() == "—" and state.inner_text() == ""
 
 
 def test_overlays_draw_over_the_frame_and_go_away(clean_page, viewer_run):

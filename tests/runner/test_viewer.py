@@ -172,3 +172,16 @@ def test_paper_viewer_keeps_each_pair_overlap_before_the_undo(tmp_path):
     # tick 1: blue (0) moved down to y 101, green (1) up to y 110: 16 x 1 px overlap
     assert rows.tolist() == [[1, 0, 1, 16, 1, 104, 110, 120, 111, 100, 101, 104, 110]]
     assert data["paper"] and data["overlay"] == ["overlap"]
+
+
+def test_the_viewer_opens_with_the_overlays_of_the_command_line(tmp_path):
+    """`run --viewer --overlay velocity,contacts` opens with those checked (the data's `overlay`),
+    not only the scenario's; `--overlay none` opens with none, even where the scenario asks."""
+    path = ROOT / "scenarios" / "fig2_case1.yaml"  # its scenario asks for overlap
+    argv = ["run", str(path), "--out", str(tmp_path), "--viewer", "--no-gif", "--quiet"]
+    assert cli.main([*argv, "--overlay", "contacts,velocity"]) == 0
+    data = _page_data((tmp_path / "fig2_case1" / "viewer.html").read_text())
+    assert data["overlay"] == ["velocity", "contacts"]
+    assert cli.main([*argv, "--overlay", "none"]) == 0
+    data = _page_data((tmp_path / "fig2_case1" / "viewer.html").read_text())
+    assert data["overlay"] == []

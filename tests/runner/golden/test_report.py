@@ -3,9 +3,13 @@
 from __future__ import annotations
 
 import base64
+import html
 import json
 import os
 import re
+import shutil
+from pathlib import Path
+from urllib.parse import unquote_to_bytes
 
 import numpy as np
 
@@ -71,13 +75,30 @@ def test_scenario_report_folder(tmp_path):
     assert summary["bless"] == "collide2d bless scenarios/demo.yaml"
 
 
+def _links(page_path) -> list:
+    """The files a page links, as paths: every href is an anchor or a relative link to a file
+    that exists in the report folder."""
+    page = page_path.read_text()
+    out = []
+    for href in re.findall(r'href="([^"]+)"', page):
+        if href.startswith("#"):
+            continue
+        href = html.unescape(href)
+        assert ":" not in href and not href.startswith("/"), href
+        target = (page_path.parent / os.fsdecode(unquote_to_bytes(href))).resolve()
+        assert target.is_file(), href
+        out.append(target)
+    return out
+
+
 def _assert_self_contained(page):
-    """Nothing is loaded from anywhere: every src is an inline image, every href an anchor."""
+    """Nothing is loaded from anywhere: every src is an inline image, every href an anchor or a
+    relative link (to a file beside the page, `_links`)."""
     assert "http://" not in page and "https://" not in page and "<link" not in page
     srcs = re.findall(r'src="([^"]+)"', page)
     assert srcs, "the page shows no images"
     assert all(src.startswith("data:image/png;base64,") for src in srcs)
-    assert all(h.startswith("#") for h in re.findall(r'href="([^"]+)"', page))
+    assert all(":" not in h for h in re.findall(r'href="([^"]+)"', page))
 
 
 def _images(page) -> list[np.ndarray]:
@@ -134,30 +155,48 @@ def test_crop_surrounds_the_change_within_the_frame():
     assert golden_page.crop_zoom((4, 14, 116, 66)) == 2
 
 
-def test_event_table_marks_the_first_divergence_with_context():
-    from collide2d.runner.golden import serialize as ser
-
-    def line(tick, i):
-        return json.dumps({"tick": tick, "t": tick / 10, "type": "wall", "id": i, "side": "left"})
-
-    golden = [line(k, 0) for k in range(10)]
-    run = golden[:6] + [line(6, 1)] + golden[7:]
-    out = _failed_outcome(
-        texts={
-            "events_expected.jsonl": ("\n".join(golden) + "\n").encode(),
-            "events_actual.jsonl": ("\n".join(run) + "\n").encode(),
-        }
-    )
-    out.first_event = 6
-    assert len(ser.parse_events(out.texts["events_actual.jsonl"])) == 10
+def _event_rows(out) -> list:
+    """(kind, golden #, run #, golden cell, run cell) of each row of the page's event table."""
     page = golden_page.page("t", [out]).decode()
     table = page[page.index('<table class="events">') : page.index("</table>")]
-    rows = re.findall(r'<tr class="(\w+)"><td>(\d+)</td>', table)
-    assert rows == [("same", "4"), ("same", "5"), ("same", "6"), ("first", "7"),
-                    ("same", "8"), ("same", "9"), ("same", "10")]
-    assert "3 matching events before" in table and "first divergence at #7" in table
-    first = re.search(r'<tr class="first">.*?</tr>', table).group(0)
-    assert "tick 6, wall, 0" in first and "tick 6, wall, 1" in first
+    rows = re.findall(
+        r'<tr class="(\w+)[^"]*"(?: hidden)?><td>(\d*)</td><td>(.*?)</td><td>(\d*)</td>'
+        r"<td>(.*?)</td></tr>",
+        table,
+    )
+    return [(k, int(i) if i else None, int(j) if j else None, e, a) for k, i, e, j, a in rows]
+
+
+def test_event_diff_aligns_the_logs_and_names_the_objects():
+    """An event the run inserted or dropped shifts nothing after it: every other event stands
+    beside its equal; objects are named by their `name` (with their id), or by id alone."""
+
+    def line(tick, i, side="left"):
+        return {"tick": tick, "t": tick / 10, "type": "wall", "id": i, "side": side}
+
+    golden = [line(k, k % 3) for k in range(20)]
+    run = golden[:4] + [line(4, 2, "top")] + golden[4:12] + golden[13:16]
+    run += [line(16, 0, "right")] + golden[17:]  # inserted after #4, #13 dropped, #17 changed
+    out = _failed_outcome(
+        texts={
+            name: "".join(json.dumps(e) + "\n" for e in events).encode()
+            for name, events in (("events_expected.jsonl", golden), ("events_actual.jsonl", run))
+        }
+    )
+    out.first_event, out.names = 4, ("box", None, "<b>ball</b>")
+    rows = _event_rows(out)
+    kinds = {(k, i, j) for k, i, j, _e, _a in rows if k not in ("same", "folded")}
+    assert kinds == {("first", None, 5), ("dropped", 13, None), ("changed", 17, 17)}
+    for kind, i, j, e, a in rows:
+        if kind == "same":  # every matching event beside its equal, whatever came before
+            assert e == a and golden[i - 1] == run[j - 1]
+    # all 20 golden events shown (folded or not), in order
+    assert [i for _k, i, _j, _e, _a in rows if i is not None] == list(range(1, 21))
+    first = next(r for r in rows if r[0] == "first")
+    assert first[4].startswith("tick 4, wall, &lt;b&gt;ball&lt;/b&gt; (#2) ")
+    dropped = next(r for r in rows if r[0] == "dropped")
+    assert dropped[3].startswith("tick 12, wall, box (#0) ") and dropped[4] == "<i>(none)</i>"
+    assert next(r for r in rows if r[1] == 2)[3].startswith("tick 1, wall, #1 ")
 
 
 def test_html_escapes_what_it_shows(tmp_path):
@@ -191,3 +230,52 @@ def test_message_lists_problems_paths_and_command(tmp_path, monkeypatch):
     assert "    diff:     rep/demo/frame_000006_diff.png" in msg
     assert "  report: rep/demo/index.html" in msg
     assert msg.index("events:") < msg.index("frame 6") < msg.index("frame 9")
+
+
+def _moved_box_report(tmp_path) -> Path:
+    """rep/ of `collide2d check --report rep` where one box of fig2_case1 starts 2 px right."""
+    from collide2d.runner.golden import cli
+
+    root = Path(__file__).resolve().parents[3]
+    (tmp_path / "scenarios").mkdir()
+    text = (root / "scenarios" / "fig2_case1.yaml").read_text()
+    assert "position: [100, 100]" in text
+    text = text.replace("position: [100, 100]", "position: [102, 100]", 1)
+    (tmp_path / "scenarios" / "fig2_case1.yaml").write_text(text)
+    shutil.copytree(root / "goldens" / "fig2_case1", tmp_path / "goldens" / "fig2_case1")
+    argv = ["check", "--quiet", "--root", str(tmp_path), "--report", str(tmp_path / "rep")]
+    assert cli.main(argv) == 1
+    return tmp_path / "rep"
+
+
+def test_the_report_links_the_full_logs_both_full_frames_and_a_viewer(tmp_path):
+    rep = _moved_box_report(tmp_path)
+    folder = rep / "fig2_case1"
+    for page_path in (rep / "index.html", folder / "index.html"):
+        linked = {p.relative_to(folder.resolve()).as_posix() for p in _links(page_path)}
+        frames = {p.name for p in folder.glob("frame_*.png")}
+        assert {n[: -len("_actual.png")] for n in frames if n.endswith("_actual.png")}
+        texts = {p.name for p in folder.iterdir() if p.suffix in (".jsonl", ".csv")}
+        assert {"events_expected.jsonl", "events_actual.jsonl"} <= texts
+        assert linked == frames | texts | {"viewer.html"}, page_path
+    assert b'id="data"' in (folder / "viewer.html").read_bytes()
+
+
+def test_a_failing_checks_viewer_holds_the_golden_frames_as_its_ghost(tmp_path):
+    import zlib
+
+    from collide2d.runner.golden.store import GoldenStore
+
+    rep = _moved_box_report(tmp_path)
+    page = (rep / "fig2_case1" / "viewer.html").read_text()
+    head = '<script id="data" type="application/json">'
+    data = json.loads(page[page.index(head) + len(head) :].split("</script>", 1)[0])
+    golden = GoldenStore(tmp_path).read("fig2_case1")
+    assert data["ghostFrames"] == sorted(golden.frames) and len(golden.frames) > 1
+    ghost = np.frombuffer(zlib.decompress(base64.b64decode(data["ghost"])), np.uint8)
+    h, w = data["height"], data["width"]
+    ghost = ghost.reshape(len(data["ghostFrames"]), h, w, 3)
+    for k, rgb in zip(data["ghostFrames"], ghost, strict=True):
+        assert np.array_equal(rgb, golden.frames[k]), k
+    assert data["frames"] == 21 and data["overlay"] == ["overlap"]  # this run, as it asks
+    assert 'id="ov-ghost" checked' in page
