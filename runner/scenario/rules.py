@@ -192,7 +192,8 @@ def _velocity_faults(cols: Columns, paper: bool, fps: int, out: list) -> None:
         return
     moving = ~static & ~fast
     said = {}
-    for v in np.unique(vel[moving]).tolist():  # the distinct values only
+    # the distinct values only (sorted(set()): np.unique would import numpy.ma on every load)
+    for v in sorted(set(vel[moving].tolist())):
         try:
             motion.paper_rate(int(v) if v.is_integer() else v, fps)
         except ValueError as exc:
