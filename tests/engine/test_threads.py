@@ -62,10 +62,10 @@ def run_paper(monkeypatch, chunks, bodies, world, broadphase=None):
 
     monkeypatch.setattr(paper_model, "chunks_for", lambda n: chunks)
     model = make("paper", world, bodies, broadphase=broadphase)
-    assert int(model._bp[7][4]) == chunks
+    assert model._plan.chunks == chunks
     # small first calls: the event log and the candidate list outgrow their buffers mid-run
     events = np.concatenate([model.advance(k) for k in (1, 1, 58)])
-    return events.tobytes(), model.pos.tobytes(), model.step.tobytes(), model.event_counts()
+    return events.tobytes(), model._S.pos.tobytes(), model._S.step.tobytes(), model.event_counts()
 
 
 @pytest.mark.parametrize("chunks", [2, 3])
