@@ -67,6 +67,16 @@ def test_the_paper_model_keeps_its_state_in_named_records():
 
 
 @pytest.mark.parametrize("model", BOUNDED)
+def test_the_stepped_model_keeps_its_state_in_named_records():
+    world = WorldSpec(100, 80, 10)
+    m = make("stepped", world, Bodies.boxes([[0, 0], [30, 0]], 9, [[10, 0], [-10, 0]]))
+    assert is_named_record(m._S) and is_named_record(m._bp)
+    assert m._bp.state.dtype == np.int64 and m._bp.params.dtype == np.float64
+    before = m._bp.order
+    m.advance(12)
+    assert m._bp.order is before and m.event_counts()[1] == 1  # the pair met once
+
+
 def test_no_kernel_of_a_model_takes_more_than_ten_parameters(model):
     found = list(kernels(MODELS / model))
     assert len(found) >= 5  # the reader finds the kernels

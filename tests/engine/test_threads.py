@@ -28,7 +28,7 @@ def dense_boxes(n, seed, world):
 def run_stepped(monkeypatch, chunks, bodies, world, geometry=None):
     monkeypatch.setattr(stepped_model, "chunks_for", lambda n: chunks)
     model = make("stepped", world, bodies, geometry=geometry)
-    assert int(model._bp[6][stepped_model.ST_CHUNKS]) == chunks
+    assert int(model._bp.state[stepped_model.ST_CHUNKS]) == chunks
     events = model.advance(40)
     return (
         events.tobytes(),
