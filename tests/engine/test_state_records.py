@@ -66,7 +66,6 @@ def test_the_paper_model_keeps_its_state_in_named_records():
     assert m._plan.chunks == 1 and m.positions()[0].tolist() == [5.0, 0.0]
 
 
-@pytest.mark.parametrize("model", BOUNDED)
 def test_the_stepped_model_keeps_its_state_in_named_records():
     world = WorldSpec(100, 80, 10)
     m = make("stepped", world, Bodies.boxes([[0, 0], [30, 0]], 9, [[10, 0], [-10, 0]]))
@@ -77,6 +76,7 @@ def test_the_stepped_model_keeps_its_state_in_named_records():
     assert m._bp.order is before and m.event_counts()[1] == 1  # the pair met once
 
 
+@pytest.mark.parametrize("model", BOUNDED)
 def test_no_kernel_of_a_model_takes_more_than_ten_parameters(model):
     found = list(kernels(MODELS / model))
     assert len(found) >= 5  # the reader finds the kernels
