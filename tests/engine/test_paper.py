@@ -282,7 +282,7 @@ def test_kernel_equals_the_all_pairs_reference(data):
     events = np.concatenate([m.advance(30), m.advance(1), m.advance(49)])
     assert logged(events) == ref_log
     assert m.positions().astype(int).tolist() == ref_pos
-    assert m.step.tolist() == ref_step
+    assert m._S.step.tolist() == ref_step
 
 
 def test_dense_crowd_equals_the_reference_and_logging_changes_nothing():
@@ -310,7 +310,7 @@ def test_reach_boxes_in_int64_give_the_int32_run(monkeypatch):
     small = Model(WorldSpec(160, 120, 10), Bodies.boxes(pos, 9, vel))
     monkeypatch.setattr(paper, "REACH_INT32_MAX", 100)  # as if the world were far too large
     large = Model(WorldSpec(160, 120, 10), Bodies.boxes(pos, 9, vel))
-    assert small._bp[-1].dtype == np.int32 and large._bp[-1].dtype == np.int64
+    assert small._lists.reach.dtype == np.int32 and large._lists.reach.dtype == np.int64
     assert logged(small.advance(200)) == logged(large.advance(200))
     assert small.positions().tobytes() == large.positions().tobytes()
     assert paper._reach_dtype(WorldSpec(2**30, 100, 10), np.ones((1, 2)), np.ones((1, 2))) == (
@@ -355,7 +355,7 @@ def test_every_broad_phase_and_no_skip_equal_the_reference(data, broadphase, ski
     m = Model(WorldSpec(*world, 10), bodies, broadphase=broadphase, skip=skip)
     assert logged(m.advance(60)) == ref_log
     assert m.positions().astype(int).tolist() == ref_pos
-    assert m.step.tolist() == ref_step
+    assert m._S.step.tolist() == ref_step
 
 
 def test_a_crowd_in_a_wide_world_agrees_across_methods_and_chunks():
@@ -372,10 +372,10 @@ def test_a_crowd_in_a_wide_world_agrees_across_methods_and_chunks():
     for broadphase in (None, "sweep", "grid", "cells"):
         m = Model(world, bodies, broadphase=broadphase)
         events = m.advance(150)
-        runs.append((events.tobytes(), m.pos.tobytes(), m.step.tobytes()))
+        runs.append((events.tobytes(), m._S.pos.tobytes(), m._S.step.tobytes()))
     m = Model(world, bodies)
     events = np.concatenate([m.advance(k) for k in (1, 1, 48, 100)])
-    runs.append((events.tobytes(), m.pos.tobytes(), m.step.tobytes()))
+    runs.append((events.tobytes(), m._S.pos.tobytes(), m._S.step.tobytes()))
     assert all(r == runs[0] for r in runs)
     assert len(events) > 2000
 
@@ -403,7 +403,7 @@ def test_profile_runs_the_same_ticks_as_advance():
     assert tuple(spent) == tuple(name for name, _ in STAGES)
     assert tuple(spent) == ("move", "broad", "narrow", "response") and b.tick == 80
     assert all(v >= 0.0 for v in spent.values())
-    assert a.pos.tolist() == b.pos.tolist() and a.step.tolist() == b.step.tolist()
-    assert a.count.tolist() == b.count.tolist()
+    assert a._S.pos.tolist() == b._S.pos.tolist() and a._S.step.tolist() == b._S.step.tolist()
+    assert a._S.count.tolist() == b._S.count.tolist()
     assert a.event_counts() == b.event_counts() and min(a.event_counts()) > 0
     assert logged(a.advance(30)) == logged(b.advance(30))

@@ -33,6 +33,7 @@ from collide2d.engine.models.stepped.candidates import (
 )
 from collide2d.engine.models.stepped.model import STAGES
 from collide2d.engine.models.stepped.narrow import narrow
+from collide2d.engine.models.stepped.records import Step
 from collide2d.engine.models.stepped.step import step
 from collide2d.engine.response import exchange, fold, separate
 from collide2d.engine.world import KIND_CIRCLE, Bodies, Looks, WorldSpec
@@ -397,13 +398,16 @@ def test_buffers_that_fill_mid_run_grow_and_change_no_bit(broadphase):
     for tiny in (False, True):
         model = make("stepped", world, bodies, broadphase=broadphase)
         if tiny:
-            bp = list(model._bp)
-            for slot, dtype in ((0, np.int64), (1, np.int64), (9, np.float64), (12, np.int64)):
-                bp[slot] = np.empty(1, dtype)  # keys, near, when, spare
-            model._bp = tuple(bp)
+            model._bp = model._bp._replace(
+                keys=np.empty(1, np.int64),
+                near=np.empty(1, np.int64),
+                when=np.empty(1, np.float64),
+                spare=np.empty(1, np.int64),
+            )
         events = np.concatenate([model.advance(17), model.advance(23)])
         runs.append((events.tobytes(), model.positions().tobytes(), model.velocities().tobytes()))
-        grown = (model._bp[0].size, model._bp[1].size, model._bp[9].size, model._bp[12].size)
+        grown = (model._bp.keys.size, model._bp.near.size, model._bp.when.size)
+        grown += (model._bp.spare.size,)
     assert runs[0] == runs[1]
     assert len(np.frombuffer(runs[0][0], dtype=events.dtype)) > 20
     assert min(grown) > 1  # each buffer grew
@@ -438,9 +442,9 @@ def test_the_objects_inside_follow_the_broad_phases_order(broadphase):
     ids = []
     for ticks in (1, 5, 40, 60):
         model.advance(ticks)
-        order = model._bp[2]
+        order = model._bp.order
         assert np.abs(order - np.arange(n)).sum() <= REORDER_ROWS * np.sqrt(n) * n
-        keys, state = model._bp[0], model._bp[6]
+        keys, state = model._bp.keys, model._bp.state
         starts = state[ST_BANDS:]
         assert starts[0] == 0 and starts[-1] == state[ST_KEYS] > 500
         assert (np.diff(starts) >= 0).all()
@@ -465,7 +469,7 @@ def test_the_bands_skipped_hold_no_pair_in_contact():
     for tick in range(1, 61):
         for first, last in ((0, 2), (2, 4)):  # move and broad; narrow and response
             if first == 2:
-                keys, state, params = model._bp[0], model._bp[6], model._bp[7]
+                keys, state, params = model._bp.keys, model._bp.state, model._bp.params
                 found = []
                 for bands in (BANDS, within_reach(params)):
                     near, when = np.empty(4000, np.int64), np.empty(4000)
@@ -477,10 +481,12 @@ def test_the_bands_skipped_hold_no_pair_in_contact():
                 assert found[0] == found[1]
                 contacts += len(found[0])
                 shares.append(keys_within(state, within_reach(params)) / state[ST_KEYS])
-            rows, times, _, model._bp = step(
-                first, last, model._S, dt, 900.0, 700.0, False, model._cores, tick, tick * dt,
-                False, rows, times, 0, model._bp,
+            at = Step(dt, width=900.0, height=700.0, exact=False, tick=tick, t=tick * dt, log=False)
+            rows, times, _, grown = step(
+                first, last, tuple(model._S), tuple(at), model._cores, rows, times, 0,
+                tuple(model._bp),
             )  # fmt: skip
+            model._grown(grown)
     assert contacts > 100 and min(shares) < 0.3 and max(shares) > 1.5 * min(shares)
 
 
@@ -540,7 +546,7 @@ def test_blocks_of_rows_change_nothing(monkeypatch, blocks, chunks):
     assert logged(events) == ref_log
     assert model.positions().tobytes() == ref_pos.tobytes()
     assert model.velocities().tobytes() == ref_vel.tobytes()
-    state = model._bp[6]
+    state = model._bp.state
     assert len(state) == ST_BANDS + 2 * blocks * BANDS + 1
     assert state[ST_FUSED] > 30
 
@@ -558,7 +564,7 @@ def test_profile_runs_the_same_ticks_as_advance():
     assert a.velocities().tobytes() == b.velocities().tobytes()
     assert a.event_counts() == b.event_counts() and min(a.event_counts()) > 0
     # advance ran move and narrow together on most steps, profile always apart
-    assert a._bp[6][ST_FUSED] > 20 and b._bp[6][ST_FUSED] == 0
+    assert a._bp.state[ST_FUSED] > 20 and b._bp.state[ST_FUSED] == 0
     assert a.advance(20).tobytes() == b.advance(20).tobytes()
 
 

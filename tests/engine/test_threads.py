@@ -29,7 +29,7 @@ def dense_boxes(n, seed, world):
 def run_stepped(monkeypatch, chunks, bodies, world, geometry=None):
     monkeypatch.setattr(stepped_model, "chunks_for", lambda n: chunks)
     model = make("stepped", world, bodies, geometry=geometry)
-    assert int(model._bp[6][stepped_model.ST_CHUNKS]) == chunks
+    assert int(model._bp.state[stepped_model.ST_CHUNKS]) == chunks
     events = model.advance(40)
     return (
         events.tobytes(),
@@ -63,10 +63,10 @@ def run_paper(monkeypatch, chunks, bodies, world, broadphase=None):
 
     monkeypatch.setattr(paper_model, "chunks_for", lambda n: chunks)
     model = make("paper", world, bodies, broadphase=broadphase)
-    assert int(model._bp[7][4]) == chunks
+    assert model._plan.chunks == chunks
     # small first calls: the event log and the candidate list outgrow their buffers mid-run
     events = np.concatenate([model.advance(k) for k in (1, 1, 58)])
-    return events.tobytes(), model.pos.tobytes(), model.step.tobytes(), model.event_counts()
+    return events.tobytes(), model._S.pos.tobytes(), model._S.step.tobytes(), model.event_counts()
 
 
 @pytest.mark.parametrize("chunks", [2, 3])

@@ -45,6 +45,7 @@ state is int32 when the world allows it (half the memory each tick streams throu
 from __future__ import annotations
 
 import time
+from typing import NamedTuple
 
 import numpy as np
 
@@ -131,17 +132,57 @@ _DONE, _LOG_FULL, _KEYS_FULL = range(3)
 _kernel = njit(cache=True, _nrt=False)
 
 
+class State(NamedTuple):
+    """The objects' state, one row per object in id order (int32 when the world allows it, else
+    int64; numba takes a named tuple as it takes a tuple, and the kernels read it by field)."""
+
+    pos: np.ndarray  # (n, 2) top-left corners, px
+    size: np.ndarray  # (n, 2) box sides, px
+    room: np.ndarray  # (n, 2) world side - box side, px: the largest position inside the world
+    step: np.ndarray  # (n, 2) the step V of each velocity component, px
+    period: np.ndarray  # (n, 2) its period P, ticks
+    count: np.ndarray  # (n, 2) its counter, ticks since it last fired
+    movable: np.ndarray  # (n,) bool: what the broad phase pairs
+
+
+class Plan(NamedTuple):
+    """The kernel's settings, whole numbers but the cell."""
+
+    window: int  # the candidate list's window, ticks (_WINDOW_TICKS)
+    cap: int  # the largest margin, px (_MARGIN_MAX_PX)
+    longest: int  # the longest window, ticks (_WINDOW_MAX_TICKS)
+    cell: float  # the grid's cell side, px (broadphase.choose)
+    chunks: int  # the split stages' chunks (threads.chunks_for; 1 for no split)
+
+
+class Lists(NamedTuple):
+    """The candidate list kept between calls, and the broad and narrow stages' scratch."""
+
+    order: np.ndarray  # (n,) int64 sweep order
+    fence: np.ndarray  # (n, 4) [x lo, x hi, y lo, y hi] the positions each object may hold while
+    # the list lasts (made with the list)
+    keys: np.ndarray  # candidate keys a << KEY_SHIFT | b
+    near: np.ndarray  # this tick's near pairs (room for each thread's share past len(keys))
+    disp: np.ndarray  # (n, 2) this tick's displacement
+    lo: np.ndarray  # (n, 2) int64 grown reach boxes, low corners
+    hi: np.ndarray  # (n, 2) int64 grown reach boxes, high corners
+    found: np.ndarray  # (chunks, 3) int64 what each thread of a split stage found
+    forced: np.ndarray  # int64 the periods of the steps longer than the largest margin, each once,
+    # sorted (see _WINDOW_MAX_TICKS)
+    finder: np.ndarray  # the method's marker (broadphase.marker: only that pair finder compiles)
+    reach: np.ndarray  # (n, 4) reach boxes of this tick, for the narrow stage (`_reach`)
+    ws: tuple  # the pair finders' scratch (broadphase.workspace)
+
+
 @njit(cache=True, inline="always")
-def _move(pos, step, period, count, disp, fence, room, first, last, tick, log, ev, n_ev):
-    """Move and walls for objects first ... last-1, object by object in id order
+def _move(S, disp, fence, first, last, tick, log, ev, n_ev):
+    """Move and walls for objects first ... last-1 of the State S, object by object in id order
     (docs/models.md#paper-walls): counters rise by one and a component whose counter reaches its
     period moves by its step; one that left the world moving outward reverses and takes that step
-    back (a wall event, logged from row n_ev on).
-
-    room (n, 2) = world side - box side; fence (n, 4) = [x lo, x hi, y lo, y hi], the positions
-    each object may hold while the candidate list lasts. Returns (event rows, whether any object is
-    now past its fence, wall events).
+    back (a wall event, logged from row n_ev on). disp receives this tick's displacements; fence
+    is Lists.fence. Returns (event rows, whether any object is now past its fence, wall events).
     """
+    pos, step, period, count, room = S.pos, S.step, S.period, S.count, S.room
     strayed = False
     walls = 0
     for i in range(first, last):
@@ -169,24 +210,21 @@ def _move(pos, step, period, count, disp, fence, room, first, last, tick, log, e
 
 
 @njit(cache=True, parallel=True)
-def _move_split(pos, size, step, period, count, disp, fence, room, reach, tick, log, ev, n_ev,
-                found):
-    """`_move` with the objects cut into len(found) contiguous runs, one per thread: run c logs
+def _move_split(S, L, tick, log, ev, n_ev):
+    """`_move` with the objects cut into len(L.found) contiguous runs, one per thread: run c logs
     its walls from row n_ev + 2 x its first object (an object meets at most two walls a tick),
     then the rows are moved together in run order, as one thread writes them. Each run also
     writes its objects' reach boxes (`_reach`) for the narrow stage, so that the threads start
-    once less a tick. Returns what `_move` returns for all objects; found (chunks, 3) int64 is
-    scratch."""
+    once less a tick. Returns what `_move` returns for all objects; L.found is scratch."""
+    pos, size, disp, fence, reach, found = S.pos, S.size, L.disp, L.fence, L.reach, L.found
     n = pos.shape[0]
     chunks = found.shape[0]
     for c in prange(chunks):
         first = c * n // chunks
+        last = (c + 1) * n // chunks
         row = n_ev + 2 * first
-        end, strayed, walls = _move(
-            pos, step, period, count, disp, fence, room, first, (c + 1) * n // chunks, tick, log,
-            ev, row,
-        )
-        _reach(pos, size, disp, reach, first, (c + 1) * n // chunks)
+        end, strayed, walls = _move(S, disp, fence, first, last, tick, log, ev, row)
+        _reach(pos, size, disp, reach, first, last)
         found[c, 0] = end - row
         found[c, 1] = strayed
         found[c, 2] = walls
@@ -206,8 +244,7 @@ def _move_split(pos, size, step, period, count, disp, fence, room, reach, tick, 
 
 
 @njit(cache=True)
-def _relist(pos, size, step, period, count, disp, fence, movable, window, cap, finder, cell,
-            order, lo, hi, keys, ws, found):
+def _relist(S, L, window, cap, cell, found):
     """List the pairs whose reach boxes, each grown by its object's margin, overlap (keys
     a << KEY_SHIFT | b, a < b, in no particular order); pairs of two immovable objects are left
     out. Returns how many there are; only as many as `keys` holds are written.
@@ -216,7 +253,10 @@ def _relist(pos, size, step, period, count, disp, fence, movable, window, cap, f
     (`_window`), |V| x the steps it fires in them (a pair or a wall only reverses or takes a step
     back), at most `cap` px, from either end of this tick's step (the pair stage may take it
     back); its fence is that range of positions. While every object stays within its fence, every
-    box it holds lies in its grown reach box, so every pair that can overlap is listed."""
+    box it holds lies in its grown reach box, so every pair that can overlap is listed. found
+    (chunks,) int64 is the pair tests' scratch."""
+    pos, size, step, period, count = S.pos, S.size, S.step, S.period, S.count
+    disp, fence, lo, hi = L.disp, L.fence, L.lo, L.hi
     for i in range(pos.shape[0]):
         for ax in range(2):
             d = disp[i, ax]
@@ -229,7 +269,7 @@ def _relist(pos, size, step, period, count, disp, fence, movable, window, cap, f
             fence[i, 2 * ax + 1] = high
             lo[i, ax] = low
             hi[i, ax] = high + size[i, ax]
-    return find_split(finder, lo, hi, movable, cell, order, keys, ws, found)
+    return find_split(L.finder, lo, hi, S.movable, cell, L.order, L.keys, L.ws, found)
 
 
 @njit(cache=True, inline="always")
@@ -305,9 +345,10 @@ def _near_split(keys, n_keys, near, reach, found):
 
 
 @njit(cache=True, inline="always")
-def _pairs(pos, size, step, disp, near, n_near, tick, log, ev, n_ev, st):
+def _pairs(S, disp, near, n_near, tick, log, ev, n_ev, st):
     """The flip rule on every overlapping pair of `near`, in (a, b) order
     (docs/models.md#paper-pairs)."""
+    pos, size, step = S.pos, S.size, S.step
     for c in range(n_near):
         a = near[c] >> KEY_SHIFT
         b = near[c] & KEY_MASK
@@ -336,23 +377,17 @@ def _pairs(pos, size, step, disp, near, n_near, tick, log, ev, n_ev, st):
 
 
 @_kernel
-def _run(pos, size, room, step, period, count, movable, stop, log, st, bp, ev, ws):
+def _run(state, settings, lists, st, stop, log, ev):
     """Run stage after stage until st[_S_TICK] * _N_STAGES + st[_S_STAGE] = stop (advance: ticks
     done x _N_STAGES, a tick's end); returns _DONE, or _LOG_FULL / _KEYS_FULL when `ev` or the
     candidate buffers need more room (grow them and call again: the tick resumes at the stage it
-    stopped). st: the scalar state (see _S_*); bp = (order, fence, keys, near, disp, lo, hi,
-    params, found, forced, finder, reach) with params = [window ticks, method, grid cell px,
-    largest margin px, chunks, longest window ticks] (float64; chunks: threads.chunks_for, 1 for
-    no split), found (chunks, 3) the split stages' scratch, forced the periods of the steps
-    longer than the largest margin (see _WINDOW_MAX_TICKS) and finder the method's marker
-    (broadphase.marker: only that pair finder is compiled)."""
-    order, fence, keys, near, disp, lo, hi, params, found, forced, finder, reach = bp
-    cell = params[2]
-    window = int(params[0])
-    cap = int(params[3])
-    chunks = int(params[4])
-    longest = int(params[5])
-    n = pos.shape[0]
+    stopped). state, settings, lists: the fields of a State, a Plan and a Lists, as plain tuples
+    (numba reads a plain tuple's type in a fraction of the time it takes for a named tuple: a few
+    microseconds a call); st: the scalar state (see _S_*)."""
+    S, plan, L = State(*state), Plan(*settings), Lists(*lists)
+    keys, near, disp, reach, found = L.keys, L.near, L.disp, L.reach, L.found
+    chunks = plan.chunks
+    n = S.pos.shape[0]
     n_ev = st[_S_EVENTS]
     while st[_S_TICK] * _N_STAGES + st[_S_STAGE] < stop:
         tick = st[_S_TICK] + 1
@@ -364,14 +399,9 @@ def _run(pos, size, room, step, period, count, movable, stop, log, st, bp, ev, w
                 st[_S_EVENTS] = n_ev
                 return _LOG_FULL
             if chunks > 1:
-                n_ev, strayed, walls = _move_split(
-                    pos, size, step, period, count, disp, fence, room, reach, tick, log, ev,
-                    n_ev, found,
-                )
+                n_ev, strayed, walls = _move_split(S, L, tick, log, ev, n_ev)
             else:
-                n_ev, strayed, walls = _move(
-                    pos, step, period, count, disp, fence, room, 0, n, tick, log, ev, n_ev
-                )
+                n_ev, strayed, walls = _move(S, disp, L.fence, 0, n, tick, log, ev, n_ev)
             st[_S_WALLS] += walls
             # the list is made anew once an object is past its fence
             st[_S_RELIST] = st[_S_KEYS] < 0 or strayed
@@ -380,11 +410,8 @@ def _run(pos, size, room, step, period, count, movable, stop, log, st, bp, ev, w
         elif stage == _STAGE_BROAD:
             # broad: the candidate list, when it is to be made anew
             if st[_S_RELIST]:
-                k = _relist(
-                    pos, size, step, period, count, disp, fence, movable,
-                    _window(tick, forced, window, longest), cap, finder, cell, order, lo, hi,
-                    keys, ws, found[:chunks, 0],
-                )
+                window = _window(tick, L.forced, plan.window, plan.longest)
+                k = _relist(S, L, window, plan.cap, plan.cell, found[:chunks, 0])
                 if k > keys.shape[0]:
                     st[_S_NEEDED] = k
                     st[_S_EVENTS] = n_ev
@@ -396,13 +423,13 @@ def _run(pos, size, room, step, period, count, movable, stop, log, st, bp, ev, w
             if chunks > 1:
                 st[_S_NEAR] = _near_split(keys, st[_S_KEYS], near, reach, found[:, 0])
             else:
-                st[_S_NEAR] = _near(pos, size, disp, keys, st[_S_KEYS], near, reach)
+                st[_S_NEAR] = _near(S.pos, S.size, disp, keys, st[_S_KEYS], near, reach)
         else:
             # response: the rule on each of them
             if log and n_ev + st[_S_NEAR] > ev.shape[0]:
                 st[_S_EVENTS] = n_ev
                 return _LOG_FULL
-            n_ev = _pairs(pos, size, step, disp, near, st[_S_NEAR], tick, log, ev, n_ev, st)
+            n_ev = _pairs(S, disp, near, st[_S_NEAR], tick, log, ev, n_ev, st)
         if stage == _STAGE_RESPONSE:
             st[_S_STAGE] = _STAGE_MOVE
             st[_S_TICK] = tick
@@ -432,41 +459,49 @@ class Model:
         small = _reach_dtype(world, size, step)
         if pos.size and int(np.abs(pos).max()) > REACH_INT32_MAX // 2:
             small = np.int64  # objects placed far outside the world
-        self.pos, self.size, self.step = pos.astype(small), size.astype(small), step.astype(small)
-        self.period = period.astype(small)
-        self.count = np.zeros_like(self.step)
-        n = self.pos.shape[0]
-        self.movable = ~np.asarray(bodies.static, bool) if skip else np.ones(n, bool)
+        n = pos.shape[0]
         limit = np.array([world.width, world.height], np.int64)
-        self._room = np.ascontiguousarray(limit - size).astype(small)
+        self._S = State(
+            pos=pos.astype(small),
+            size=size.astype(small),
+            room=np.ascontiguousarray(limit - size).astype(small),
+            step=step.astype(small),
+            period=period.astype(small),
+            count=np.zeros(step.shape, small),
+            movable=~np.asarray(bodies.static, bool) if skip else np.ones(n, bool),
+        )
         self._ev = new_log(True, _INITIAL_ROWS)[0]
         self._st = np.zeros(_S_SIZE, np.int64)
         self._st[_S_KEYS] = -1
-        self._st[_S_PAIRS] = n >= 2 and (bool(self.movable.any()) or not skip)
-        grown = self.size + 2 * _margins(self.step, self.period)
+        self._st[_S_PAIRS] = n >= 2 and (bool(self._S.movable.any()) or not skip)
+        grown = self._S.size + 2 * _margins(self._S.step, self._S.period)
         method, cell = choose(world.width, world.height, grown, broadphase)
         chunks = chunks_for(n)
-        params = np.array(
-            [_WINDOW_TICKS, method, cell, _MARGIN_MAX_PX, chunks, _WINDOW_MAX_TICKS], np.float64
+        self._plan = Plan(
+            window=_WINDOW_TICKS,
+            cap=_MARGIN_MAX_PX,
+            longest=_WINDOW_MAX_TICKS,
+            cell=float(cell),
+            chunks=chunks,
         )
-        long_steps = np.abs(self.step) > _MARGIN_MAX_PX
+        long_steps = np.abs(self._S.step) > _MARGIN_MAX_PX
         keys = max(_INITIAL_ROWS, 2 * n)
-        self._bp = (
-            np.argsort(self.pos[:, 0], kind="stable").astype(np.int64),  # sweep order
-            np.zeros((n, 4), small),  # fences (made with the list)
-            np.empty(keys, np.int64),  # candidate keys
-            np.empty(keys + chunks, np.int64),  # near pairs (room for each thread's share)
-            np.zeros((n, 2), small),  # this tick's displacement
-            np.empty((n, 2), np.int64),  # reach boxes
-            np.empty((n, 2), np.int64),
-            params,
-            np.zeros((chunks, 3), np.int64),  # what each thread of a split stage found
-            # periods of the long steps (sorted, each once; np.unique would import numpy.ma)
-            np.array(sorted(set(period[long_steps].tolist())), np.int64),
-            marker(method),
-            np.empty((n, 4), small),  # reach boxes of this tick, for the narrow stage
+        self._lists = Lists(
+            order=np.argsort(self._S.pos[:, 0], kind="stable").astype(np.int64),
+            fence=np.zeros((n, 4), small),
+            keys=np.empty(keys, np.int64),
+            near=np.empty(keys + chunks, np.int64),
+            disp=np.zeros((n, 2), small),
+            lo=np.empty((n, 2), np.int64),
+            hi=np.empty((n, 2), np.int64),
+            found=np.zeros((chunks, 3), np.int64),
+            # each once, sorted: np.unique would import numpy.ma
+            forced=np.array(sorted(set(period[long_steps].tolist())), np.int64),
+            finder=marker(method),
+            reach=np.empty((n, 4), small),
+            ws=workspace(n, np.int64),
         )
-        self._ws = workspace(n, np.int64)
+        self._args = None
         self._split = SplitChoice(chunks)
 
     def advance(self, ticks: int, log: bool = True) -> np.ndarray:
@@ -502,7 +537,7 @@ class Model:
         leave it. Each stage is timed from Python, so each count includes a call's overhead
         (microseconds), which dominates in small scenes. A scene that splits runs split (the
         clock does not choose here)."""
-        self._bp[7][4] = self._split.chunks
+        self._chunks(self._split.chunks)
         spent = {name: 0.0 for name, _ in STAGES}
         clock = time.perf_counter
         for _ in range(int(ticks)):
@@ -516,48 +551,41 @@ class Model:
     def _ticks(self, ticks: int, log: bool, chunks: int) -> None:
         """Run `ticks` ticks, the split stages cut into `chunks` (1: not split); their events
         are added to the log."""
-        self._bp[7][4] = chunks
+        self._chunks(chunks)
         self._run_to((self.tick + ticks) * _N_STAGES, log)
+
+    def _chunks(self, chunks: int) -> None:
+        """Cut the split stages into `chunks` from now on (1: not split)."""
+        if self._plan.chunks != chunks:
+            self._plan = self._plan._replace(chunks=int(chunks))
+            self._args = None
 
     def _run_to(self, stop: int, log: bool) -> None:
         """Run `_run` to `stop` (ticks done x _N_STAGES + stage), growing the buffers it asks
         to grow."""
         while True:
-            status = _run(
-                self.pos,
-                self.size,
-                self._room,
-                self.step,
-                self.period,
-                self.count,
-                self.movable,
-                stop,
-                log,
-                self._st,
-                self._bp,
-                self._ev,
-                self._ws,
-            )
+            if self._args is None:  # `_run` takes them as plain tuples
+                self._args = (tuple(self._S), tuple(self._plan), tuple(self._lists))
+            status = _run(*self._args, self._st, stop, log, self._ev)
             if status == _DONE:
                 break
             if status == _LOG_FULL:
-                self._ev = grown(self._ev, 2 * self.pos.shape[0])
+                self._ev = grown(self._ev, 2 * self._S.pos.shape[0])
             else:
                 rows = 2 * int(self._st[_S_NEEDED])
-                chunks = self._split.chunks
-                self._bp = (
-                    self._bp[:2]
-                    + (np.empty(rows, np.int64), np.empty(rows + chunks, np.int64))
-                    + self._bp[4:]
+                self._lists = self._lists._replace(
+                    keys=np.empty(rows, np.int64),
+                    near=np.empty(rows + self._split.chunks, np.int64),
                 )
+                self._args = None
         self.tick = int(self._st[_S_TICK])
 
     def positions(self) -> np.ndarray:
-        return self.pos.astype(np.float64)
+        return self._S.pos.astype(np.float64)
 
     def velocities(self) -> np.ndarray:
         """Velocities in px/s: V / P * fps per component."""
-        return self.step / self.period * float(self.fps)
+        return self._S.step / self._S.period * float(self.fps)
 
 
 def _reach_dtype(world: WorldSpec, size: np.ndarray, step: np.ndarray):

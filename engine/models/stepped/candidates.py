@@ -179,7 +179,8 @@ def _reorder(S, order, scratch, keys, n_keys, chunks):
     if chunks > 1:
         _reorder_split(S, order, scratch, keys, n_keys, chunks)
         return
-    body, inv_mass, static, movable, ext, rank, anchor = S
+    body, inv_mass, static, movable = S.body, S.inv_mass, S.static, S.movable
+    ext, rank, anchor = S.ext, S.rank, S.anchor
     n = order.shape[0]
     _gather_range(body, inv_mass, static, movable, ext, order, scratch, 0, n)
     _place_range(body, inv_mass, static, movable, ext, rank, anchor, order, scratch, 0, n)
@@ -193,7 +194,8 @@ def _reorder(S, order, scratch, keys, n_keys, chunks):
 @njit(cache=True, parallel=True)
 def _reorder_split(S, order, scratch, keys, n_keys, chunks):
     """`_reorder` on `chunks` threads: the same state and keys."""
-    body, inv_mass, static, movable, ext, rank, anchor = S
+    body, inv_mass, static, movable = S.body, S.inv_mass, S.static, S.movable
+    ext, rank, anchor = S.ext, S.rank, S.anchor
     n = order.shape[0]
     for c in prange(chunks):
         _gather_range(
@@ -361,14 +363,15 @@ def _strayed(order):
 
 
 @njit(cache=True)
-def relist(S, dt, bp):
+def relist(S, dt, L, keys, spare):
     """Make the candidate list anew from the boxes grown by the margin, each over the step of dt
     s just taken (so that a pair that cut a corner within it is listed), note each pair's band,
     put the objects inside in the broad phase's order (sweep and cells; the pairs renamed to
-    match), anchor every object where it is and sort the list by bucket. Returns (the key
-    buffers, possibly grown: the list and a spare; how many keys)."""
-    body, inv_mass, static, movable, ext, rank, anchor = S
-    keys, near, order, lo, hi, folds, state, params, ws, when, finder, scratch, spare = bp
+    match), anchor every object where it is and sort the list by bucket. S: a State, L: a Lists
+    (records.py) but for its key buffers, keys and spare. Returns (the key buffers, possibly
+    grown: the list and a spare; how many keys)."""
+    body, anchor = S.body, S.anchor
+    order, lo, hi, state, params = L.order, L.lo, L.hi, L.state, L.params
     margin = params[P_MARGIN]
     chunks = state[ST_CHUNKS]
     n = body.shape[0]
@@ -378,10 +381,10 @@ def relist(S, dt, bp):
         _grow_range(body, lo, hi, margin, dt, 0, n)
     cell = params[P_CELL]
     found = np.zeros(chunks, np.int64)
-    k = find_split(finder, lo, hi, movable, cell, order, keys, ws, found)
+    k = find_split(L.finder, lo, hi, S.movable, cell, order, keys, L.ws, found)
     while k > keys.shape[0]:
         keys = np.empty(2 * k, np.int64)
-        k = find_split(finder, lo, hi, movable, cell, order, keys, ws, found)
+        k = find_split(L.finder, lo, hi, S.movable, cell, order, keys, L.ws, found)
     if spare.shape[0] < keys.shape[0]:
         spare = np.empty(keys.shape[0], np.int64)
     if chunks > 1:
@@ -389,7 +392,7 @@ def relist(S, dt, bp):
     else:
         _band_range(lo, hi, keys, 0, k, margin)
     if state[ST_METHOD] != METHOD_GRID and _strayed(order):
-        _reorder(S, order, scratch, keys, k, chunks)
+        _reorder(S, order, L.scratch, keys, k, chunks)
     else:
         for i in range(n):
             anchor[i, 0] = body[i, B_X]

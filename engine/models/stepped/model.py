@@ -50,7 +50,6 @@ an object from one place in memory.
 from __future__ import annotations
 
 import time
-from typing import NamedTuple
 
 import numpy as np
 
@@ -66,6 +65,7 @@ from collide2d.engine.models.stepped.candidates import (
     state_size,
 )
 from collide2d.engine.models.stepped.move import BODY_COLUMNS
+from collide2d.engine.models.stepped.records import Lists, State, Step
 from collide2d.engine.models.stepped.step import STAGES, run, step
 from collide2d.engine.shapes import GEOMETRIES, build_cores
 from collide2d.engine.sort import median
@@ -73,7 +73,7 @@ from collide2d.engine.splitchoice import SplitChoice
 from collide2d.engine.threads import chunks_for
 from collide2d.engine.world import Bodies, WorldSpec
 
-__all__ = ["STAGES", "Model", "State"]
+__all__ = ["STAGES", "Lists", "Model", "State", "Step"]
 
 # The candidate list's margin, px: this many of the fastest object's step (|v|·dt), within
 # [MARGIN_MIN_PX, MARGIN_MAX_SIDES x the median box side]. A wider margin remakes the list less
@@ -89,23 +89,9 @@ DRIFT_SLACK_REL = 1e-12
 CANDIDATES_PER_OBJECT = 4
 
 
-class State(NamedTuple):
-    """The stepped model's state arrays, every row in the broad phase's order (numba takes a
-    named tuple as it takes a tuple; the kernels unpack it by position)."""
-
-    body: np.ndarray  # (n, 6) float64 per object x, y (top-left corner, px), vx, vy (px/s),
-    # w, h (px): move.B_*
-    inv_mass: np.ndarray  # (n,) float64, 0 for static objects
-    static: np.ndarray  # (n,) bool
-    movable: np.ndarray  # (n,) bool: what the broad phase pairs
-    ext: np.ndarray  # (n,) int64 the id of each row
-    rank: np.ndarray  # (n,) int64 the row of each id
-    anchor: np.ndarray  # (n, 2) float64 where each was when the candidate list was made, px
-
-
 class Model:
     """Fixed-step elastic model; see the module docstring. Surface as in engine.models.
-    Its state is a `State`, in the broad phase's order."""
+    Its state is a `State` (records.py), in the broad phase's order."""
 
     def __init__(
         self,
@@ -139,18 +125,19 @@ class Model:
         body[:, 2:4] = vel
         body[:, 4:6] = size
         self._S = State(
-            body,
-            np.array(bodies.inv_mass, np.float64),
-            static,
-            movable,
-            np.arange(n, dtype=np.int64),
-            np.arange(n, dtype=np.int64),
-            pos.copy(),
+            body=body,
+            inv_mass=np.array(bodies.inv_mass, np.float64),
+            static=static,
+            movable=movable,
+            ext=np.arange(n, dtype=np.int64),
+            rank=np.arange(n, dtype=np.int64),
+            anchor=pos.copy(),
         )
+        self._state = tuple(self._S)  # as `step.run` takes it
         cores = build_cores(bodies, geometry)
         self._cores = (cores.shape, cores.radius, cores.start, cores.verts, cores.normals)
         self._bp = _broad_phase(world, pos, vel, size, movable, substeps, skip, broadphase)
-        self._split = SplitChoice(self._bp[6][ST_CHUNKS])
+        self._split = SplitChoice(self._bp.state[ST_CHUNKS])
 
     def advance(self, ticks: int, log: bool = True) -> np.ndarray:
         """Run `ticks` ticks; the events in the order they happened (empty when log is False).
@@ -161,28 +148,29 @@ class Model:
 
     def _advance(self, ticks: int, log: bool, chunks: int) -> np.ndarray:
         """`advance`, its split stages cut into `chunks` (1: not split)."""
-        self._bp[6][ST_CHUNKS] = chunks
+        self._bp.state[ST_CHUNKS] = chunks
         world = (float(self.world.width), float(self.world.height), float(self.world.fps))
         rows, times = new_log(log)
-        rows, times, n, self._bp = run(
+        rows, times, n, grown = run(
             world,
             self.substeps,
             self.tick,
             int(ticks),
             bool(log),
-            self._S,
+            self._state,
             self.geometry == "exact",
             self._cores,
             rows,
             times,
-            self._bp,
+            tuple(self._bp),
         )
+        self._grown(grown)
         self.tick += int(ticks)
         return event_records(rows, times, n)
 
     def event_counts(self) -> tuple[int, int]:
         """(wall events, pair events) so far, logged or not."""
-        state = self._bp[6]
+        state = self._bp.state
         return int(state[ST_WALLS]), int(state[ST_PAIRS])
 
     def profile(self, ticks: int) -> dict[str, float]:
@@ -195,7 +183,7 @@ class Model:
         choose here). The move and the narrow phase, which `advance` runs together block by block
         while the list holds (narrow.move_narrow), run here one after the other, so that
         each has a time of its own."""
-        self._bp[6][ST_CHUNKS] = self._split.chunks
+        self._bp.state[ST_CHUNKS] = self._split.chunks
         fps = float(self.world.fps)
         width, height = float(self.world.width), float(self.world.height)
         dt = 1.0 / (fps * self.substeps)
@@ -208,26 +196,20 @@ class Model:
             for _ in range(self.substeps):
                 for stage, name in enumerate(STAGES):
                     began = clock()
-                    rows, times, _, self._bp = step(
-                        stage,
-                        stage + 1,
-                        self._S,
-                        dt,
-                        width,
-                        height,
-                        exact,
-                        self._cores,
-                        tick,
-                        t,
-                        False,
-                        rows,
-                        times,
-                        0,
-                        self._bp,
-                    )
+                    at = (dt, width, height, exact, tick, t, False)
+                    rows, times, _, grown = step(
+                        stage, stage + 1, self._state, at, self._cores, rows, times, 0,
+                        tuple(self._bp),
+                    )  # fmt: skip
+                    self._grown(grown)
                     spent[name] += clock() - began
         self.tick += int(ticks)
         return spent
+
+    def _grown(self, grown: tuple) -> None:
+        """Take the buffers a step handed back (keys, spare, near, when): those that grew."""
+        keys, spare, near, when = grown
+        self._bp = self._bp._replace(keys=keys, spare=spare, near=near, when=when)
 
     def positions(self) -> np.ndarray:
         """(n, 2) float64 top-left corners, px."""
@@ -249,7 +231,7 @@ def _reorder_scratch(n: int) -> tuple:
 
 
 def _broad_phase(world, pos, vel, size, movable, substeps, skip, broadphase):
-    """The candidate list's state and scratch (see `step.run`): its margin from the
+    """The candidate list's state and scratch (a `Lists`): its margin from the
     fastest step and the box sizes, the method and cell from the scene or `broadphase`
     (broadphase.choose)."""
     n = pos.shape[0]
@@ -265,18 +247,18 @@ def _broad_phase(world, pos, vel, size, movable, substeps, skip, broadphase):
     order = np.arange(n, dtype=np.int64)
     if method == METHOD_SWEEP:
         order = np.argsort(pos[:, 0], kind="stable").astype(np.int64)
-    return (
-        np.empty(max(16, CANDIDATES_PER_OBJECT * n), np.int64),  # keys
-        np.empty(max(16, n), np.int64),  # near
-        order,
-        np.empty_like(pos),  # lo
-        np.empty_like(pos),  # hi
-        np.empty((2 * n, 4), np.int64),  # folds
-        state,
-        np.array([margin, cell, slack] + [0.0] * (PARAMS_SIZE - 3)),  # P_*
-        workspace(n),
-        np.empty(max(16, n)),  # when
-        marker(method),  # finder: the kernels compile only this method's pair finder
-        _reorder_scratch(n),
-        np.empty(max(16, CANDIDATES_PER_OBJECT * n), np.int64),  # spare keys
+    return Lists(
+        keys=np.empty(max(16, CANDIDATES_PER_OBJECT * n), np.int64),
+        near=np.empty(max(16, n), np.int64),
+        order=order,
+        lo=np.empty_like(pos),
+        hi=np.empty_like(pos),
+        folds=np.empty((2 * n, 4), np.int64),
+        state=state,
+        params=np.array([margin, cell, slack] + [0.0] * (PARAMS_SIZE - 3)),  # P_*
+        ws=workspace(n),
+        when=np.empty(max(16, n)),
+        finder=marker(method),
+        scratch=_reorder_scratch(n),
+        spare=np.empty(max(16, CANDIDATES_PER_OBJECT * n), np.int64),
     )

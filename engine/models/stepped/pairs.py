@@ -57,15 +57,15 @@ def _contact(a, b, ea, eb, body, dt, exact, shape, radius, start, verts, normals
 
 
 @njit(cache=True)
-def respond(
-    S, dt, width, height, exact, cores, near, n_near, inside, tick, t, log, rows, times, n_ev,
-    state, params,
-):
+def respond(S, at, cores, near, n_near, rows, times, n_ev, L):
     """Respond to every overlapping, approaching pair of `near` (ascending keys of ids) in order,
-    after a step of dt s; count each in state[ST_PAIRS], log it when `log`; params[P_PUSHED] the
-    farthest from its anchor on an axis that an object pushed apart ended (px, 0 when none was).
-    inside (k, 3) int64 is scratch (the move's fold rows, free by now)."""
-    body, inv_mass, static, movable, ext, rank, anchor = S
+    after the step `at` (a Step); count each in L.state[ST_PAIRS], log it when at.log;
+    L.params[P_PUSHED] the farthest from its anchor on an axis that an object pushed apart ended
+    (px, 0 when none was). S: a State, L: a Lists (records.py); L.folds, the move's fold rows,
+    free by now, is scratch."""
+    body, inv_mass, rank, anchor = S.body, S.inv_mass, S.rank, S.anchor
+    state, params, inside = L.state, L.params, L.folds
+    dt, width, height, exact = at.dt, at.width, at.height, at.exact
     shape, radius, start, verts, normals = cores
     pos = body  # its columns 0, 1: the corners, as response.separate reads them
     size = body[:, B_W : B_H + 1]
@@ -127,8 +127,8 @@ def respond(
         for i in (a, b):
             pushed = max(pushed, abs(body[i, B_X] - anchor[i, 0]), abs(body[i, B_Y] - anchor[i, 1]))
         state[ST_PAIRS] += 1
-        if log:
-            rows, times = log_event(rows, times, n_ev, tick, t, EV_PAIR, ea, eb, code)
+        if at.log:
+            rows, times = log_event(rows, times, n_ev, at.tick, at.t, EV_PAIR, ea, eb, code)
             n_ev += 1
     params[P_PUSHED] = pushed
     return rows, times, n_ev

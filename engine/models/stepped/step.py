@@ -2,10 +2,10 @@
 STAGES (move, broad, narrow, response), and `run`, which runs every stage of every step of a
 number of ticks in one call.
 
-Input: the world (width, height, fps), the substeps, the state (`model.State`), the geometry,
-the exact shapes' cores, the event log's buffers and the broad phase's state and scratch (`bp`,
-below). Output: the state advanced in place, the events logged, and the buffers that grew, which
-replace the caller's.
+Input: the world (width, height, fps), the substeps, the state (`records.State`), the geometry,
+the exact shapes' cores, the event log's buffers and the broad phase's state and scratch
+(`records.Lists`). Output: the state advanced in place, the events logged, and the buffers that
+grew, which replace the caller's.
 
 While the candidate list holds, a step runs its move and narrow stages together, block by block
 (narrow.move_narrow: the same pairs, tested while their rows are in the cache); a step
@@ -40,6 +40,7 @@ from collide2d.engine.models.stepped.candidates import (
 from collide2d.engine.models.stepped.move import log_walls, move_walls
 from collide2d.engine.models.stepped.narrow import move_narrow, narrow
 from collide2d.engine.models.stepped.pairs import respond
+from collide2d.engine.models.stepped.records import Lists, State, Step
 
 # The stages of one step, in the order `step` runs them; `Model.profile` times each by name
 # through the same kernel.
@@ -67,34 +68,36 @@ def _holds(state, params):
 
 
 @njit(cache=True)
-def step(first, last, S, dt, width, height, exact, cores, tick, t, log, rows, times, n_ev, bp):
+def step(first, last, state, at, cores, rows, times, n_ev, lists):
     """Run the stages first ... last-1 (of STAGES) of one step; returns (event buffers, how many
-    events, bp): the buffers that grew replace the caller's. What a stage hands the next waits
-    in bp between calls: the drift in params[P_DRIFT], the overlapping pairs in state[ST_NEAR]."""
-    keys, near, order, lo, hi, folds, state, params, ws, when, finder, scratch, spare = bp
-    rows, times, n_ev, lists = _stages(
-        first, last, S, dt, width, height, exact, cores, tick, t, log, rows, times, n_ev, bp,
-        (keys, spare, near, when),
-    )
-    keys, spare, near, when = lists
-    return rows, times, n_ev, (
-        keys, near, order, lo, hi, folds, state, params, ws, when, finder, scratch, spare
-    )
+    events, (keys, spare, near, when)): the buffers that grew replace the caller's. state, at and
+    lists are the fields of a `State`, a `Step` and a `Lists` (records.py), as plain tuples. What a
+    stage hands the next waits in the lists between calls: the drift in params[P_DRIFT], the
+    overlapping pairs in state[ST_NEAR]."""
+    L = Lists(*lists)
+    return _stages(first, last, State(*state), Step(*at), cores, rows, times, n_ev, L, _growing(L))
+
+
+@njit(cache=True, inline="always")
+def _growing(L):
+    """The buffers of `L` that can grow, in the order `_stages` keeps them."""
+    return L.keys, L.spare, L.near, L.when
 
 
 @njit(cache=True)
-def _stages(first, last, S, dt, width, height, exact, cores, tick, t, log, rows, times, n_ev, bp,
-            lists):
-    """`step`, with the buffers that can grow apart from bp: lists = (keys, spare, near, when)
-    (bp's own slots for them are not read); returns (event buffers, how many events, lists).
-    `run` keeps them apart from bp between steps, so that a step hands back these four arrays
-    and not all of bp's (each array handed back costs two atomic reference counts: handing back
-    all of bp took a step's fixed cost, measured on two objects, from 0.6 to 1.0 us)."""
-    body, inv_mass, static, movable, ext, rank, anchor = S
-    _, _, order, lo, hi, folds, state, params, ws, _, finder, scratch, _ = bp
+def _stages(first, last, S, at, cores, rows, times, n_ev, L, lists):
+    """`step` on the records themselves, with the buffers that can grow apart from L: lists =
+    (keys, spare, near, when) (L's own fields for them are not read); returns (event buffers, how
+    many events, lists). `run` keeps them apart from L between steps, so that a step hands back
+    these four arrays and not all of L's (each array handed back costs two atomic reference
+    counts: handing back all of the record took a step's fixed cost, measured on two objects,
+    from 0.6 to 1.0 us)."""
+    body, anchor = S.body, S.anchor
+    folds, state, params = L.folds, L.state, L.params
     keys, spare, near, when = lists
+    dt = at.dt
     chunks = state[ST_CHUNKS]
-    sides = (width, height)
+    sides = (at.width, at.height)
     # the move and the narrow phase block by block, while the list will hold for this step
     fused = first == _MOVE and last == _LAST and state[ST_POSSIBLE] != 0 and _holds(state, params)
     if first <= _MOVE < last:
@@ -102,20 +105,20 @@ def _stages(first, last, S, dt, width, height, exact, cores, tick, t, log, rows,
         # from where the candidate list was made, and how far its path reached
         if fused:
             n_folds, drift, state[ST_NEAR] = move_narrow(
-                body, static, ext, anchor, dt, sides, folds, keys, state, params, near, when,
+                body, S.static, S.ext, anchor, dt, sides, folds, keys, state, params, near, when,
                 chunks,
             )
             state[ST_FUSED] += 1
         else:
-            n_folds, drift = move_walls(body, static, ext, anchor, dt, sides, folds, chunks)
+            n_folds, drift = move_walls(body, S.static, S.ext, anchor, dt, sides, folds, chunks)
         params[P_REACH] = max(drift, start_reach(params))
         params[P_GROWTH] = max(drift - params[P_DRIFT], 0.0)
         params[P_DRIFT] = drift
         if n_folds:
             for r in range(n_folds):  # one wall event per fold
                 state[ST_WALLS] += folds[r, 1] + folds[r, 2]
-            if log:
-                rows, times, n_ev = log_walls(folds, n_folds, tick, t, rows, times, n_ev)
+            if at.log:
+                rows, times, n_ev = log_walls(folds, n_folds, at.tick, at.t, rows, times, n_ev)
     if state[ST_POSSIBLE] == 0:  # no pair can happen
         return rows, times, n_ev, lists
     tested = fused
@@ -123,16 +126,14 @@ def _stages(first, last, S, dt, width, height, exact, cores, tick, t, log, rows,
         # the candidate list made anew once an object drifted its margin (what the step tested
         # on the old list then does not count)
         if state[ST_KEYS] < 0 or params[P_DRIFT] >= params[P_MARGIN] - params[P_SLACK]:
-            keys, spare, state[ST_KEYS] = relist(
-                S, dt,
-                (keys, near, order, lo, hi, folds, state, params, ws, when, finder, scratch, spare),
-            )  # fmt: skip
+            keys, spare, state[ST_KEYS] = relist(S, dt, L, keys, spare)
             lists = (keys, spare, near, when)
             tested = False
     if first <= _NARROW < last and not (tested and state[ST_NEAR] <= near.shape[0]):
         # the listed pairs in contact this step, in the order their contacts began, from the
         # bands near enough to touch by now
         bands = within_reach(params)
+        ext = S.ext
         state[ST_NEAR] = narrow(body, ext, keys, state, bands, near, when, dt, sides, chunks)
         while state[ST_NEAR] > near.shape[0]:
             near = np.empty(2 * state[ST_NEAR], np.int64)
@@ -140,70 +141,28 @@ def _stages(first, last, S, dt, width, height, exact, cores, tick, t, log, rows,
             lists = (keys, spare, near, when)
             state[ST_NEAR] = narrow(body, ext, keys, state, bands, near, when, dt, sides, chunks)
     if first <= _RESPONSE < last:
-        rows, times, n_ev = respond(
-            S,
-            dt,
-            width,
-            height,
-            exact,
-            cores,
-            near,
-            state[ST_NEAR],
-            folds,
-            tick,
-            t,
-            log,
-            rows,
-            times,
-            n_ev,
-            state,
-            params,
-        )
+        rows, times, n_ev = respond(S, at, cores, near, state[ST_NEAR], rows, times, n_ev, L)
     return rows, times, n_ev, lists
 
 
 @njit(cache=True)
-def run(world, substeps, tick0, ticks, log, S, exact, cores, rows, times, bp):
+def run(world, substeps, tick0, ticks, log, state, exact, cores, rows, times, lists):
     """Run ticks tick0+1 ... tick0+ticks, every step all of `step`; returns (event buffers, how
-    many events, bp): the buffers that grew replace the caller's.
+    many events, (keys, spare, near, when)): the buffers that grew replace the caller's.
 
-    S: the state arrays (a `model.State`). bp = (keys, near, order, lo, hi, folds, state,
-    params, ws, when, finder, scratch, spare): the candidate list kept between calls (sorted by
-    bucket, candidates.py) and scratch
-    (`near`, `when`: this step's pairs in contact and the times their contacts began; `order`,
-    `lo`, `hi`, `ws`: the broad phase's; `folds`: the move's fold rows; `finder`: the marker of
-    the method, broadphase.marker, so that a kernel compiles only that pair finder; `scratch`:
-    the reorder's, candidates.py; `spare`: a second key buffer the relist sorts into); state and
-    params as candidates.py names their slots (ST_*,
-    P_*).
+    world = (width, height, fps); state: the fields of a `State`, lists those of a `Lists`
+    (records.py), as plain tuples.
     """
     width, height, fps = world
     dt = 1.0 / (fps * substeps)
     n_ev = np.int64(0)  # not the literal 0, which would compile step once more for it
-    keys, near, order, lo, hi, folds, state, params, ws, when, finder, scratch, spare = bp
-    lists = (keys, spare, near, when)
+    S, L = State(*state), Lists(*lists)
+    grows = _growing(L)
     for tick in range(tick0 + 1, tick0 + ticks + 1):
         t = tick / fps
+        at = Step(dt, width, height, exact, tick, t, log)
         for _ in range(substeps):
-            rows, times, n_ev, lists = _stages(
-                _FIRST,
-                _LAST,
-                S,
-                dt,
-                width,
-                height,
-                exact,
-                cores,
-                tick,
-                t,
-                log,
-                rows,
-                times,
-                n_ev,
-                bp,
-                lists,
+            rows, times, n_ev, grows = _stages(
+                _FIRST, _LAST, S, at, cores, rows, times, n_ev, L, grows
             )
-    keys, spare, near, when = lists
-    return rows, times, n_ev, (
-        keys, near, order, lo, hi, folds, state, params, ws, when, finder, scratch, spare
-    )
+    return rows, times, n_ev, grows

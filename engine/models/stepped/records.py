@@ -1,0 +1,60 @@
+"""The stepped model's state records, read by field in every kernel: `State` (the objects),
+`Lists` (the candidate list kept between steps, the broad phase's state and the stages'
+scratch) and `Step` (what one step is run with).
+
+numba takes a named tuple as it takes a tuple, but reads the type of one handed to it from Python
+field by field (microseconds a call, against a fraction of one for a plain tuple): the kernels
+that Python calls (step.run, step.step) take each record as a plain tuple of its fields and name
+it again inside (`State(*state)`).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+
+class State(NamedTuple):
+    """The stepped model's state arrays, every row in the broad phase's order."""
+
+    body: np.ndarray  # (n, 6) float64 per object x, y (top-left corner, px), vx, vy (px/s),
+    # w, h (px): move.B_*
+    inv_mass: np.ndarray  # (n,) float64, 0 for static objects
+    static: np.ndarray  # (n,) bool
+    movable: np.ndarray  # (n,) bool: what the broad phase pairs
+    ext: np.ndarray  # (n,) int64 the id of each row
+    rank: np.ndarray  # (n,) int64 the row of each id
+    anchor: np.ndarray  # (n, 2) float64 where each was when the candidate list was made, px
+
+
+class Lists(NamedTuple):
+    """The candidate list kept between calls (sorted by bucket, candidates.py), the broad
+    phase's state and the stages' scratch. `keys`, `near`, `when` and `spare` can grow: a step
+    hands the four back (step.run), and the kernels keep them apart from the record meanwhile."""
+
+    keys: np.ndarray  # int64 the candidate list
+    near: np.ndarray  # int64 this step's pairs in contact
+    order: np.ndarray  # (n,) int64 the broad phase's order
+    lo: np.ndarray  # (n, 2) float64 grown boxes, low corners
+    hi: np.ndarray  # (n, 2) float64 grown boxes, high corners
+    folds: np.ndarray  # (2n, 4) int64 the move's fold rows
+    state: np.ndarray  # int64 scalar state, slots candidates.ST_*
+    params: np.ndarray  # float64 scalar state, slots candidates.P_*
+    ws: tuple  # the pair finders' scratch (broadphase.workspace)
+    when: np.ndarray  # float64 the times this step's contacts began
+    finder: np.ndarray  # the method's marker (broadphase.marker: only that finder compiles)
+    scratch: tuple  # the reorder's scratch (candidates._reorder)
+    spare: np.ndarray  # int64 a second key buffer the relist sorts into
+
+
+class Step(NamedTuple):
+    """What one step is run with."""
+
+    dt: float  # its length, s
+    width: float  # the world's sides, px
+    height: float
+    exact: bool  # whether objects collide by their real shapes (shapes.py), not their boxes
+    tick: int  # the tick it belongs to
+    t: float  # the time of that tick's end, s (the events' time)
+    log: bool  # whether events are logged
