@@ -206,16 +206,14 @@ def plural(count: int, noun: str) -> str:
 
 
 # The commands that run kernels: they time compilation apart and say when it starts.
-COMPILING_COMMANDS = ("run", "check", "bless", "validate", "stress", "bench")
+COMPILING_COMMANDS = ("run", "check", "bless", "validate", "stress", "bench", "sweep")
 
 
 def compile_notice() -> None:
-    """The one line a terminal shows when kernels start compiling."""
-    print(
-        "compiling kernels, first run only (numba caches them for later runs) …",
-        file=sys.stderr,
-        flush=True,
-    )
+    """The one line a terminal shows when kernels start compiling (above a progress bar drawn)."""
+    from collide2d.runner.output import progress
+
+    progress.say("compiling kernels, first run only (numba caches them for later runs) …")
 
 
 def command_of(argv: list[str]) -> str | None:
