@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 
 from collide2d.runner.command.exitcodes import EXIT_BAD_INPUT, EXIT_OK
@@ -55,17 +56,23 @@ def run_validate(args: argparse.Namespace) -> int:
     return status
 
 
+# The files a project's scenarios folder holds as scenarios, as `check` lists them.
+SCENARIO_SUFFIXES = (".yaml", ".yml")
+
+
 def project_files(project) -> list[str]:
     """The scenario files of the project's scenarios folder, sorted by name, as shown."""
-    from collide2d.runner.golden.store import scenario_files
-
-    return [shown_path(p) for p in scenario_files(project.root, project.value("scenarios"))]
+    folder = project.scenarios
+    if not folder.is_dir():
+        return []
+    files = [p for p in folder.iterdir() if p.suffix in SCENARIO_SUFFIXES and p.is_file()]
+    return [shown_path(p) for p in sorted(files, key=lambda p: p.name)]
 
 
 def shown_path(path) -> str:
-    from collide2d.runner.golden.store import shown_path as shown
-
-    return shown(path)
+    """`path` relative to the current folder when inside it, else as it is."""
+    shown = os.path.relpath(path)
+    return str(path) if shown.startswith("..") else shown
 
 
 def run_schema(args: argparse.Namespace) -> int:
