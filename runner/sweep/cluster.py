@@ -156,9 +156,15 @@ def progress_for(total: int, label: str, quiet: bool) -> Progress | None:
 
 
 def _tell_compiling() -> None:
+    """Send COMPILING_TOPIC's event from the worker compiling (nothing outside a task: a cluster
+    in this very process, whose first compilation may come on another thread)."""
     from distributed import get_worker
 
-    get_worker().log_event(COMPILING_TOPIC, "compiling")
+    try:
+        worker = get_worker()
+    except ValueError:
+        return
+    worker.log_event(COMPILING_TOPIC, "compiling")
 
 
 def _telling(fn, item):
