@@ -8,6 +8,11 @@ process spent compiling (nested compilations, a kernel compiling the kernels it 
 once), and `notice()`, when given, is called once, at the start of the first compilation (the CLI
 prints "compiling kernels, first run only ..." on a terminal). With NUMBA_DISABLE_JIT=1 nothing
 compiles and `seconds()` stays 0.
+
+Kernels a cluster's worker process compiles (a sweep's, a check's with `--workers`) are not this
+process's: `relay(tell)`, in the worker, calls `tell()` at the start of its first compilation (it
+sends an event back, runner.sweep.cluster), and `told()`, here, gives the notice then, once for
+the command whichever process compiles first.
 """
 
 from __future__ import annotations
@@ -53,3 +58,18 @@ def _listen() -> None:
 def seconds() -> float:
     """Seconds this process has spent compiling kernels since `install` (0 before it)."""
     return _state["seconds"]
+
+
+def told() -> None:
+    """Another process (a cluster's worker) started compiling: the notice, if not given yet."""
+    notice, _state["notice"] = _state["notice"], None
+    if notice is not None:
+        notice()
+
+
+def relay(tell: Callable[[], None]) -> None:
+    """In a cluster's worker: `tell()` when this process starts compiling its first kernel. A
+    worker in the command's own process (an in-process cluster) leaves this process's notice as it
+    is: its compilations are counted and told here already."""
+    if not _state["installed"]:
+        install(tell)

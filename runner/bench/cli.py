@@ -1,9 +1,14 @@
 """The `bench` subcommand: its arguments, and the run that drives the parts and writes the report.
 
 `register` adds the subcommand without loading the parts; `cmd_bench` loads them when
-`collide2d bench` runs, runs the parts asked for (default: all but peers) and writes
-OUT/bench/bench.csv, bench.md and the plots. Exit status: 0, or 2 on bad input (a scenarios folder
-without the benchmark scenarios, a report folder that is a symbolic link).
+`collide2d bench` runs, runs the parts asked for (default: scaling, error, skips, targets) and
+writes OUT/bench/bench.csv, bench.md and the plots. The parts that read scenario files (FILE_PARTS)
+read them from `--scenarios`, else from the project's scenarios folder (runner.command.settings);
+when that folder lacks the benchmark scenarios (a user's project), the default run leaves those
+parts out and says so. On a terminal a bar counts the parts done from the start, the progress
+lines printed above it. Exit status: 0 when every target of the headline is met, 1 when one is
+missed (each named on stderr), 2 on bad input (a part asked for whose scenarios are missing, a
+report folder that is a symbolic link).
 """
 
 from __future__ import annotations
@@ -14,30 +19,18 @@ import time
 from pathlib import Path
 
 from collide2d.engine import models
-from collide2d.runner.command.exitcodes import EXIT_BAD_INPUT, EXIT_OK
+from collide2d.runner.command.exitcodes import EXIT_BAD_INPUT, EXIT_DIFFERENCE, EXIT_OK
 
 PARTS = ("scaling", "error", "peers", "skips", "targets", "paper", "exact", "raster")
 PARTS += ("stages", "load")  # runner/bench/stages.py, load.py
 DEFAULT_PARTS = ("scaling", "error", "skips", "targets")
+FILE_PARTS = ("error", "skips", "targets", "paper", "raster")  # read scenarios/*.yaml
 REPORT_DIR = "bench"
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
     from collide2d.runner import lanes
-    from collide2d.runner.bench import (
-        error,
-        exact,
-        paper,
-        peers,
-        plots,
-        raster,
-        report,
-        scaling,
-        scenes,
-        skips,
-        targets,
-        timing,
-    )
+    from collide2d.runner.bench import plots, report, scaling, scenes, timing
     from collide2d.runner.output import files as outputs
 
     lanes.set_mode("on")  # every run the bench times is compiled (runner.lanes)
@@ -48,27 +41,72 @@ def cmd_bench(args: argparse.Namespace) -> int:
     ns = args.n or list(scaling.QUICK_N if quick else scaling.SCALING_N)
     models_ = args.model or list(models.MODEL_NAMES)
     in_process = args.in_process or quick
-    folder = Path(args.scenarios) if args.scenarios else scenes.PROJECT_SCENARIOS
+    folder = Path(args.scenarios) if args.scenarios else project_scenarios()
     missing = [n for n in scenes.NEEDED_SCENARIOS if not (folder / f"{n}.yaml").is_file()]
-    if missing and set(parts) - {"scaling", "peers", "exact"}:
+    reading = [p for p in parts if p in FILE_PARTS]
+    if missing and reading:
+        if args.scenarios or args.part:  # asked for by name: refused
+            print(
+                f"collide2d bench: error: {folder} lacks {missing[0]}.yaml; point "
+                "--scenarios at a folder of the benchmark scenarios",
+                file=sys.stderr,
+            )
+            return EXIT_BAD_INPUT
+        parts = tuple(p for p in parts if p not in FILE_PARTS)
         print(
-            f"collide2d bench: error: {folder} lacks {missing[0]}.yaml; point "
-            "--scenarios at the project's scenarios/ folder",
+            f"collide2d bench: {folder} lacks {missing[0]}.yaml, so no {', '.join(reading)} "
+            "part (point --scenarios at a folder of the benchmark scenarios)",
             file=sys.stderr,
         )
-        return EXIT_BAD_INPUT
     target = Path(args.out) / REPORT_DIR
     if target.is_symlink():
         print(f"collide2d bench: error: {target} is a symbolic link", file=sys.stderr)
         return EXIT_BAD_INPUT
-    echo = timing.Echo(args.quiet)
+    echo = timing.Echo(args.quiet, parts)
+    try:
+        rows, seconds = _run_parts(args, parts, ns, models_, quick, in_process, folder, echo)
+    finally:
+        echo.close()
+    outputs.make_folder(target)
+    args_line = "collide2d bench " + " ".join(sys.argv[2:]) if len(sys.argv) > 1 else "bench"
+    outputs.atomic_write_text(target / "bench.csv", report.csv_text(rows))
+    outputs.atomic_write_text(target / "bench.md", report.markdown(rows, args_line, seconds))
+    written = ["bench.csv", "bench.md"] + plots.plots(rows, target)
+    headline = report.headline(rows)
+    if not args.quiet:
+        for what, figure, goal, met in headline:
+            goal = f"  (target {goal}) {met}" if goal else ""
+            print(f"{figure:>14}  {what}{goal}")
+        print(f"bench: {len(rows)} rows in {seconds:.1f}s -> {target} ({', '.join(written)})")
+    missed = report.missed(headline)
+    for what, figure, goal in missed:
+        print(f"collide2d bench: target missed: {what}: {figure} (target {goal})", file=sys.stderr)
+    return EXIT_DIFFERENCE if missed else EXIT_OK
+
+
+def _run_parts(args, parts, ns, models_, quick, in_process, folder, echo) -> tuple[list, float]:
+    """(the rows of the parts, seconds they took)."""
+    from collide2d.runner.bench import (
+        error,
+        exact,
+        paper,
+        peers,
+        raster,
+        scaling,
+        scenes,
+        skips,
+        targets,
+    )
+
     began = time.perf_counter()
     rows: list[dict] = []
     # pymunk is timed in turn with the stepped model's runs, when both are asked for (peers.py)
     peer = peers.timer(quick) if "peers" in parts and peers.pymunk_available() else None
     if "scaling" in parts:
+        echo.part("scaling")
         rows += scaling.scaling(models_, ns, quick, in_process, echo, peer)
     if "peers" in parts:
+        echo.part("peers")
         if peer is not None:
             stepped = [r for r in rows if r["part"] == "scaling" and r["model"] == "stepped"]
             missing = [n for n in ns if n not in {r["n"] for r in stepped}]
@@ -86,37 +124,42 @@ def cmd_bench(args: argparse.Namespace) -> int:
                 file=sys.stderr,
             )
     if "error" in parts:
+        echo.part("error")
         rows += error.error_ladder(scenes.BENCH_SCENARIOS, models_, quick, echo, folder)
     if "skips" in parts:
+        echo.part("skips")
         rows += skips.skips(quick, echo, folder)
     if "targets" in parts:
+        echo.part("targets")
         rows += targets.targets(quick, echo, folder)
     if "paper" in parts:
+        echo.part("paper")
         rows += paper.paper(quick, echo, folder)
     if "exact" in parts:
+        echo.part("exact")
         rows += exact.exact(quick, echo)
     if "raster" in parts:
+        echo.part("raster")
         rows += raster.raster(quick, echo, folder)
     if "stages" in parts:
+        echo.part("stages")
         from collide2d.runner.bench import stages
 
         rows += stages.stages(quick, echo, args.n)
     if "load" in parts:
+        echo.part("load")
         from collide2d.runner.bench import load
 
         rows += load.load(quick, echo)
-    seconds = time.perf_counter() - began
-    outputs.make_folder(target)
-    args_line = "collide2d bench " + " ".join(sys.argv[2:]) if len(sys.argv) > 1 else "bench"
-    outputs.atomic_write_text(target / "bench.csv", report.csv_text(rows))
-    outputs.atomic_write_text(target / "bench.md", report.markdown(rows, args_line, seconds))
-    written = ["bench.csv", "bench.md"] + plots.plots(rows, target)
-    if not args.quiet:
-        for what, figure, goal, met in report.headline(rows):
-            goal = f"  (target {goal}) {met}" if goal else ""
-            print(f"{figure:>14}  {what}{goal}")
-        print(f"bench: {len(rows)} rows in {seconds:.1f}s -> {target} ({', '.join(written)})")
-    return EXIT_OK
+    return rows, time.perf_counter() - began
+
+
+def project_scenarios() -> Path:
+    """The scenarios folder of the project here (runner.command.settings: its [tool.collide2d]
+    table, else the nearest scenarios/ folder up from here)."""
+    from collide2d.runner.command import settings
+
+    return settings.find().folder("scenarios")
 
 
 def register(subparsers) -> None:

@@ -101,14 +101,34 @@ def best_of(fn, repeats: int) -> float:
 
 
 class Echo:
-    """Progress lines on stderr (nothing when quiet)."""
+    """Progress lines on stderr (nothing when quiet); on a terminal, below them, a bar of the
+    `parts` done, drawn from the start (compiling the first part's kernels takes a while)."""
 
-    def __init__(self, quiet: bool):
+    def __init__(self, quiet: bool, parts: tuple[str, ...] = ()):
+        from collide2d.runner.output.progress import Progress
+
         self.quiet = quiet
+        self.parts = parts
+        self.started = 0
+        shown = parts and not quiet and sys.stderr.isatty()
+        self.bar = Progress(len(parts), "bench", unit=" parts", waiting=True) if shown else None
 
     def __call__(self, text: str) -> None:
         if not self.quiet:
-            print(text, file=sys.stderr, flush=True)
+            from collide2d.runner.output.progress import say
+
+            say(text)
+
+    def part(self, name: str) -> None:
+        """The part `name` starts: the parts before it are done."""
+        if self.bar is not None:
+            self.bar.label(f"bench: {name}")
+            self.bar.update(self.started)
+        self.started += 1
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
 
 
 class Timing(NamedTuple):

@@ -62,42 +62,43 @@ def register_run(subparsers) -> None:
     p = subparsers.add_parser(
         "run",
         help="run a scenario and write its frames, GIF and event log",
-        description="Run SCENARIO (default: the bundled 50-box demo of the paper's section IV) "
-        "and write OUT/NAME/: frames/*.png, animation.gif, events.jsonl, final.csv, summary.json. "
-        "Flags override the scenario's output and settings.",
+        usage="collide2d run [SCENARIO] [options]",
+        description=RUN_EXAMPLES,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("scenario", nargs="?", help="scenario YAML file (default: the bundled demo)")
-    p.add_argument(
+    written = p.add_argument_group("what is written (default: as the scenario's output says)")
+    written.add_argument(
         "--out",
         metavar="DIR",
         help="output folder (default: the project's [tool.collide2d] out, else out)",
     )
-    p.add_argument(
+    written.add_argument(
         "--gif",
         action=argparse.BooleanOptionalAction,
         default=None,
         help="write animation.gif (default: the scenario's output.gif)",
     )
-    p.add_argument(
+    written.add_argument(
         "--png",
         action=argparse.BooleanOptionalAction,
         default=None,
         help="write PNG frames: the scenario's output.frames, or all when it asks for "
         "none (default: only if output.frames asks for some)",
     )
-    p.add_argument(
+    written.add_argument(
         "--events",
         action=argparse.BooleanOptionalAction,
         default=None,
         help="write events.jsonl (default: the scenario's output.events)",
     )
-    p.add_argument(
+    written.add_argument(
         "--viewer",
         action=argparse.BooleanOptionalAction,
         default=None,
         help="write viewer.html, a player of the run (default: the scenario's output.viewer)",
     )
-    p.add_argument(
+    written.add_argument(
         "--overlay",
         type=overlay_names,
         default=None,
@@ -105,20 +106,39 @@ def register_run(subparsers) -> None:
         help="draw debug overlays into the PNG and GIF frames, comma-separated: "
         f"{', '.join(OVERLAY_NAMES)}, or none (default: the scenario's output.overlay)",
     )
-    add_override_arguments(p)
-    p.add_argument(
+    written.add_argument(
         "--scale",
         type=positive_int,
         default=1,
         metavar="K",
         help="enlarge PNG and GIF frames K times, nearest neighbour (default 1)",
     )
-    p.add_argument("--quiet", action="store_true", help="no progress bar, no notes")
-    add_limit_arguments(p, output=True)
-    add_cap_argument(p)
-    add_threads_argument(p)
-    add_jit_argument(p)
+    add_override_arguments(p.add_argument_group("instead of the scenario's settings"))
+    running = p.add_argument_group("how it runs")
+    running.add_argument("--quiet", action="store_true", help="no progress bar, no notes")
+    add_threads_argument(running)
+    add_jit_argument(running)
+    add_cap_argument(add_limit_arguments(p, output=True))
     p.set_defaults(func=cmd_run)
+
+
+RUN_EXAMPLES = """\
+Run SCENARIO (default: the bundled 50-box demo of the paper's section IV) and write OUT/NAME/:
+frames/*.png, animation.gif, events.jsonl, final.csv, summary.json.
+
+examples:
+  collide2d run                                 the bundled demo -> out/paper_fifty_boxes/
+  collide2d run scenarios/example.yaml          a scenario of yours -> out/example/
+  collide2d run s.yaml --model exact --fps 60   the same scene under another model and rate
+  collide2d run s.yaml --png --scale 4          every frame as PNG, four times the size
+  collide2d run s.yaml --overlay velocity,labels --viewer
+                                                debug overlays, and viewer.html to play it
+  collide2d run s.yaml --quiet --no-gif         no progress bar, no animation.gif
+
+The options below override what the scenario file says; the --max-* limits, last, guard against
+a scenario too big for the machine (raise them for a big run, or in pyproject.toml's
+[tool.collide2d.limits]).
+"""
 
 
 def overlay_names(text: str) -> tuple[str, ...]:
@@ -206,16 +226,14 @@ def plural(count: int, noun: str) -> str:
 
 
 # The commands that run kernels: they time compilation apart and say when it starts.
-COMPILING_COMMANDS = ("run", "check", "bless", "validate", "stress", "bench")
+COMPILING_COMMANDS = ("run", "check", "bless", "validate", "stress", "bench", "sweep")
 
 
 def compile_notice() -> None:
-    """The one line a terminal shows when kernels start compiling."""
-    print(
-        "compiling kernels, first run only (numba caches them for later runs) …",
-        file=sys.stderr,
-        flush=True,
-    )
+    """The one line a terminal shows when kernels start compiling (above a progress bar drawn)."""
+    from collide2d.runner.output import progress
+
+    progress.say("compiling kernels, first run only (numba caches them for later runs) …")
 
 
 def command_of(argv: list[str]) -> str | None:

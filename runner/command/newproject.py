@@ -3,7 +3,8 @@
 `collide2d init [DIR]` (default: the current folder) writes `scenarios/example.yaml` (a commented
 scenario showing every section; kept if it exists), a `[tool.collide2d]` table in
 `pyproject.toml` (the file created, or the table appended to it; a file that already has the table
-is left alone), and an `out/` line in `.gitignore`, then prints the next three commands. Nothing
+is left alone), and `out/` and `report/` lines in `.gitignore` (what `run` and `check --report`
+write; each added unless the file ignores it already), then prints the next three commands. Nothing
 is overwritten: each step says whether it created, extended or kept its file.
 
 A pyproject.toml is read as TOML readers read it (its bytes as UTF-8, line ends untouched) and is
@@ -57,7 +58,7 @@ out = "out"               # `collide2d run` writes OUT/NAME/ here
 # substeps = 8
 # geometry = "exact"
 """
-IGNORE = "out/"
+IGNORES = ("out/", "report/")  # the folders of run's outputs and check's report
 NEXT = (
     ("collide2d run scenarios/example.yaml", "see it: out/example/animation.gif"),
     ("pytest --update-goldens", "record its golden in goldens/ (commit that folder)"),
@@ -121,10 +122,18 @@ def init(root: Path) -> list[str]:
     gitignore = root / ".gitignore"
     old = _read(gitignore)
     lines = (old or b"").splitlines()
-    if any(line.encode() in lines for line in (IGNORE, IGNORE.rstrip("/"), "/" + IGNORE)):
-        said.append(f"kept      {gitignore} (it ignores {IGNORE})")
+    missing = [
+        ignore
+        for ignore in IGNORES
+        if not any(v.encode() in lines for v in (ignore, ignore.rstrip("/"), "/" + ignore))
+    ]
+    if not missing:
+        said.append(f"kept      {gitignore} (it ignores {' and '.join(IGNORES)})")
     else:
-        batch.add(_target(gitignore, project), _with_line(gitignore, old, IGNORE), old)
+        new = old
+        for ignore in missing:
+            new = _with_line(gitignore, new, ignore)
+        batch.add(_target(gitignore, project), new, old)
         said.append(f"{'created' if old is None else 'extended':<9} {gitignore}")
     batch.commit()
     return said

@@ -46,8 +46,9 @@ def whole(text: str) -> int:
         raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
 
 
-def add_limit_arguments(parser: argparse.ArgumentParser, *, output: bool = False) -> None:
-    """Add the limit options (defaults from Limits); `output` adds --max-output-bytes too."""
+def add_limit_arguments(parser: argparse.ArgumentParser, *, output: bool = False):
+    """Add the limit options (defaults from Limits) in a group of their own, returned; `output`
+    adds --max-output-bytes too."""
     defaults = Limits()
     group = parser.add_argument_group("limits")
     for flag, field, what in _LIMIT_OPTIONS + (_OUTPUT_OPTIONS if output else ()):
@@ -60,6 +61,7 @@ def add_limit_arguments(parser: argparse.ArgumentParser, *, output: bool = False
             help=f"largest number of {what} (default {getattr(defaults, field):,}, or the "
             "project's [tool.collide2d.limits])",
         )
+    return group
 
 
 def limits_from_args(args: argparse.Namespace, project=None) -> Limits:

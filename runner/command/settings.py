@@ -54,6 +54,19 @@ class ConfigError(ScenarioError):
     """The `[tool.collide2d]` table refused: str(err) is `PATH:LINE:COL: error: MESSAGE`."""
 
 
+class ConfigErrors(ConfigError):
+    """Every refusal of one table, in line order (`errors`), so that one run of a command shows
+    them all; str(err) is one line each. As a ConfigError it is the first of them."""
+
+    def __init__(self, errors: list[ConfigError]):
+        first = errors[0]
+        super().__init__(first.path, first.line, first.col, first.message)
+        self.errors = list(errors)
+
+    def __str__(self) -> str:
+        return "\n".join(str(e) for e in self.errors)
+
+
 class FolderClash(ValueError):
     """A folder named on the command line is the project folder, holds it, or meets one of the
     project's folders (`Config.apart`): str(err) is the message for the user."""
@@ -239,16 +252,24 @@ def _config(root: Path, pyproject: Path | None, table: dict) -> Config:
     if pyproject is None:
         return config
     source = f"{pyproject} [{TABLE}]"
+    refused: list[ConfigError] = []  # every refusal of the table, all told at once
 
     def fail(key: str, message: str):
         return ConfigError(str(pyproject), _line(pyproject, key.split(".")[-1]), 1, message)
+
+    def setting(name: str, check, *args) -> None:
+        """settings[name] = check(*args) from the table, or its refusal kept."""
+        try:
+            config.settings[name] = Setting(check(*args), source)
+        except ConfigError as err:
+            refused.append(err)
 
     def known(keys, given: dict, where: str) -> None:
         for k in given:
             if k not in keys:
                 near = difflib.get_close_matches(k, keys, n=1)
                 hint = f"; did you mean '{near[0]}'?" if near else f"; expected {', '.join(keys)}"
-                raise fail(k, f"[{where}] has no setting '{k}'{hint}")
+                refused.append(fail(k, f"[{where}] has no setting '{k}'{hint}"))
 
     def whole(key: str, value, lo: int = 1, hi: int | None = None) -> int:
         if isinstance(value, bool) or not isinstance(value, int) or value < lo:
@@ -257,33 +278,40 @@ def _config(root: Path, pyproject: Path | None, table: dict) -> Config:
             raise fail(key, f"{key} must be at most {hi}, not {_brief(value)}")
         return value
 
+    def choice(key: str, name: str, value, choices) -> str:
+        if value not in choices:
+            raise fail(key, f"{name} must be one of {' | '.join(choices)}, not {_brief(value)}")
+        return value
+
     known(TOP_KEYS, table, TABLE)
     for key in FOLDER_KEYS:
         if key in table:
-            config.settings[key] = Setting(_folder(table[key], key, root, fail), source)
-    _apart(config, table, fail)
+            setting(key, _folder, table[key], key, root, fail)
+    if not refused:  # the folders are apart only once each is a folder of the project
+        refused += _apart(config, table, fail)
     if "threads" in table:
-        config.settings["threads"] = Setting(whole("threads", table["threads"]), source)
+        setting("threads", whole, "threads", table["threads"])
     if "jit" in table:
-        if table["jit"] not in JIT_CHOICES:
-            raise fail("jit", f"jit must be one of {' | '.join(JIT_CHOICES)}, not {table['jit']!r}")
-        config.settings["jit"] = Setting(table["jit"], source)
+        setting("jit", choice, "jit", "jit", table["jit"], JIT_CHOICES)
     for section, keys in (("limits", LIMIT_KEYS), ("model", MODEL_KEYS)):
         given = table.get(section, {})
         if not isinstance(given, dict):
-            raise fail(section, f"[{TABLE}.{section}] must be a table")
+            refused.append(fail(section, f"[{TABLE}.{section}] must be a table"))
+            continue
         known(keys, given, f"{TABLE}.{section}")
         for k, v in given.items():
             name = f"{section}.{k}"
+            if k not in keys:
+                continue
             if section == "model" and k in _model_bounds():  # a scenario file's own bounds
-                v = whole(name, v, *_model_bounds()[k])
+                setting(name, whole, name, v, *_model_bounds()[k])
             elif k in MODEL_CHOICES:
-                if v not in MODEL_CHOICES[k]:
-                    choices = " | ".join(MODEL_CHOICES[k])
-                    raise fail(k, f"{name} must be one of {choices}, not {_brief(v)}")
+                setting(name, choice, k, name, v, MODEL_CHOICES[k])
             else:
-                v = whole(name, v)
-            config.settings[name] = Setting(v, source)
+                setting(name, whole, name, v)
+    if refused:
+        refused.sort(key=lambda e: (e.line, e.col))
+        raise refused[0] if len(refused) == 1 else ConfigErrors(refused)
     return config
 
 
@@ -315,20 +343,24 @@ def _folder(value, key: str, root: Path, fail) -> str:
     return value
 
 
-def _apart(config: Config, table: dict, fail) -> None:
-    """Refuse a folder of the table that is the project folder or meets another (the same folder,
-    or one inside the other), at the line of the setting the table gives (the later one when it
-    gives both)."""
+def _apart(config: Config, table: dict, fail) -> list:
+    """The refusals (ConfigErrors) of each folder of the table that is the project folder or
+    meets another (the same folder, or one inside the other), at the line of the setting the
+    table gives (the later one when it gives both)."""
+    refused = []
     given = [k for k in table if k in FOLDER_KEYS]  # in the file's order
     for i, key in enumerate(given):
         others = {k: config.folder(k) for k in FOLDER_KEYS if k not in table or k in given[:i]}
         why = _clash(config.folder(key), config.root, others)
         if why is not None:
-            raise fail(
-                key,
-                f"{key} = {_brief(table[key])} {why}; scenarios, goldens, report and out each "
-                "need a folder of their own inside the project",
+            refused.append(
+                fail(
+                    key,
+                    f"{key} = {_brief(table[key])} {why}; scenarios, goldens, report and out each "
+                    "need a folder of their own inside the project",
+                )
             )
+    return refused
 
 
 def _clash(path: Path, root: Path, others: dict) -> str | None:

@@ -33,9 +33,9 @@ def cluster_runs(args, scenarios, run, usage):
         raise usage(str(exc)) from None
     got: dict[int, tuple] = {}
     items = [scn for _path, scn in scenarios]
+    progress = cluster.progress_for(len(items), "check", args.quiet)  # from the start
     try:
         with cluster.connect(workers, scheduler) as client:
-            progress = cluster.progress_for(len(items), "check", args.quiet)
             complete = cluster.run_all(
                 client,
                 run,
@@ -46,6 +46,9 @@ def cluster_runs(args, scenarios, run, usage):
             )
     except cluster.SchedulerUnreachable as exc:
         raise usage(str(exc)) from None
+    finally:
+        if progress is not None:
+            progress.close()
     if not complete:
         raise KeyboardInterrupt
     return [_outcome(*got[i]) for i in range(len(items))]

@@ -136,16 +136,21 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         paths, axes, seeds, limits = matrix_from_args(args)
         folder.check_replaceable(out_root)
         runs = plan.check(paths, axes, seeds, limits, progress=checking)
-        with (
-            cluster.connect(args.workers, args.scheduler) as client,
-            folder.staged(out_root) as stage,
-        ):
-            if not args.quiet:
-                where = args.scheduler or f"{args.workers or os.cpu_count()} local workers"
-                print(f"sweep: {len(runs)} runs on {where}", file=sys.stderr, flush=True)
-            progress = cluster.progress_for(len(runs), "sweep", args.quiet)
-            table, complete = driver.run_sweep(client, runs, progress=progress)
-            written = results.write(stage, table, complete)
+        if not args.quiet:
+            where = args.scheduler or f"{args.workers or os.cpu_count()} local workers"
+            print(f"sweep: {len(runs)} runs on {where}", file=sys.stderr, flush=True)
+        # the bar from the start: starting the cluster and compiling the kernels take a while
+        progress = cluster.progress_for(len(runs), "sweep", args.quiet)
+        try:
+            with (
+                cluster.connect(args.workers, args.scheduler) as client,
+                folder.staged(out_root) as stage,
+            ):
+                table, complete = driver.run_sweep(client, runs, progress=progress)
+                written = results.write(stage, table, complete)
+        finally:
+            if progress is not None:
+                progress.close()
     except (
         cluster.DaskMissing,
         cluster.SchedulerUnreachable,

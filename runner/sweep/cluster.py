@@ -10,7 +10,9 @@ submits `fn(item)` for every item, a window of tasks at a time, and hands each r
 exception it raised) to `on_result(i, value, error)` as runs finish, in any order. A task whose
 worker dies is run again elsewhere by the scheduler (up to its `allowed-failures`), so every item
 gets one result; on Ctrl-C (SIGINT, answered inside `connect` even by a process started with it
-ignored) the tasks still pending are cancelled and `run_all` returns False.
+ignored) the tasks still pending are cancelled and `run_all` returns False. A worker that starts
+compiling kernels says so (an event on COMPILING_TOPIC), and this process gives the compile notice
+then (runner.compiling.told), as a run on its own gives it.
 
 Dask is the optional `dask` extra: `require_dask` raises `DaskMissing` with the install command.
 """
@@ -34,6 +36,7 @@ INSTALL = 'pip install "collide2d[dask]"'
 # keep the command waiting (Dask's own default is 30 s).
 CONNECT_TIMEOUT_S = 3
 MESSAGES_KEPT = 16  # messages a connection keeps for debugging (see `connect`)
+COMPILING_TOPIC = "collide2d-compiling"  # a worker's event: it started compiling kernels
 SCHEMES = ("tcp", "tls", "ws", "wss", "ucx")  # Dask's network protocols
 _ADDRESS = re.compile(
     r"(?:(?P<scheme>[a-z]+)://)?"
@@ -146,10 +149,36 @@ def _joined(Client, scheduler: str):
 
 def progress_for(total: int, label: str, quiet: bool) -> Progress | None:
     """A progress bar of runs (done/total, rate and time left) on stderr when it is a terminal and
-    not quiet, else None."""
+    not quiet, else None; drawn at once, its clock running while the first runs compile."""
     if quiet or not sys.stderr.isatty():
         return None
-    return Progress(total, label, unit=" runs")
+    return Progress(total, label, unit=" runs", waiting=True)
+
+
+def _tell_compiling() -> None:
+    """Send COMPILING_TOPIC's event from the worker compiling (nothing outside a task: a cluster
+    in this very process, whose first compilation may come on another thread)."""
+    from distributed import get_worker
+
+    try:
+        worker = get_worker()
+    except ValueError:
+        return
+    worker.log_event(COMPILING_TOPIC, "compiling")
+
+
+def _telling(fn, item):
+    """fn(item) in a worker, which says when it starts compiling kernels (COMPILING_TOPIC)."""
+    from collide2d.runner import compiling
+
+    compiling.relay(_tell_compiling)
+    return fn(item)
+
+
+def _heard(_event) -> None:
+    from collide2d.runner import compiling
+
+    compiling.told()
 
 
 def run_all(
@@ -169,13 +198,14 @@ def run_all(
 
     def send() -> bool:
         for i, item in source:
-            future = client.submit(fn, item, key=f"{label}-{token}-{i}", pure=False)
+            future = client.submit(_telling, fn, item, key=f"{label}-{token}-{i}", pure=False)
             pending[future.key] = (i, size(item) if size is not None else 1, future)
             finished.add(future)
             return True
         return False
 
     done = 0
+    client.subscribe_topic(COMPILING_TOPIC, _heard)
     try:
         while send() and (window is None or len(pending) < window):
             pass
@@ -193,9 +223,9 @@ def run_all(
             send()
     except KeyboardInterrupt:
         client.cancel([f for _i, _n, f in pending.values()])
+        return False
+    finally:
+        client.unsubscribe_topic(COMPILING_TOPIC)
         if progress is not None:
             progress.close()
-        return False
-    if progress is not None:
-        progress.close()
     return True

@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 
 import pytest
+import yaml
 
 from collide2d.runner.command import newproject as init_module
 from collide2d.runner.command import settings as config
@@ -40,16 +41,29 @@ def test_init_makes_a_project_and_prints_the_next_three_commands(tmp_path, capsy
     root = tmp_path / "p"
     example = root / "scenarios" / "example.yaml"
     scenario = load(example)
-    assert scenario.name == "example" and scenario.model == "paper"
+    assert scenario.name == "example"
+    # a model that collides each shape as itself: the example's ball collides as a circle
+    assert (scenario.model, scenario.geometry) == ("stepped", "exact")
+    assert any(o.get("shape") == "circle" for o in yaml.safe_load(example.read_text())["objects"])
     text = example.read_text()
     for section in ("version", "name", "description", "world", "model", "ticks", "objects",
                     "generate", "output", "golden"):  # fmt: skip
         assert f"\n{section}:" in "\n" + text, section
     assert text.count("#") >= 10  # commented
     assert config.find(root).file == (root / "pyproject.toml").resolve()
-    assert (root / ".gitignore").read_text() == "out/\n"
+    assert (root / ".gitignore").read_text() == "out/\nreport/\n"  # run's and check's folders
     commands = [line.split("#")[0].strip() for line in out.splitlines()[-3:]]
     assert commands == ["collide2d run scenarios/example.yaml", "pytest --update-goldens", "pytest"]
+
+
+def test_init_adds_to_a_gitignore_only_the_folders_it_does_not_ignore(tmp_path, capsys):
+    (tmp_path / ".gitignore").write_text("out\n")
+    assert main(["init", str(tmp_path)]) == 0
+    assert (tmp_path / ".gitignore").read_text() == "out\nreport/\n"
+    (tmp_path / ".gitignore").write_text("/report/\nout/\n")
+    assert main(["init", str(tmp_path)]) == 0
+    assert (tmp_path / ".gitignore").read_text() == "/report/\nout/\n"
+    assert "(it ignores out/ and report/)" in capsys.readouterr().out
 
 
 def test_init_extends_what_is_there_and_overwrites_nothing(tmp_path, capsys):
@@ -61,7 +75,7 @@ def test_init_extends_what_is_there_and_overwrites_nothing(tmp_path, capsys):
     assert (tmp_path / "scenarios" / "example.yaml").read_text() == "version: 1\n"
     assert (tmp_path / "pyproject.toml").read_text().startswith('[project]\nname = "mine"\n\n')
     assert config.has_table(tmp_path / "pyproject.toml")
-    assert (tmp_path / ".gitignore").read_text() == "*.pyc\nout/\n"
+    assert (tmp_path / ".gitignore").read_text() == "*.pyc\nout/\nreport/\n"
     before = {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()}
     assert main(["init", str(tmp_path)]) == 0  # again: everything kept
     assert {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()} == before
@@ -301,7 +315,7 @@ def test_init_extends_a_gitignore_in_its_own_bytes_and_line_ends(tmp_path, capsy
     old = b"# caf\xe9\r\n*.pyc"
     (tmp_path / ".gitignore").write_bytes(old)
     assert main(["init", str(tmp_path)]) == 0
-    assert (tmp_path / ".gitignore").read_bytes() == old + b"\r\nout/\r\n"
+    assert (tmp_path / ".gitignore").read_bytes() == old + b"\r\nout/\r\nreport/\r\n"
     utf16 = tmp_path / "u"
     utf16.mkdir()
     (utf16 / ".gitignore").write_bytes("*.pyc\n".encode("utf-16"))

@@ -113,7 +113,6 @@ def test_limits_from_args():
 @pytest.mark.parametrize(
     "argv",
     [
-        ["validate"],
         ["validate", GOOD, "--max-objects", "0"],
         ["validate", GOOD, "--max-ticks", "many"],
         ["validate", GOOD, "--model", "fast"],
