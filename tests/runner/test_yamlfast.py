@@ -112,6 +112,18 @@ def test_the_lane_gives_the_scenario_of_the_general_path(small_lane, model, seed
     assert small_lane == [40]  # the lane took the list
 
 
+def reads_as_general(source: str) -> None:
+    """`source` gives the Scenario of the general path, or is refused in its very words."""
+    try:
+        expected = general(source)
+    except ScenarioError as err:
+        with pytest.raises(ScenarioError) as info:
+            loads(source)
+        assert str(info.value) == str(err)
+    else:
+        same(loads(source), expected)
+
+
 def at(k, old, new):
     """A change of line k of the list."""
     return lambda ls: ls[:k] + [ls[k].replace(old, new)] + ls[k + 1 :]
@@ -141,14 +153,7 @@ def at(k, old, new):
 )
 def test_what_the_lane_declines_the_general_path_reads_or_refuses(small_lane, change):
     source = text(change(lines(3)))
-    try:
-        expected = general(source)
-    except ScenarioError as err:
-        with pytest.raises(ScenarioError) as info:
-            loads(source)
-        assert str(info.value) == str(err)
-    else:
-        same(loads(source), expected)
+    reads_as_general(source)
     assert small_lane == []  # declined (or found at fault) before the lane gave any objects
 
 
@@ -228,14 +233,7 @@ def test_a_list_of_one_form_gives_the_scenario_of_the_general_path(small_lane, k
 )
 def test_one_form_with_a_line_apart_reads_as_the_general_path(small_lane, change):
     source = text(change(one_form(2)))
-    try:
-        expected = general(source)
-    except ScenarioError as err:
-        with pytest.raises(ScenarioError) as info:
-            loads(source)
-        assert str(info.value) == str(err)
-    else:
-        same(loads(source), expected)
+    reads_as_general(source)
 
 
 def block(items: list[str], indent: int = 2, pairs: str = "lines") -> list[str]:
@@ -305,14 +303,7 @@ def block_at(k, old, new):
 def test_what_the_block_lane_declines_the_general_path_reads_or_refuses(small_lane, change):
     items = block(lines(3), 2, "lines")
     source = text(change(items))
-    try:
-        expected = general(source)
-    except ScenarioError as err:
-        with pytest.raises(ScenarioError) as info:
-            loads(source)
-        assert str(info.value) == str(err)
-    else:
-        same(loads(source), expected)
+    reads_as_general(source)
     assert small_lane == []  # declined (or found at fault) before the lane gave any objects
 
 
