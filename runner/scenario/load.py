@@ -560,11 +560,13 @@ class _Reader(Nodes):
         ticks = 0
         if "ticks" in top:
             node = top["ticks"][1]
-            ticks = self.integer(node, "ticks", lo=0)
-            if ticks > limit and not overridden:
-                raise self.error(
-                    node, f"ticks {ticks} is past the limit of {limit} ticks; {raise_it}"
-                )
+            ticks = self.integer(
+                node,
+                "ticks",
+                lo=0,
+                hi=None if overridden else limit,
+                past=lambda shown: f"ticks {shown} is past the limit of {limit} ticks; {raise_it}",
+            )
         else:
             node = top["duration"][1] if "duration" in top else None
             seconds = DEFAULT_DURATION

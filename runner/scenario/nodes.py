@@ -201,11 +201,12 @@ class Nodes:
             raise self.error(node, f"{what} must be at most {fmt(hi)}{unit}, not {fmt(v)}")
         return v
 
-    def integer(self, node, what: str, *, lo=None, hi=None, of="", unit="") -> int:
+    def integer(self, node, what: str, *, lo=None, hi=None, of="", unit="", past=None) -> int:
         """A whole number (a float with no fraction counts) in [lo, hi]; hi is MAX_INTEGER unless
         given, and a given lo is at least -MAX_INTEGER.
 
-        `of` completes "a whole number" in messages (" of pixels"), `unit` follows the bounds.
+        `of` completes "a whole number" in messages (" of pixels"), `unit` follows the bounds;
+        `past(shown)`, when given, says why a number above hi is refused (a limit and its option).
         """
         v = self.scalar(node, what)
         if isinstance(v, float) and math.isfinite(v) and v.is_integer():
@@ -218,7 +219,8 @@ class Nodes:
         if v < lo:
             raise self.error(node, f"{what} must be at least {lo}{unit}, not {shown}")
         if v > hi:
-            raise self.error(node, f"{what} must be at most {hi}{unit}, not {shown}")
+            said = f"{what} must be at most {hi}{unit}, not {shown}"
+            raise self.error(node, past(shown) if past is not None else said)
         return v
 
     def color(self, node, what: str) -> tuple[int, int, int]:

@@ -132,6 +132,8 @@ def test_billion_laughs_is_refused_in_well_under_a_second_with_little_memory(cap
             "area is more than the world's",
         ),
         ("ticks: 1000000000000", [], "past the limit of 1000000000 ticks"),
+        # past int64 too: the limit a user can raise is named, not the largest integer
+        ("ticks: 99999999999999999999999", [], "past the limit of 1000000000 ticks; raise it"),
         (
             "ticks: 100000000\noutput: {frames: {every: 1}}",
             [],
