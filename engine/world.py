@@ -22,11 +22,21 @@ KIND_NAMES = ("box", "circle", "polygon")
 
 @dataclass(frozen=True)
 class WorldSpec:
-    """The world rectangle in pixels (x right, y down) and the ticks per simulated second."""
+    """The world rectangle in pixels (x right, y down), the ticks per simulated second, and the
+    physics of docs/scenario-format.md#gravity: gravity (px/s², y down), the walls' restitution
+    and friction. The defaults (no gravity, elastic frictionless walls) are the elastic world.
+    """
 
     width: int
     height: int
     fps: int
+    gravity: tuple[float, float] = (0.0, 0.0)
+    restitution: float = 1.0
+    friction: float = 0.0
+
+    @property
+    def has_gravity(self) -> bool:
+        return self.gravity[0] != 0.0 or self.gravity[1] != 0.0
 
 
 @dataclass(frozen=True)
@@ -54,6 +64,8 @@ class Bodies:
     vert_start (n+1,) int64    polygon i's vertices are verts[vert_start[i]:vert_start[i+1]]
     verts      (m, 2) int64    polygon vertices relative to the box's top-left corner
     looks      Looks           colour and fill, for drawing only
+    restitution (n,)  float64  e in [0, 1] (default 1: elastic)
+    friction   (n,)   float64  Coulomb's mu >= 0 (default 0: frictionless)
     """
 
     kind: np.ndarray
@@ -65,6 +77,15 @@ class Bodies:
     vert_start: np.ndarray
     verts: np.ndarray
     looks: Looks
+    restitution: np.ndarray | None = None
+    friction: np.ndarray | None = None
+
+    def __post_init__(self):
+        n = self.kind.shape[0]
+        if self.restitution is None:
+            object.__setattr__(self, "restitution", np.ones(n))
+        if self.friction is None:
+            object.__setattr__(self, "friction", np.zeros(n))
 
     @property
     def n(self) -> int:
