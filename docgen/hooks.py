@@ -22,7 +22,8 @@ from docgen import pictures, reference  # noqa: E402
 
 def generated_pages() -> dict[str, str]:
     """Every generated page, by its path in the site's sources."""
-    changelog = (ROOT / "CHANGELOG.md").read_text(encoding="utf-8")
+    # the changelog's links lead into docs/ from the repository's top; on the site it sits there
+    changelog = (ROOT / "CHANGELOG.md").read_text(encoding="utf-8").replace("](docs/", "](")
     return {
         "reference/commands.md": reference.commands_page(),
         "reference/schema.md": reference.schema_page(),

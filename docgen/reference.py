@@ -153,7 +153,7 @@ def describe(node: dict) -> str:
         values = node["enum"]
         if len(values) > 12:
             return f"one of {len(values)} names"
-        return " \\| ".join(f"`{v}`" for v in values)
+        return " | ".join(f"`{v}`" for v in values)  # cell() escapes the bars
     for key in ("anyOf", "oneOf"):
         if key in node:
             return " or ".join(describe(n) for n in node[key])
@@ -184,13 +184,13 @@ def describe(node: dict) -> str:
     return f"{text} {', '.join(bounds)}" if bounds else text
 
 
-def _keys_table(node: dict) -> list[str]:
+def _keys_table(node: dict, top: bool = False) -> list[str]:
     required = set(node.get("required", ()))
     rows = ["| key | required | value | description |", "| --- | --- | --- | --- |"]
     for key, sub in node.get("properties", {}).items():
         value = describe(sub)
-        if sub.get("type") == "object" and "properties" in sub:
-            value = f"mapping: [{key}](#{key})"
+        if top and sub.get("type") == "object" and "properties" in sub:
+            value = f"mapping: [{key}](#{key})"  # a section of its own below
         rows.append(
             f"| `{key}` | {'yes' if key in required else ''} | {cell(value)} "
             f"| {cell(sub.get('description', ''))} |"
@@ -198,13 +198,14 @@ def _keys_table(node: dict) -> list[str]:
     return rows
 
 
-def _section(title: str, node: dict) -> list[str]:
+def _section(title: str, node: dict, top: bool = False) -> list[str]:
     out = [f"## {title}", ""]
     if node.get("description"):
-        out += [node["description"][0].upper() + node["description"][1:] + ".", ""]
+        text = node["description"].rstrip(".")
+        out += [text[:1].upper() + text[1:] + ".", ""]
     variants = node.get("oneOf") or node.get("anyOf")
     if "properties" in node:
-        out += [*_keys_table(node), ""]
+        out += [*_keys_table(node, top), ""]
         if node.get("additionalProperties") is False:
             out += ["Any other key is refused.", ""]
     elif variants and any("properties" in v for v in variants):
@@ -237,10 +238,8 @@ def schema_page() -> str:
         " model's velocities, frames up to `ticks`, convex polygons) only the loader checks:"
         " [Scenario format](../scenario-format.md) gives those rules and the defaults.",
         "",
-        f"{schema['description']}",
-        "",
     ]
-    out += _section("Top level", schema)
+    out += _section("Top level", schema, top=True)
     if "not" in schema and "required" in schema["not"]:
         keys = " and ".join(f"`{k}`" for k in schema["not"]["required"])
         out += [f"{keys} exclude each other.", ""]

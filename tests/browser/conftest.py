@@ -5,7 +5,7 @@ never a browser of its own download: `browser_type_launch_args` points Playwrigh
 test here is skipped, saying why, when no such binary exists. `clean_page` is Playwright's `page`
 at a device scale of 1 (a CSS pixel is a screen pixel, so screenshots compare with PNG frames) that
 fails the test on any console error or uncaught exception. With `COLLIDE2D_SCREENSHOTS=DIR` set,
-tests save the README's screenshots into DIR (`COLLIDE2D_SCREENSHOTS=docs pytest tests/browser`).
+tests save the docs' screenshots (docs/report.png, docs/viewer.png) into DIR (`COLLIDE2D_SCREENSHOTS=docs pytest tests/browser`).
 """
 
 from __future__ import annotations
@@ -79,7 +79,7 @@ def shot(locator) -> np.ndarray:
 
 
 def save_screenshot(target, name: str, **options) -> None:
-    """Save a README screenshot of a page or locator (`screenshot(**options)`) when
+    """Save a docs screenshot of a page or locator (`screenshot(**options)`) when
     COLLIDE2D_SCREENSHOTS names a folder; a small PNG of at most 64 colours."""
     folder = os.environ.get("COLLIDE2D_SCREENSHOTS")
     if not folder:

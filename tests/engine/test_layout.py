@@ -1,6 +1,6 @@
 """The engine's layout: each model is a package holding what only it uses, the modules at the top
-of engine/ are shared, and the imports between them run one way (docs/architecture.md, README
-"Design").
+of engine/ are shared, and the imports between them run one way (docs/architecture.md,
+docs/explanation/design.md).
 
 Imports are read from the sources (every import statement, those inside functions included), so
 these tests load no kernel.

@@ -1,7 +1,7 @@
 """The runner's layout: a package or module per concern, each package saying in its docstring what
 it is for and what it may import, the imports keeping to that and running one way, small modules in
 small folders, and no two names told apart only by a suffix across concerns (docs/architecture.md,
-README "Design").
+docs/explanation/design.md).
 
 Imports are read from the sources (every import statement, those inside functions included), so
 these tests load no module of the project.
