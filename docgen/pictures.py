@@ -87,11 +87,9 @@ def strip(rows: list[list[Image.Image]], scale: int) -> Image.Image:
     """Rows of equal-sized images, enlarged `scale` times (nearest neighbour), GAP apart."""
     cell_w, cell_h = rows[0][0].size
     cols = max(len(r) for r in rows)
-    sheet = Image.new(
-        "RGB",
-        (cols * cell_w * scale + (cols - 1) * GAP, len(rows) * cell_h * scale + (len(rows) - 1) * GAP),
-        GREY,
-    )
+    width = cols * cell_w * scale + (cols - 1) * GAP
+    height = len(rows) * cell_h * scale + (len(rows) - 1) * GAP
+    sheet = Image.new("RGB", (width, height), GREY)
     for r, row in enumerate(rows):
         for c, image in enumerate(row):
             big = image.resize((cell_w * scale, cell_h * scale), Image.NEAREST)
@@ -147,7 +145,8 @@ def tutorial_pictures() -> dict[str, bytes]:
         project = Path(tmp)
         collide2d("init", cwd=project)
         collide2d("run", "scenarios/example.yaml", "--scale", "3", "--quiet", cwd=project)
-        pictures["tutorial/example.gif"] = (project / "out" / "example" / "animation.gif").read_bytes()
+        gif = project / "out" / "example" / "animation.gif"
+        pictures["tutorial/example.gif"] = gif.read_bytes()
         collide2d("bless", cwd=project)
         scenario = project / "scenarios" / "example.yaml"
         text = scenario.read_text(encoding="utf-8")

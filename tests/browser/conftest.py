@@ -5,7 +5,8 @@ never a browser of its own download: `browser_type_launch_args` points Playwrigh
 test here is skipped, saying why, when no such binary exists. `clean_page` is Playwright's `page`
 at a device scale of 1 (a CSS pixel is a screen pixel, so screenshots compare with PNG frames) that
 fails the test on any console error or uncaught exception. With `COLLIDE2D_SCREENSHOTS=DIR` set,
-tests save the docs' screenshots (docs/report.png, docs/viewer.png) into DIR (`COLLIDE2D_SCREENSHOTS=docs pytest tests/browser`).
+tests save the docs' screenshots (docs/report.png, docs/viewer.png) into DIR
+(`COLLIDE2D_SCREENSHOTS=docs pytest tests/browser`).
 """
 
 from __future__ import annotations

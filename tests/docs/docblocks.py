@@ -102,7 +102,9 @@ def matches(shown: list[str], printed: list[str]) -> bool:
 def session_env() -> dict:
     """A user's shell: this interpreter's scripts first on PATH, no CI, no pytest of ours."""
     drop = ("CI", "PYTHONPATH", "COLUMNS", "PYTEST_ADDOPTS", "PYTEST_CURRENT_TEST")
-    env = {k: v for k, v in os.environ.items() if k not in drop and not k.startswith("PYTEST_XDIST")}
+    env = {
+        k: v for k, v in os.environ.items() if k not in drop and not k.startswith("PYTEST_XDIST")
+    }
     env["PATH"] = f"{Path(sys.executable).parent}{os.pathsep}{env.get('PATH', '')}"
     env["NO_COLOR"] = "1"
     return env
@@ -151,9 +153,10 @@ def collide2d_lines(block: Block) -> list[str]:
         line = line.strip()
         if line.startswith("$ "):
             line = line[2:]
-        for part in re.split(r"&&|;|\|", line):
+        for part in re.split(r"&&|;|\||>", line):
             words = shlex.split(part, comments=True)
-            while words and re.fullmatch(r"[A-Z_]+=\S*", words[0]):
+            # env assignments, and a YAML list item's `- run:` / `- ` before a job's command
+            while words and re.fullmatch(r"[A-Z_]+=\S*|-|[a-z_]+:", words[0]):
                 words = words[1:]
             if words[:1] == ["collide2d"]:
                 found.append(shlex.join(words[1:]))

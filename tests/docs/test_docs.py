@@ -13,7 +13,6 @@ import io
 import re
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 import yaml
@@ -60,9 +59,15 @@ def test_the_readmes_demo_gif_is_what_the_demo_draws(tmp_path):
     )
     assert proc.returncode == 0, proc.stderr
     made = tmp_path / "paper_fifty_boxes" / "animation.gif"
+
+    def frames(image):
+        return [
+            (f.convert("RGB").tobytes(), f.info.get("duration"))
+            for f in ImageSequence.Iterator(image)
+        ]
+
     with Image.open(ROOT / "docs" / "demo.gif") as shown, Image.open(made) as drawn:
-        a = [(f.convert("RGB").tobytes(), f.info.get("duration")) for f in ImageSequence.Iterator(shown)]
-        b = [(f.convert("RGB").tobytes(), f.info.get("duration")) for f in ImageSequence.Iterator(drawn)]
+        a, b = frames(shown), frames(drawn)
     assert len(a) == len(b) > 1 and a == b, "remake docs/demo.gif: collide2d run, then copy it"
 
 
@@ -84,8 +89,10 @@ def _parse(line: str) -> str | None:
 
 def test_every_collide2d_command_line_shown_is_one_the_parser_takes():
     lines = [(b, line) for b in all_blocks(*SHELLS) for line in collide2d_lines(b)]
-    assert len(lines) > 40
-    refused = [f"{b.where()}: collide2d {line}: {why}" for b, line in lines if (why := _parse(line))]
+    assert len(lines) > 30
+    refused = [
+        f"{b.where()}: collide2d {line}: {why}" for b, line in lines if (why := _parse(line))
+    ]
     assert not refused, "\n".join(refused)
 
 
@@ -111,7 +118,50 @@ def test_every_scenario_shown_loads(tmp_path):
             except Exception as err:  # noqa: BLE001 - the message names the block
                 pytest.fail(f"{block.where()}: {err}")
             shown.append(block)
-    assert len(shown) >= 4
+    assert len(shown) >= 3
+
+
+def test_every_sweep_file_shown_reads_as_a_sweep(tmp_path):
+    from collide2d.runner.sweep import sweepfile
+
+    shown = [b for b in all_blocks("yaml") if re.search(r"^sweep: 1$", b.text, re.M)]
+    assert shown
+    for k, block in enumerate(shown):
+        folder = tmp_path / f"p{k}"
+        (folder / "sweeps").mkdir(parents=True)
+        (folder / "scenarios").mkdir()
+        for scenario in (ROOT / "scenarios").glob("*.yaml"):
+            (folder / "scenarios" / scenario.name).write_bytes(scenario.read_bytes())
+        path = folder / "sweeps" / "shown.yaml"
+        path.write_text(block.text, encoding="utf-8")
+        assert sweepfile.is_sweep_file(str(path)), block.where()
+        paths, axes, seeds = sweepfile.read(str(path))
+        assert paths and axes and seeds, block.where()
+
+
+def test_the_python_shown_runs_and_makes_the_table_it_says(tmp_path, monkeypatch):
+    from collide2d.runner.scenario.load import load
+
+    (block,) = [b for b in blocks(ROOT / "docs" / "how-to" / "tables.md") if b.lang == "python"]
+    monkeypatch.chdir(tmp_path)
+    exec(compile(block.text, block.where(), "exec"), {})
+    (tmp_path / "crowd.yaml").write_text(
+        "version: 1\nworld: {width: 800, height: 800, fps: 30}\nmodel: stepped\nticks: 1\n"
+        "objects: {file: bodies.npy}\n",
+        encoding="utf-8",
+    )
+    assert len(load(str(tmp_path / "crowd.yaml")).names) == 10_000
+    assert not [b for b in all_blocks("python") if b.path.name != "tables.md"]
+
+
+def test_every_wheel_the_docs_name_is_of_this_version():
+    version = re.search(r'^version = "([^"]+)"', (ROOT / "pyproject.toml").read_text(), re.M)[1]
+    named = [
+        (path, found)
+        for path in doc_files()
+        for found in re.findall(r"collide2d-([0-9][^-]*)-py3-none-any\.whl", path.read_text())
+    ]
+    assert named and all(found == version for _path, found in named), named
 
 
 def test_every_yaml_block_is_yaml_and_the_ci_jobs_run_check_with_junit_and_report():
@@ -131,6 +181,7 @@ def test_every_yaml_block_is_yaml_and_the_ci_jobs_run_check_with_junit_and_repor
 SESSION_PAGES = sorted({b.path for b in all_blocks("console")})
 
 
+@pytest.mark.slow  # a minute: the tutorial runs pytest four times
 @pytest.mark.parametrize("page", SESSION_PAGES, ids=lambda p: str(p.relative_to(ROOT)))
 def test_every_console_session_prints_what_its_page_shows(page, tmp_path, monkeypatch):
     monkeypatch.delenv("CI", raising=False)
@@ -180,14 +231,16 @@ def test_the_generated_pages_name_every_command_option_and_scenario_key():
                 yield from keys(sub)
 
     for key in set(keys(schema)):
-        assert f"| `{key}` |" in text, key
+        assert f"`{key}`" in text, key  # a row of its own, or named in its mapping
     from collide2d.runner.command import settings
 
     settings_text = reference.settings_page()
-    for key in (*settings.FOLDER_KEYS, "threads", "jit", *settings.LIMIT_KEYS, *settings.MODEL_KEYS):
+    keys = (*settings.FOLDER_KEYS, "threads", "jit", *settings.LIMIT_KEYS, *settings.MODEL_KEYS)
+    for key in keys:
         assert f"| `{key}` |" in settings_text, key
 
 
+@pytest.mark.slow  # half a minute or more: the build runs the scenarios its pictures show
 @pytest.mark.skipif(
     importlib.util.find_spec("mkdocs") is None
     or importlib.util.find_spec("material") is None
