@@ -268,11 +268,13 @@ def settings_page() -> str:
     from collide2d.runner.scenario.limits import Limits
 
     _parser, commands, _helps = command_parsers()
-    options = {}
-    for sub in commands.values():
+    options = {}  # a setting's dest: the first command that takes it, as `COMMAND --flag`
+    for name, sub in commands.items():
         for action in sub._actions:
-            for flag in action.option_strings:
-                options.setdefault(action.dest, flag)
+            if action.dest in ("scenarios",):  # bench's own folder of scenes, not the setting
+                continue
+            for flag in action.option_strings[:1]:
+                options.setdefault(action.dest, f"{name} {flag}")
     limits = Limits()
     out = [
         GENERATED.format(source="runner/command/settings.py and runner/scenario/limits.py"),

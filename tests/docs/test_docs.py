@@ -11,6 +11,7 @@ import contextlib
 import importlib.util
 import io
 import re
+import shutil
 import subprocess
 import sys
 
@@ -94,6 +95,42 @@ def test_every_collide2d_command_line_shown_is_one_the_parser_takes():
         f"{b.where()}: collide2d {line}: {why}" for b, line in lines if (why := _parse(line))
     ]
     assert not refused, "\n".join(refused)
+
+
+# The commands a test runs, beside parsing them: the quick ones, in a copy of the project's
+# scenarios and goldens (bench, stress, sweep and a check of the whole corpus take minutes, and
+# their sessions are the business of their own tests; `bless` writes goldens).
+RUN_VERBS = ("run", "validate", "schema", "config", "init", "--version")
+
+
+@pytest.mark.slow  # a minute: a run of every quick command the pages show
+def test_every_quick_collide2d_command_shown_runs(tmp_path, monkeypatch):
+    import shlex
+
+    monkeypatch.delenv("CI", raising=False)
+    project = tmp_path / "project"
+    for folder in ("scenarios", "goldens", "sweeps"):
+        shutil.copytree(ROOT / folder, project / folder)
+    lines = {line for b in all_blocks(*SHELLS) for line in collide2d_lines(b)}
+    quick = sorted(
+        line for line in lines
+        if shlex.split(line)[:1] and shlex.split(line)[0] in RUN_VERBS
+        or (line.startswith("check scenarios/") and "--scheduler" not in line)
+    )
+    assert len(quick) >= 15
+    failed = []
+    for line in quick:
+        proc = subprocess.run(
+            [sys.executable, "-m", "collide2d", *shlex.split(line)],
+            cwd=project,
+            capture_output=True,
+            text=True,
+            env=session_env(),
+            timeout=600,
+        )
+        if proc.returncode != 0:
+            failed.append(f"collide2d {line}: exit {proc.returncode}: {proc.stderr.strip()}")
+    assert not failed, "\n".join(failed)
 
 
 def test_every_scenario_shown_loads(tmp_path):
