@@ -219,12 +219,13 @@ SESSION_PAGES = sorted({b.path for b in all_blocks("console")})
 
 
 @pytest.mark.slow  # a minute: the tutorial runs pytest four times
-@pytest.mark.parametrize("page", SESSION_PAGES, ids=lambda p: str(p.relative_to(ROOT)))
-def test_every_console_session_prints_what_its_page_shows(page, tmp_path, monkeypatch):
+# (not `page`: pytest-playwright's fixture of that name would run it once per browser)
+@pytest.mark.parametrize("doc_page", SESSION_PAGES, ids=lambda p: str(p.relative_to(ROOT)))
+def test_every_console_session_prints_what_its_page_shows(doc_page, tmp_path, monkeypatch):
     monkeypatch.delenv("CI", raising=False)
     folder = tmp_path / "work"
     folder.mkdir()
-    run_session([b for b in blocks(page) if b.lang == "console"], folder)
+    run_session([b for b in blocks(doc_page) if b.lang == "console"], folder)
 
 
 def test_the_tutorial_has_sessions_that_fail_and_pass_as_ci_does():
