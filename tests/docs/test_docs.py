@@ -133,7 +133,7 @@ def test_every_quick_collide2d_command_shown_runs(tmp_path, monkeypatch):
     assert not failed, "\n".join(failed)
 
 
-def test_every_scenario_shown_loads(tmp_path):
+def test_every_scenario_shown_loads_and_runs(tmp_path):
     from collide2d.runner.scenario.load import load
 
     shown = []
@@ -154,6 +154,15 @@ def test_every_scenario_shown_loads(tmp_path):
                 load(str(scenario))
             except Exception as err:  # noqa: BLE001 - the message names the block
                 pytest.fail(f"{block.where()}: {err}")
+            proc = subprocess.run(
+                [sys.executable, "-m", "collide2d", "run", scenario, "--out", "out", "--quiet"],
+                cwd=folder,
+                capture_output=True,
+                text=True,
+                env=session_env(),
+            )
+            assert proc.returncode == 0, f"{block.where()}: {proc.stderr}"
+            assert list((folder / "out").glob("*/summary.json")), block.where()
             shown.append(block)
     assert len(shown) >= 3
 
