@@ -10,9 +10,11 @@ objects is written once for lists, blocks, tables and the fast lane alike (sizes
 model's whole numbers and rates, inside the world), and report each object's first fault at its
 node. What differs between models is one `ModelRules` value: under the paper model positions are
 whole pixels, every velocity component of a moving object is a rate the model can take at the
-world's fps (`engine.motion.paper_rate`) and generated velocities are drawn as whole numbers; under
-geometry `exact` a polygon must be convex with some area (`polygon_problem`). Polygon points lie
-within MAX_POINT_OFFSET px of the object's position.
+world's fps (`engine.motion.paper_rate`) and generated velocities are drawn as whole numbers; a
+polygon must be convex under every model, and under geometry `exact` have some area as well
+(`polygon_problem`). Polygon points lie within MAX_POINT_OFFSET px of the object's position. An
+object's `restitution` and `friction` are read here; their bounds and what each model takes of
+them are rules too.
 
 An object's name follows the one rule for names wherever it is written
 (`runner.scenario.rules.object_names`).
@@ -55,6 +57,8 @@ OBJECT_KEYS = (
     "static",
     "fill",
     "name",
+    "restitution",
+    "friction",
 )
 BLOCK_KEYS = (
     "count",
@@ -69,6 +73,8 @@ BLOCK_KEYS = (
     "fill",
     "static",
     "name",
+    "restitution",
+    "friction",
 )
 RANGE_KEYS = ("min", "max")
 
@@ -80,8 +86,11 @@ class ModelRules:
     # positions are whole pixels and a moving object's velocity is a paper rate at the fps (paper)
     paper_rates: bool = False
     whole_velocities: bool = False  # generated velocities are whole numbers (paper)
-    convex_polygons: bool = False  # polygons are convex with some area (geometry exact)
+    polygon_area: bool = False  # polygons have some area (geometry exact)
     origin: str | None = None  # "--model M" when the model came from the command line
+    # restitution 1 and friction 0 only (the exact model, elastic and frictionless for now); the
+    # paper model takes neither (paper_rates)
+    elastic: bool = False
 
     @classmethod
     def of(cls, model: str, geometry: str, origin: str | None = None) -> ModelRules:
@@ -89,26 +98,28 @@ class ModelRules:
         return cls(
             paper_rates=paper,
             whole_velocities=paper,
-            convex_polygons=geometry == "exact",
+            polygon_area=geometry == "exact",
             origin=origin,
+            elastic=model == "exact",
         )
 
 
 _NO_MODEL = ModelRules()  # the model was refused: its rules wait
 
 
-def polygon_problem(points: np.ndarray) -> str | None:
+def polygon_problem(points: np.ndarray, area: bool = True) -> str | None:
     """Why the closed polygon `points` (k, 2) int is not convex, or None when it is.
 
-    Consecutive repeated points and collinear points are allowed; zero area, a turn back along the
-    same line, turns both ways and winding around more than once are not.
+    Consecutive repeated points and collinear points are allowed; zero area (unless `area` is
+    False: points on one line, drawn as a line), a turn back along the same line, turns both ways
+    and winding around more than once are not.
     """
     p = np.asarray(points, np.int64)
     keep = np.any(p != np.roll(p, 1, axis=0), axis=1)
     p = p[keep] if keep.any() else p[:1]
     d = p - p[0]
     if not np.any(d[:, 0] * np.roll(d[:, 1], -1) - np.roll(d[:, 0], -1) * d[:, 1]):
-        return "it has zero area (its points lie on one line)"
+        return "it has zero area (its points lie on one line)" if area else None
     area2 = int(np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1]))
     if area2 == 0:
         return "it is not convex: it crosses itself"
@@ -146,6 +157,7 @@ class Listed:
     node: object
     written: tuple[float, float]  # the position as written (a polygon's box starts elsewhere)
     at: dict  # {(field, axis): (node, what)} of each value a rule may refuse (rules.Fault)
+    contact: tuple[float, float] = (math.nan, math.nan)  # restitution, friction (NaN: not given)
 
     @property
     def line(self) -> int:
@@ -167,6 +179,7 @@ class Block:
     node: object
     at: dict  # {(field, axis): (node, what)}, as Listed.at
     index: int = 0
+    contact: tuple[float, float] = (math.nan, math.nan)  # restitution, friction (NaN: not given)
 
     @property
     def line(self) -> int:
@@ -189,6 +202,8 @@ def _columns(items, pos, vel) -> rule.Columns:
         vel=np.asarray(vel, np.float64).reshape(n, 2),
         mass=np.array([o.mass if ("mass", 0) in o.at else np.nan for o in items], np.float64),
         static=np.array([o.static for o in items], bool).reshape(n),
+        restitution=np.array([o.contact[0] for o in items], np.float64).reshape(n),
+        friction=np.array([o.contact[1] for o in items], np.float64).reshape(n),
     )
 
 
@@ -243,6 +258,18 @@ class ObjectReader(Nodes):
         if wanted not in m:
             raise self.error(node, f"{what} ({shape}) is missing '{wanted}'")
         return shape
+
+    def contact(self, m: dict, what: str, at: dict) -> tuple[float, float]:
+        """(restitution, friction) of an object or a block as written, NaN where not given: their
+        bounds and what the model takes of them are rules (runner.scenario.rules)."""
+        out = []
+        for key in ("restitution", "friction"):
+            v = math.nan
+            if key in m:
+                v = float(self.number(m[key][1], f"{what}.{key}")) + 0.0
+                at[(key, 0)] = (m[key][1], f"{what}.{key}")
+            out.append(v)
+        return out[0], out[1]
 
     def common(self, m: dict, what: str, at: dict):
         """color, mass, static, fill, name of an object or a block."""
@@ -332,7 +359,7 @@ class ObjectReader(Nodes):
         kind = _KIND_OF_SHAPE[shape]
         return Listed(
             i, kind, pos, size, vel, mass, static, color, color_node, fill, verts, name, node,
-            written, at,
+            written, at, self.contact(m, what, at),
         )  # fmt: skip
 
     # -- the rules, once the world and the model are known
@@ -354,23 +381,22 @@ class ObjectReader(Nodes):
         refused = set()
         for row, o in enumerate(listed):
             problem = None
-            if model.convex_polygons and o.verts is not None:
-                problem = polygon_problem(o.verts)
+            if o.verts is not None:
+                problem = polygon_problem(o.verts, model.polygon_area)
             if problem is not None:
                 refused.add(row)
                 node, what = o.at[("size", 0)]
-                self.attempt(
-                    _raise,
-                    self.error(
-                        node,
+                said = f"{what}: a polygon must be convex, but {problem}"
+                if model.polygon_area:
+                    said = (
                         f"{self.prefix(model.origin)}{what}: under geometry 'exact' a polygon "
-                        f"must be convex with some area, but {problem}",
-                    ),
-                )
+                        f"must be convex with some area, but {problem}"
+                    )
+                self.attempt(_raise, self.error(node, said))
         cols = _columns(listed, [o.written for o in listed], [o.vel for o in listed])
         cols.corner = np.array([o.pos for o in listed], np.float64).reshape(-1, 2)
         fps, bounds = (world.fps, (world.width, world.height)) if world else (None, None)
-        found = rule.faults(cols, model.paper_rates, fps, bounds)
+        found = rule.faults(cols, model.paper_rates, fps, bounds, model.elastic)
         for f in rule.first_per_row(found):
             if f.row not in refused:
                 self.attempt(_raise, self.fault(listed, f, model, fps_from, "objects"))
@@ -450,7 +476,8 @@ class ObjectReader(Nodes):
             velocity_range=velocity_range,
         )
         kind = _KIND_OF_SHAPE[shape]
-        return Block(spec, kind, mass, static, color, color_node, fill, name, node, at, k)
+        contact = self.contact(m, what, at)
+        return Block(spec, kind, mass, static, color, color_node, fill, name, node, at, k, contact)
 
     def velocity_range(self, vnode, what: str, at: dict):
         """((vx0, vy0), (vx1, vy1)) of `velocity: {min: [vx, vy], max: [vx, vy]}`."""
@@ -501,7 +528,7 @@ class ObjectReader(Nodes):
             b.spec = dataclasses.replace(b.spec, whole=model.whole_velocities)
         speed = [(b.spec.speed or 0.0,) * 2 for b in blocks]
         cols = _columns(blocks, np.zeros((len(blocks), 2)), speed)
-        found = rule.first_per_row(rule.faults(cols, model.paper_rates, fps))
+        found = rule.first_per_row(rule.faults(cols, model.paper_rates, fps, None, model.elastic))
         refused = {f.row for f in found}
         for f in found:
             self.attempt(_raise, self.fault(blocks, f, model, fps_from, "generate"))

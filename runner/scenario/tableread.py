@@ -37,9 +37,12 @@ from collide2d.runner.scenario.limits import Limits
 from collide2d.runner.scenario.parse import ScenarioError
 from collide2d.runner.scenario.rules import MAX_OBJECT_NAME_CHARS
 
-COLUMNS = ("id", "shape", "w", "h", "x", "y", "vx", "vy", "mass", "color", "name", "static", "fill")
+COLUMNS = (
+    "id", "shape", "w", "h", "x", "y", "vx", "vy", "mass", "color", "name", "static", "fill",
+    "restitution", "friction",
+)  # fmt: skip
 REQUIRED = ("id", "shape", "w", "h", "x", "y")
-NUMBERS = ("id", "w", "h", "x", "y", "vx", "vy")
+NUMBERS = ("id", "w", "h", "x", "y", "vx", "vy", "restitution", "friction")
 # Longest text a cell may hold, per text column (characters, as written); wider columns would cost
 # memory for every row. A name's bound is the one every object name has (runner.scenario.rules).
 TEXT_CHARS = {
@@ -96,7 +99,8 @@ def header_error(shown: str, header: list[str]) -> None:
             1,
             1,
             f"the table lacks the column(s) {', '.join(missing)} (header: id, shape, "
-            "w, h, x, y and optionally vx, vy, mass, color, name, static, fill)",
+            "w, h, x, y and optionally vx, vy, mass, color, name, static, fill, restitution, "
+            "friction)",
         )
 
 
