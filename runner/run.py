@@ -161,7 +161,7 @@ def _drive(
                 )
                 raise RunStopped(
                     f"{scenario.path or scenario.name}: error: the {scenario.model} model stopped "
-                    f"the run in {when}: {exc}"
+                    f"the run in {when}: {exc}{_names_of(exc, scenario.names)}"
                 ) from None
             if log_events and len(events) and on_events is not None:
                 on_events(events)
@@ -215,6 +215,13 @@ def make_model(scenario: Scenario):
         sleep_after=scenario.sleep_after,
     )
     return models.make(scenario.model, scenario.world, scenario.bodies, **options)
+
+
+def _names_of(exc: Runaway, names) -> str:
+    """The names of the objects a runaway names by id (engine.errors.NoRoom.objects), for its
+    message: " (object 3 is ball, object 4 is cup)"; "" when none of them has a name."""
+    named = [f"object {i} is {names[i]}" for i in getattr(exc, "objects", ()) if names[i]]
+    return f" ({', '.join(named)})" if named else ""
 
 
 def _drawn(renderer, model, k: int, overlay) -> np.ndarray:

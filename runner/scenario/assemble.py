@@ -81,7 +81,8 @@ def bodies(
         raise reader.error(
             blocks[0].node,
             f"generate places objects around the listed objects' boxes, which must not overlap "
-            f"here: objects[{pair[1]}] and objects[{pair[0]}] (shapes that only touch are legal "
+            f"here: {_who(listed, pair[1])} and {_who(listed, pair[0])} (shapes that only touch "
+            "are legal "
             "without generate)",
         )
     try:
@@ -226,6 +227,12 @@ def check_names(reader: Nodes, names, listed, blocks, lines) -> None:
                 reader.path, lines[i], 1, f"a generated object is named {name!r}, {said}"
             )
         seen[name] = i
+
+
+def _who(listed, i: int) -> str:
+    """objects[i], with its name when it has one: `objects[3] (ball)`."""
+    name = None if isinstance(listed, _TableRows) else listed[i].name
+    return f"objects[{i}]" + (f" ({name})" if name else "")
 
 
 class _TableRows:

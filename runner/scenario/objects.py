@@ -1,23 +1,19 @@
 """The `objects` and `generate` sections: each listed object and generate block, read and checked.
 
 `ObjectReader` reads every object field at its place (shape and its size key, position, velocity or
-speed, colour, mass, static, fill, name) whatever the world and the model, and returns `Listed`
-objects and `Block`s, from which `runner.scenario.assemble` builds the arrays; each remembers the
-node of every value a rule may refuse. Once the world and the model are known, `check` and
-`check_blocks` put those values in columns and ask `runner.scenario.rules`, where every rule of
-objects is written once for lists, blocks, tables and the fast lane alike (sizes, masses within
-[MIN_MASS, MAX_MASS], velocity components within [-MAX_SPEED, MAX_SPEED], static objects, the paper
-model's whole numbers and rates, inside the world), and report each object's first fault at its
-node. What differs between models is one `ModelRules` value: under the paper model positions are
-whole pixels, every velocity component of a moving object is a rate the model can take at the
-world's fps (`engine.motion.paper_rate`) and generated velocities are drawn as whole numbers; a
-polygon must be convex under every model, and under geometry `exact` have some area as well
-(`polygon_problem`). Polygon points lie within MAX_POINT_OFFSET px of the object's position. An
-object's `restitution` and `friction` are read here; their bounds and what each model takes of
-them are rules too.
-
-An object's name follows the one rule for names wherever it is written
-(`runner.scenario.rules.object_names`).
+speed, colour, mass, static, fill, name, restitution, friction) whatever the world and the model,
+and returns `Listed` objects and `Block`s, from which `runner.scenario.assemble` builds the arrays;
+each remembers the node of every value a rule may refuse. Once the world and the model are known,
+`check` and `check_blocks` put those values in columns and ask `runner.scenario.rules`, where every
+rule of objects is written once for lists, blocks, tables and the fast lane alike, and report each
+object's first fault at its node. What differs between models is one `ModelRules` value: under the
+paper model positions are whole pixels, every velocity component of a moving object is a rate the
+model can take at the world's fps (`engine.motion.paper_rate`), generated velocities are drawn as
+whole numbers and restitution and friction are refused; the exact model takes only their defaults.
+A polygon must be convex under every model, and have some area under geometry `exact`
+(`polygon_problem`); its points lie within MAX_POINT_OFFSET px of the object's position. An object
+is named in messages by its `name` beside its place (`objects[3] (ball)`), its name following the
+one rule for names wherever it is written (`runner.scenario.rules.object_names`).
 """
 
 from __future__ import annotations
@@ -34,7 +30,7 @@ from collide2d.runner.scenario import generate as gen
 from collide2d.runner.scenario import parse as ys
 from collide2d.runner.scenario import rules as rule
 from collide2d.runner.scenario.limits import Limits
-from collide2d.runner.scenario.nodes import FAILED, Nodes, fmt, is_number
+from collide2d.runner.scenario.nodes import FAILED, Nodes, _raise, fmt, is_number
 from collide2d.runner.scenario.rules import DEFAULT_MASS, NameRefused, object_names
 
 DEFAULT_COLOR = (255, 255, 255)
@@ -305,9 +301,9 @@ class ObjectReader(Nodes):
         return self.each(self.listed, items)
 
     def listed(self, i: int, node) -> Listed:
-        what = f"objects[{i}]"
         at: dict = {}
         m = self.mapping(node, "object", OBJECT_KEYS)
+        what = f"objects[{i}]" + _named(m)
         shape = self.shape_of(m, node, what, SHAPES)
         verts = None
         offset = (0, 0)
@@ -587,12 +583,16 @@ def fault_error(reader: Nodes, items, f: rule.Fault, kind: str, origin=None, fps
     text = f.text
     if f.other is not None:
         a = items[f.other]
-        text = text.format(other=f"{kind}[{a.index}] (line {a.line})")
+        name = f"{a.name}, " if getattr(a, "name", None) else ""
+        text = text.format(other=f"{kind}[{a.index}] ({name}line {a.line})")
         what = f"{what} (line {o.line})"
     origins = (origin if "model" in f.by else None, fps_from if "fps" in f.by else None)
     said = f"{what} {text}" if f.named else text
     return reader.error(node, f"{reader.prefix(*origins)}{said}")
 
 
-def _raise(exc: Exception):
-    raise exc
+def _named(m: dict) -> str:
+    """" (NAME)" of an object mapping whose `name` is plain text, for its messages; else ""."""
+    node = m["name"][1] if "name" in m else None
+    text = ys.value(node) if isinstance(node, yaml.ScalarNode) else None
+    return f" ({text.strip()})" if isinstance(text, str) and text.strip() else ""

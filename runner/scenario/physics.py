@@ -124,9 +124,9 @@ class ModelReader(Nodes):
         """The world's physics keys the model `kind` does not take, each refused at its key: the
         paper model takes none, the exact model only their defaults."""
         said = self.prefix(self.model_from)
-        for key, (knode, vnode) in physics.nodes.items():
+        for key, (_, vnode) in physics.nodes.items():
             if kind == "paper":
-                raise self.error(knode, f"{said}world.{key} {PAPER_REFUSES.format(key=key)}")
+                raise self.error(vnode, f"{said}world.{key} {PAPER_REFUSES.format(key=key)}")
             if kind != "exact":
                 continue
             if key == "gravity" and physics.gravity != (0.0, 0.0):
