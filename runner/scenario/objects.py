@@ -574,18 +574,18 @@ def fault_error(reader: Nodes, items, f: rule.Fault, kind: str, origin=None, fps
     """The ScenarioError of Fault `f` of `items` (listed objects or blocks, `kind` "objects" or
     "generate"), at the node of the value it is about: `--model M: objects[3].size w must be
     ...`; a fault of the whole object (its box) is at the object, and an object it overlaps is
-    named with its line."""
+    named with its line; each by its name too when it has one (`objects[3] (ball, line 7)`)."""
     o = items[f.row]
-    if f.field == "box":
-        node, what = o.node, f"{kind}[{o.index}]"
-    else:
-        node, what = o.at[(f.field, f.axis)]
+
+    def who(x, line=False) -> str:
+        said = [getattr(x, "name", None)] + [f"line {x.line}"] * line
+        return f"{kind}[{x.index}]" + (f" ({', '.join(filter(None, said))})" if any(said) else "")
+
+    box = f.field == "box"
+    node, what = (o.node, who(o, f.other is not None)) if box else o.at[(f.field, f.axis)]
     text = f.text
     if f.other is not None:
-        a = items[f.other]
-        name = f"{a.name}, " if getattr(a, "name", None) else ""
-        text = text.format(other=f"{kind}[{a.index}] ({name}line {a.line})")
-        what = f"{what} (line {o.line})"
+        text = text.format(other=who(items[f.other], True))
     origins = (origin if "model" in f.by else None, fps_from if "fps" in f.by else None)
     said = f"{what} {text}" if f.named else text
     return reader.error(node, f"{reader.prefix(*origins)}{said}")
