@@ -314,3 +314,12 @@ def test_a_model_given_on_the_command_line_drops_the_files_stepped_settings():
     s = loads(scene(model="{kind: stepped, iterations: 3}", world="gravity: 0"),
               overrides={"model": "exact"})  # fmt: skip
     assert s.model == "exact" and s.iterations is None
+
+
+def test_model_exact_on_the_command_line_names_the_option_and_stepped():
+    text = scene(BALL.replace("0.8", "1"), world="gravity: 980")
+    err = refused(text, overrides={"model": "exact"})
+    lines = str(err).splitlines()
+    assert lines[0].startswith("<string>:2:52: error: --model exact: world.gravity must be 0")
+    assert "--model exact: objects[0].friction must be 0 under the exact model" in lines[1]
+    assert all("model: stepped" in line for line in lines)
