@@ -30,7 +30,7 @@ import yaml
 
 from collide2d.engine.models import MAX_EVENTS_PER_TICK, MODEL_NAMES
 from collide2d.engine.shapes import GEOMETRIES
-from collide2d.runner.scenario.nodes import Nodes, fmt
+from collide2d.runner.scenario.nodes import Nodes, _raise
 from collide2d.runner.scenario.rules import EXACT_REFUSES, MAX_FRICTION, MAX_SPEED, PAPER_REFUSES
 
 MAX_SUBSTEPS = 10_000  # substeps per tick of the stepped model
@@ -121,23 +121,23 @@ class ModelReader(Nodes):
         return WorldPhysics(gravity, restitution + 0.0, friction + 0.0, nodes)
 
     def check_world_physics(self, physics: WorldPhysics, kind: str) -> None:
-        """The world's physics keys the model `kind` does not take, each refused at its key: the
-        paper model takes none, the exact model only their defaults."""
+        """The world's physics keys the model `kind` does not take, each refused at its value
+        (all of them, when collecting errors): the paper model takes none, the exact model only
+        their defaults."""
         said = self.prefix(self.model_from)
         for key, (_, vnode) in physics.nodes.items():
+            text = None
             if kind == "paper":
-                raise self.error(vnode, f"{said}world.{key} {PAPER_REFUSES.format(key=key)}")
-            if kind != "exact":
-                continue
-            if key == "gravity" and physics.gravity != (0.0, 0.0):
-                raise self.error(
-                    vnode,
-                    f"{said}world.gravity must be 0 under the exact model, which has no gravity "
-                    "yet; gravity needs model: stepped",
+                text = PAPER_REFUSES.format(key=key)
+            elif kind == "exact" and key == "gravity" and physics.gravity != (0.0, 0.0):
+                text = (
+                    "must be 0 under the exact model, which has no gravity yet; gravity needs "
+                    "model: stepped"
                 )
-            value = getattr(physics, key)
-            if key != "gravity" and value != WORLD_PHYSICS[key]:
-                raise self.error(vnode, f"{said}world.{key} {EXACT_REFUSES[key]}, not {fmt(value)}")
+            elif kind == "exact" and key != "gravity":
+                text = EXACT_REFUSES[key] if getattr(physics, key) != WORLD_PHYSICS[key] else None
+            if text is not None:
+                self.attempt(_raise, self.error(vnode, f"{said}world.{key} {text}"))
 
     def model(self, top: dict) -> ModelSettings:
         """The ModelSettings of `model` and the overrides."""

@@ -323,3 +323,13 @@ def test_model_exact_on_the_command_line_names_the_option_and_stepped():
     assert lines[0].startswith("<string>:2:52: error: --model exact: world.gravity must be 0")
     assert "--model exact: objects[0].friction must be 0 under the exact model" in lines[1]
     assert all("model: stepped" in line for line in lines)
+
+
+def test_every_world_key_the_paper_model_has_not_is_refused_at_once():
+    err = refused(scene(world="gravity: 9.8, restitution: 0.5, friction: 0.1", model="paper"))
+    lines = str(err).splitlines()
+    assert [line.split("error: ")[1].split(" cannot")[0] for line in lines] == [
+        "world.gravity",
+        "world.restitution",
+        "world.friction",
+    ]
