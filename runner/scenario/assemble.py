@@ -263,5 +263,6 @@ def check_table_placement(table, geometry: str = "box") -> None:
     found = rules.first_overlap(table.pos, table.size, shapes)
     if found is not None:
         a = found.other
-        other = f"object {a} (row {a + 1})"
+        named = f"{table.names[a]}, " if table.names[a] else ""
+        other = f"object {a} ({named}row {a + 1})"
         raise table.error(found.row, "x", found.text.format(other=other))

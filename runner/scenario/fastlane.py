@@ -468,7 +468,7 @@ def _flag(word: np.ndarray) -> np.ndarray:
     return word == "true"
 
 
-def _fall_back(row, column, message):
+def _fall_back(row, column, message, name=None):
     """A later check (the exact model's room to move) refused an object of the fast lane: the
     general path reads the file again and refuses it at the object's line, in its own words."""
     raise FallBack

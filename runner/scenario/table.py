@@ -100,8 +100,10 @@ class Table:
         return int(self.kind.shape[0])
 
     def error(self, row: int, column: str, message: str):
-        """The ScenarioError at the cell of `row` (from 0) and `column`."""
-        return self.where(row, column, message)
+        """The ScenarioError at the cell of `row` (from 0) and `column`, the row named by its
+        object's name when it has one (but in a message about the name itself)."""
+        name = self.names[row] if column != "name" and row < len(self.names) else None
+        return self.where(row, column, message, name)
 
 
 def table_path(scenario_path: str | None, given: str) -> tuple[str, str]:
@@ -298,7 +300,7 @@ def checked(table: Table, world, paper: bool, elastic: bool = False) -> Table:
         problems.append((f.row, header.index(column), len(problems), column, f.text))
     if problems:
         r, _, _, column, message = min(problems)
-        raise table.where(r, column, message)
+        raise table.error(r, column, message)
     static = table.static
     return dataclasses.replace(
         table,

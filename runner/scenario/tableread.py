@@ -70,9 +70,12 @@ class Place:
         self.header = header
         self.text = text
 
-    def __call__(self, row: int, column: str, message: str) -> ScenarioError:
+    def __call__(self, row: int, column: str, message: str, name=None) -> ScenarioError:
+        """The error `message` at the cell of `row` (from 0) and `column`, the row named by the
+        object's `name` when it has one: `row 4 (ball), column w: ...`."""
         col = self.header.index(column) if column in self.header else 0
-        message = f"row {row + 1}, column {column}: {message}" if column else message
+        named = f" ({name})" if name else ""
+        message = f"row {row + 1}{named}, column {column}: {message}" if column else message
         if self.text is None:  # .npy: row counted from 1, the field's number
             return ScenarioError(self.shown, row + 1, col + 1, message)
         line, char = _csv_cell(self.text, row, col)

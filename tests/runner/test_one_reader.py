@@ -205,8 +205,9 @@ def test_the_same_mistake_is_refused_in_the_same_words_at_its_object(
     assert (err["csv"].line, err["csv"].col) == (K + 2, cell)
     assert (err["npy"].line, err["npy"].col) == (K + 1, at + 1)
     for form in ("csv", "npy"):
-        other = f"object {K - 1} (row {K})" if "{other}" in words else None
-        said[form] = _after(err[form].message, f"row {K + 1}, column {column}: ", other)
+        before = f"{objects[K - 1]['name']}, " if objects[K - 1]["name"] else ""
+        other = f"object {K - 1} ({before}row {K})" if "{other}" in words else None
+        said[form] = _after(err[form].message, f"row {K + 1} ({name}), column {column}: ", other)
     assert said == {"list": words, "csv": words, "npy": words}
 
 
