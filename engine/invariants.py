@@ -1,11 +1,16 @@
-"""What a state keeps or must not break: kinetic energy, momentum, the deepest overlap of two boxes.
+"""What a state keeps or must not break: kinetic and potential energy, momentum, the deepest overlap
+of two boxes.
 
-One definition of each, shared by the run summary (runner.run), the stress checks (runner.stress)
-and the benchmark's error measures (runner.bench). All take the arrays of `engine.world.Bodies` and
-a model's state: mass (n,) float64 (inf for statics), static (n,) bool, vel and pos (n, 2) float64
-(px/s, px), size (n, 2) float64 px. Energy and momentum count movable objects only; they are in px
-units per unit mass. `energy_momentum` is the kernel (numba, also callable from other kernels, as
-the stress checks do); `kinetic_energy` and `momentum` are its whole-array forms.
+One definition of each, shared by the run summary (runner.run), the stress checks (runner.stress),
+the benchmark's error measures (runner.bench) and the engine's tests. All take the arrays of
+`engine.world.Bodies` and a model's state: mass (n,) float64 (inf for statics), static (n,) bool,
+vel and pos (n, 2) float64 (px/s, px), size (n, 2) float64 px. Energy and momentum count movable
+objects only; they are in px units per unit mass. `energy_momentum` is the kernel (numba, also
+callable from other kernels, as the stress checks do); `kinetic_energy` and `momentum` are its
+whole-array forms. `potential_energy` is the energy of position in uniform gravity g (px/s², y
+down) relative to the world's origin, U = -sum m (g . c) over movable objects, c the centre of
+each object's box (docs/outputs.md#summary): with g = [0, 980] a body 10 px lower has 9800 m less.
+Kinetic plus potential is the total the models keep (elastic, frictionless) or lose, never gain.
 """
 
 from __future__ import annotations
@@ -61,6 +66,27 @@ def momentum(mass: np.ndarray, static: np.ndarray, vel: np.ndarray) -> tuple[flo
     never -0.0."""
     _, px, py = _figures(mass, static, vel)
     return float(px) + 0.0, float(py) + 0.0
+
+
+def potential_energy(mass, static, pos, size, gravity) -> float:
+    """Total potential energy in uniform `gravity` (gx, gy) px/s², relative to the world's origin:
+    -sum of m (g . c) over movable objects, c = pos + size / 2 the centre of each box (px^2/s^2
+    per unit mass). Exactly 0.0 without gravity, whatever the positions; never -0.0."""
+    gx, gy = float(gravity[0]), float(gravity[1])
+    if gx == 0.0 and gy == 0.0:
+        return 0.0
+    movable = ~np.asarray(static, np.bool_)
+    m = np.asarray(mass, np.float64)[movable]
+    c = (np.asarray(pos, np.float64) + 0.5 * np.asarray(size, np.float64)).reshape(-1, 2)[movable]
+    return float(-np.sum(m * (gx * c[:, 0] + gy * c[:, 1]))) + 0.0
+
+
+def energies(bodies, pos, vel, gravity) -> tuple[float, float, float]:
+    """(kinetic, potential, their sum) of `bodies` (engine.world.Bodies: mass, static, size) at
+    positions `pos` and velocities `vel` (n, 2), in `gravity` (gx, gy) px/s²."""
+    kinetic = kinetic_energy(bodies.mass, bodies.static, vel)
+    potential = potential_energy(bodies.mass, bodies.static, pos, bodies.size, gravity)
+    return kinetic, potential, kinetic + potential + 0.0
 
 
 @njit(cache=True)

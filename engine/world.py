@@ -23,8 +23,9 @@ KIND_NAMES = ("box", "circle", "polygon")
 @dataclass(frozen=True)
 class WorldSpec:
     """The world rectangle in pixels (x right, y down), the ticks per simulated second, and the
-    physics of docs/scenario-format.md#gravity: gravity (px/s², y down), the walls' restitution
-    and friction. The defaults (no gravity, elastic frictionless walls) are the elastic world.
+    physics of docs/scenario-format.md#gravity-restitution-and-friction: gravity (px/s², y down),
+    the walls' restitution and friction. The defaults (no gravity, elastic frictionless walls) are
+    the elastic world.
     """
 
     width: int

@@ -12,13 +12,14 @@ Frames are a `FrameRule`, so nothing sized by the number of ticks is built. A mo
 as a runaway (an `engine.errors.Runaway`: the exact model's event cap or an object with no room to
 move, the stepped model's fold limit) raises `RunStopped` with a message for the user. The summary
 counts the wall and pair events whether or not they are logged (the models count them as they
-happen). Each run's kernels run compiled or interpreted (`runner.lanes`, by the size of the run; the
-summary's `kernels` says which). Kernels compiled during a run (a first run, before numba has cached
-them) are timed apart (`runner.compiling`): the summary's `compile_time_s` holds them and
-`run_time_s` leaves them out. Ctrl-C during `run_to_dir` stops the run at the end of the current
-chunk of ticks: what was written so far (events, PNG frames, the final state at that tick, a summary
-with `interrupted_at_tick`) becomes OUT/NAME, without the GIF, which would be an animation of part
-of the run.
+happen), and gives the kinetic, potential and total energy at the start and the end
+(`engine.invariants.energies`). Each run's kernels run compiled or interpreted (`runner.lanes`, by
+the size of the run; the summary's `kernels` says which). Kernels compiled during a run (a first
+run, before numba has cached them) are timed apart (`runner.compiling`): the summary's
+`compile_time_s` holds them and `run_time_s` leaves them out. Ctrl-C during `run_to_dir` stops the
+run at the end of the current chunk of ticks: what was written so far (events, PNG frames, the final
+state at that tick, a summary with `interrupted_at_tick`) becomes OUT/NAME, without the GIF, which
+would be an animation of part of the run.
 """
 
 from __future__ import annotations
@@ -39,7 +40,7 @@ import numpy as np
 from collide2d.engine import jit, models
 from collide2d.engine.errors import Runaway
 from collide2d.engine.events import empty_events
-from collide2d.engine.invariants import kinetic_energy, momentum
+from collide2d.engine.invariants import energies, momentum
 from collide2d.engine.picture.raster import Renderer
 from collide2d.runner import compiling, lanes
 from collide2d.runner.output import budget
@@ -131,7 +132,7 @@ def _drive(
         model = overlay.wrap(model)
     logging = log_events or (overlay is not None and overlay.wants_events)
     renderer = Renderer(scenario.world, bodies) if frames else None
-    start = _energy_momentum(bodies, model.velocities())
+    start = _energy_momentum(scenario, model)
     began = time.perf_counter()
     compiled_before = compiling.seconds()
     interrupted = _Interrupt() if interruptible else None
@@ -160,7 +161,7 @@ def _drive(
                 )
                 raise RunStopped(
                     f"{scenario.path or scenario.name}: error: the {scenario.model} model stopped "
-                    f"the run in {when}: {exc}"
+                    f"the run in {when}: {exc}{_names_of(exc, scenario.names)}"
                 ) from None
             if log_events and len(events) and on_events is not None:
                 on_events(events)
@@ -178,7 +179,7 @@ def _drive(
     if progress is not None:
         progress.close()
 
-    end = _energy_momentum(bodies, model.velocities())
+    end = _energy_momentum(scenario, model)
     _check_finite(scenario, model, start, end)
     walls, pairs = model.event_counts()
     summary = {
@@ -188,7 +189,9 @@ def _drive(
         "ticks": scenario.ticks,
         "objects": bodies.n,
         "events": {"wall": walls, "pair": pairs},
-        "kinetic_energy": {"start": start[0], "end": end[0]},
+        "kinetic_energy": {"start": start[0][0], "end": end[0][0]},
+        "potential_energy": {"start": start[0][1], "end": end[0][1]},
+        "total_energy": {"start": start[0][2], "end": end[0][2]},
         "momentum": {"start": list(start[1]), "end": list(end[1])},
         "run_time_s": round(max(run_time, 0.0), 6),
         "compile_time_s": round(compiling.seconds(), 6),
@@ -205,8 +208,20 @@ def make_model(scenario: Scenario):
         substeps=scenario.substeps,
         geometry=scenario.geometry,
         max_events_per_tick=scenario.max_events_per_tick,
+        iterations=scenario.iterations,
+        slop=scenario.slop,
+        rest_speed=scenario.rest_speed,
+        sleep=scenario.sleep,
+        sleep_after=scenario.sleep_after,
     )
     return models.make(scenario.model, scenario.world, scenario.bodies, **options)
+
+
+def _names_of(exc: Runaway, names) -> str:
+    """The names of the objects a runaway names by id (engine.errors.NoRoom.objects), for its
+    message: " (object 3 is ball, object 4 is cup)"; "" when none of them has a name."""
+    named = [f"object {i} is {names[i]}" for i in getattr(exc, "objects", ()) if names[i]]
+    return f" ({', '.join(named)})" if named else ""
 
 
 def _drawn(renderer, model, k: int, overlay) -> np.ndarray:
@@ -476,7 +491,7 @@ def _check_finite(scenario: Scenario, model, start, end) -> None:
 
     The scenario's bounds (runner.scenario.load, "Numbers") keep them finite; this makes sure that a
     model breaking them stops the run with a message instead of writing inf or nan."""
-    figures = np.array([start[0], *start[1], end[0], *end[1]], np.float64)
+    figures = np.array([*start[0], *start[1], *end[0], *end[1]], np.float64)
     if not (
         np.isfinite(figures).all()
         and np.isfinite(model.positions()).all()
@@ -488,8 +503,9 @@ def _check_finite(scenario: Scenario, model, start, end) -> None:
         )
 
 
-def _energy_momentum(bodies, vel: np.ndarray) -> tuple[float, tuple[float, float]]:
-    return (
-        kinetic_energy(bodies.mass, bodies.static, vel),
-        momentum(bodies.mass, bodies.static, vel),
-    )
+def _energy_momentum(scenario: Scenario, model) -> tuple[tuple, tuple[float, float]]:
+    """((kinetic, potential, total energy), momentum) of the model's state now
+    (engine.invariants; potential relative to the world's origin, 0 without gravity)."""
+    bodies, vel = scenario.bodies, model.velocities()
+    found = energies(bodies, model.positions(), vel, scenario.world.gravity)
+    return found, momentum(bodies.mass, bodies.static, vel)

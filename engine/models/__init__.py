@@ -29,12 +29,15 @@ MODEL_NAMES = ("paper", "stepped", "exact")
 # The exact model's default cap of wall and pair events in one tick (a runaway past it).
 MAX_EVENTS_PER_TICK = 1_000_000
 # The settings a scenario gives each model (docs/scenario-format.md#model): the paper model takes
-# none.
+# none; the stepped model's contacts and rest take iterations, slop, rest_speed, sleep and
+# sleep_after (docs/scenario-format.md#gravity-restitution-and-friction).
 SCENARIO_OPTIONS = {
     "paper": (),
-    "stepped": ("substeps", "geometry"),
+    "stepped": (
+        "substeps", "geometry", "iterations", "slop", "rest_speed", "sleep", "sleep_after",
+    ),
     "exact": ("geometry", "max_events_per_tick"),
-}
+}  # fmt: skip
 
 
 def make(name: str, world: WorldSpec, bodies: Bodies, **options):
@@ -46,6 +49,6 @@ def make(name: str, world: WorldSpec, bodies: Bodies, **options):
 
 
 def scenario_options(name: str, **settings) -> dict:
-    """Of a scenario's model settings (substeps, geometry, max_events_per_tick), those that
-    model `name` takes."""
-    return {k: v for k, v in settings.items() if k in SCENARIO_OPTIONS[name]}
+    """Of a scenario's model settings (substeps, geometry, max_events_per_tick, ...), those that
+    model `name` takes and the scenario sets (None: not set, the model's default holds)."""
+    return {k: v for k, v in settings.items() if k in SCENARIO_OPTIONS[name] and v is not None}

@@ -4,7 +4,8 @@ The objects come checked but for their overlap (`runner.scenario.rules`): no two
 or table rows may overlap at the start (touching is fine; under `geometry: exact` overlap is judged
 by the real shapes, so circles racked tightly in touching boxes are legal); then each generate
 block is drawn by `runner.scenario.generate` around them; the
-per-object arrays hold the listed objects first, then each block's objects, in id order. Colours are
+per-object arrays hold the listed objects first, then each block's objects, in id order (an object's
+restitution and friction their defaults, 1 and 0, where not given). Colours are
 indexed into a palette of at most PALETTE_SIZE rows: row 0 the background, then each distinct object
 colour in order of first use.
 """
@@ -80,7 +81,8 @@ def bodies(
         raise reader.error(
             blocks[0].node,
             f"generate places objects around the listed objects' boxes, which must not overlap "
-            f"here: objects[{pair[1]}] and objects[{pair[0]}] (shapes that only touch are legal "
+            f"here: {_who(listed, pair[1])} and {_who(listed, pair[0])} (shapes that only touch "
+            "are legal "
             "without generate)",
         )
     try:
@@ -123,6 +125,15 @@ def bodies(
         polys = [o.verts for o in listed if o.verts is not None]
     vert_start = np.concatenate([[0], np.cumsum(nverts)]).astype(np.int64)
     verts = np.concatenate(polys).astype(np.int64) if polys else np.zeros((0, 2), np.int64)
+    contact = []  # restitution, friction: NaN where not given, so the object's default
+    for k, default in enumerate((rules.DEFAULT_RESTITUTION, rules.DEFAULT_FRICTION)):
+        if table is not None:
+            written = (table.restitution, table.friction)[k]
+            written = np.full(n_listed, np.nan) if written is None else written
+        else:
+            written = [o.contact[k] for o in listed]
+        values = per_object(written, [b.contact[k] for b in blocks], np.float64)
+        contact.append(np.where(np.isnan(values), default, values))
     bodies = Bodies(
         kind=kind,
         pos=all_pos,
@@ -133,6 +144,8 @@ def bodies(
         vert_start=vert_start,
         verts=verts,
         looks=Looks(color=color, fill=fill),
+        restitution=contact[0],
+        friction=contact[1],
     )
 
     if table is not None:
@@ -216,6 +229,12 @@ def check_names(reader: Nodes, names, listed, blocks, lines) -> None:
         seen[name] = i
 
 
+def _who(listed, i: int) -> str:
+    """objects[i], with its name when it has one: `objects[3] (ball)`."""
+    name = None if isinstance(listed, _TableRows) else listed[i].name
+    return f"objects[{i}]" + (f" ({name})" if name else "")
+
+
 class _TableRows:
     """A table standing where the list of objects would be: its length, for the counts."""
 
@@ -244,5 +263,6 @@ def check_table_placement(table, geometry: str = "box") -> None:
     found = rules.first_overlap(table.pos, table.size, shapes)
     if found is not None:
         a = found.other
-        other = f"object {a} (row {a + 1})"
+        named = f"{table.names[a]}, " if table.names[a] else ""
+        other = f"object {a} ({named}row {a + 1})"
         raise table.error(found.row, "x", found.text.format(other=other))

@@ -72,6 +72,8 @@ KEYS = (
     "static",
     "fill",
     "name",
+    "restitution",
+    "friction",
 )
 # Plain words YAML 1.1 reads as something other than text (booleans, null).
 _NOT_TEXT = {
@@ -328,9 +330,10 @@ def _number(values: list[str]) -> np.ndarray:
     return v + 0.0  # -0.0 is read as 0.0
 
 
-def table(split_: Split, world, paper: bool, max_objects: int):
+def table(split_: Split, world, model, max_objects: int):
     """The objects of the list as a runner.scenario.table.Table, every check of the general path run
-    by column; FallBack when anything would make the general path refuse or read it otherwise."""
+    by column under the model's rules (`model`: a runner.scenario.objects.ModelRules); FallBack
+    when anything would make the general path refuse or read it otherwise."""
     from collide2d.runner.scenario.objects import DEFAULT_COLOR
     from collide2d.runner.scenario.table import Table
 
@@ -389,9 +392,11 @@ def table(split_: Split, world, paper: bool, max_objects: int):
         if cols["mass"].two.any() or not all(v[-1:].isdigit() for v in raw):
             raise FallBack
         mass[has_mass] = _number(raw)
+    contact = {key: _numbers(cols[key], n) for key in ("restitution", "friction")}
     # every rule of objects (runner.scenario.rules): any fault is the general path's to say
-    found = rules.Columns(size, pos, vel, mass, static)
-    if rules.faults(found, paper, world.fps, (world.width, world.height)):
+    found = rules.Columns(size, pos, vel, mass, static, **contact)
+    bounds = (world.width, world.height)
+    if rules.faults(found, model.paper_rates, world.fps, bounds, model.elastic):
         raise FallBack
     color_word = words("color")
     unique, first, of = np.unique(color_word, return_index=True, return_inverse=True)
@@ -444,7 +449,17 @@ def table(split_: Split, world, paper: bool, max_objects: int):
         names=names,
         where=_fall_back,
         lines=split_.starts or tuple(range(split_.first_line + 1, split_.first_line + 1 + n)),
+        **contact,
     )
+
+
+def _numbers(col: _Column, n: int) -> np.ndarray:
+    """(n,) a column of single numbers, NaN where not given."""
+    if col.two.any():
+        raise FallBack
+    out = np.full(n, np.nan)
+    out[col.one] = _number(col.ones)
+    return out
 
 
 def _flag(word: np.ndarray) -> np.ndarray:
@@ -453,7 +468,7 @@ def _flag(word: np.ndarray) -> np.ndarray:
     return word == "true"
 
 
-def _fall_back(row, column, message):
+def _fall_back(row, column, message, name=None):
     """A later check (the exact model's room to move) refused an object of the fast lane: the
     general path reads the file again and refuses it at the object's line, in its own words."""
     raise FallBack

@@ -13,7 +13,8 @@ Reading goes in two steps: `runner.scenario.parse` turns the text into a node tr
 of `Limits` (`runner.scenario.limits`: safe tags only, depth, aliases, size, value count); then the
 tree is walked by hand, so every value is checked where it stands and every error carries its node's
 place. `runner.scenario.nodes` reads single nodes (typed, located); this module reads the top level,
-the world, the model, the tick count and the overrides; `runner.scenario.objects` reads the objects
+the world, the tick count and the overrides; `runner.scenario.physics` the model and the world's
+gravity, restitution and friction; `runner.scenario.objects` reads the objects
 and generate blocks, and once the world and the model are good checks them under the model's
 `ModelRules` (`runner.scenario.rules`, the rules of every object however it is written);
 `runner.scenario.sections` reads `output` and `golden`; `runner.scenario.assemble` builds the
@@ -37,10 +38,12 @@ is read at a cost linear in its text whatever its form (decimal, `0x`, `0b`, oct
 seed at most MAX_SEED), and a number in a float field must be finite (`.inf`, `.nan` and `1e999` are
 refused). `-0.0` is read as `0.0`. Masses lie in [MIN_MASS, MAX_MASS] and velocity components in
 [-MAX_SPEED, MAX_SPEED], so every object starts with |m v| <= sqrt(2) * 1e24, m |v|^2 / 2 <= 1e33
-and 1/m <= 1e15, and n objects with a kinetic energy E <= n * 1e33. The models keep kinetic energy
-(up to rounding) or lose it, never gain it, so no object ever moves faster than sqrt(2 E / MIN_MASS)
-<= sqrt(n) * 1.5e24 px/s: for any n a machine can hold, every velocity, energy, momentum and inverse
-mass of a run stays many orders of magnitude inside float64's range (about 1.8e308). Denormal masses
+and 1/m <= 1e15, and n objects with a kinetic energy E <= n * 1e33. Without gravity the models keep
+kinetic energy (up to rounding) or lose it, never gain it, so no object ever moves faster than
+sqrt(2 E / MIN_MASS) <= sqrt(n) * 1.5e24 px/s; gravity (runner.scenario.physics, MAX_GRAVITY) adds
+at most the fall across the world to that. For any n a machine can hold, every velocity, energy,
+momentum and inverse mass of a run stays many orders of magnitude inside float64's range (about
+1.8e308). Denormal masses
 such as `5e-324` are refused by the same bound; `static: true` is the way to an immovable object.
 
 Every value in the file must be valid on its own. The overrides then replace values (`model`
@@ -54,7 +57,6 @@ checked with the values in force; such an error starts with the override, e.g. `
 
 from __future__ import annotations
 
-import difflib
 import hashlib
 import math
 import os
@@ -66,7 +68,6 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from collide2d.engine.models import MAX_EVENTS_PER_TICK, MODEL_NAMES
 from collide2d.engine.shapes import GEOMETRIES
 from collide2d.engine.world import Bodies, WorldSpec
 from collide2d.runner.scenario import assemble
@@ -75,7 +76,7 @@ from collide2d.runner.scenario import parse as ys
 from collide2d.runner.scenario import table as tables
 from collide2d.runner.scenario.assemble import PALETTE_SIZE
 from collide2d.runner.scenario.limits import Limits
-from collide2d.runner.scenario.nodes import FAILED, MAX_INTEGER, Errors, Nodes, fmt, is_number
+from collide2d.runner.scenario.nodes import FAILED, MAX_INTEGER, Errors, fmt, is_number
 from collide2d.runner.scenario.objects import (
     BLOCK_KEYS,
     BLOCK_SHAPES,
@@ -90,8 +91,22 @@ from collide2d.runner.scenario.objects import (
     polygon_problem,
 )
 from collide2d.runner.scenario.parse import ScenarioError
+from collide2d.runner.scenario.physics import (
+    DEFAULT_MAX_EVENTS_PER_TICK,
+    MAX_EVENT_CAP,
+    MAX_GRAVITY,
+    MAX_ITERATIONS,
+    MAX_SUBSTEPS,
+    MODEL_BOUNDS,
+    MODEL_KEYS,
+    WORLD_PHYSICS,
+    ModelReader,
+)
 from collide2d.runner.scenario.rules import (
+    DEFAULT_FRICTION,
     DEFAULT_MASS,
+    DEFAULT_RESTITUTION,
+    MAX_FRICTION,
     MAX_MASS,
     MAX_OBJECT_NAME_CHARS,
     MAX_SPEED,
@@ -114,9 +129,11 @@ __all__ = [
     "DEFAULT_COLOR",
     "DEFAULT_DURATION",
     "DEFAULT_FPS",
+    "DEFAULT_FRICTION",
     "DEFAULT_HEIGHT",
     "DEFAULT_MASS",
     "DEFAULT_MAX_EVENTS_PER_TICK",
+    "DEFAULT_RESTITUTION",
     "DEFAULT_WIDTH",
     "EVERY_KEYS",
     "FORMAT_VERSION",
@@ -125,7 +142,10 @@ __all__ = [
     "GOLDEN_KEYS",
     "MAX_EVENT_CAP",
     "MAX_FPS",
+    "MAX_FRICTION",
+    "MAX_GRAVITY",
     "MAX_INTEGER",
+    "MAX_ITERATIONS",
     "MAX_MASS",
     "MAX_NAME_LENGTH",
     "MAX_OBJECT_NAME_CHARS",
@@ -146,6 +166,7 @@ __all__ = [
     "SHAPES",
     "TOP_KEYS",
     "WORLD_KEYS",
+    "WORLD_PHYSICS",
     "Golden",
     "Limits",
     "Output",
@@ -163,14 +184,6 @@ DEFAULT_FPS = 10  # ticks per simulated second
 MAX_FPS = 10_000  # ticks per simulated second
 DEFAULT_DURATION = 10  # s, when neither `ticks` nor `duration` is given
 DEFAULT_BACKGROUND = (0, 0, 0)
-MAX_SUBSTEPS = 10_000  # substeps per tick of the stepped model
-# The exact model's `max_events_per_tick`: the default, and the largest a scenario or
-# --max-events-per-tick may ask for (counted exactly in the kernel's int64 and in float64).
-DEFAULT_MAX_EVENTS_PER_TICK = MAX_EVENTS_PER_TICK
-MAX_EVENT_CAP = 2**53
-# The whole-number model settings and their (lowest, highest): of a scenario's `model`, and of a
-# project's [tool.collide2d.model] alike (runner.command.settings).
-MODEL_BOUNDS = {"substeps": (1, MAX_SUBSTEPS), "max_events_per_tick": (1, MAX_EVENT_CAP)}
 MAX_NAME_LENGTH = 100  # characters in a scenario name (it names a folder)
 NAME_PATTERN = r"[a-z0-9_-][a-z0-9._-]*"  # scenario names; never "." or "..", never a path
 NAME_FOR_TEXT = "scenario"  # the name of a scenario read from text without one
@@ -190,8 +203,7 @@ TOP_KEYS = (
     "output",
     "golden",
 )
-WORLD_KEYS = ("width", "height", "fps", "background")
-MODEL_KEYS = ("kind", "substeps", "geometry", "max_events_per_tick")
+WORLD_KEYS = ("width", "height", "fps", "background", *WORLD_PHYSICS)
 OVERRIDE_KEYS = ("model", "fps", "ticks", "max_events_per_tick")
 
 
@@ -218,6 +230,12 @@ class Scenario:
     # each generate block as drawn (runner.scenario.generate.BlockSpec), its objects the last of
     # `bodies`: what a sweep draws again for another seed (runner.sweep.reseed)
     generated: tuple = ()
+    # the stepped model's settings for contacts and rest; None: the model's default
+    iterations: int | None = None
+    slop: float | None = None  # px
+    rest_speed: float | None = None  # px/s
+    sleep: bool | None = None
+    sleep_after: float | None = None  # s
 
 
 def load(
@@ -253,7 +271,7 @@ def loads(
     return _Reader(path, None, overrides, limits, defaults).scenario(text, digest)
 
 
-class _Reader(Nodes):
+class _Reader(ModelReader):
     """One reading of one scenario: its path, limits and overrides, and the top-level sections."""
 
     def __init__(self, path: str, file_path: str | None, overrides, limits, defaults=None):
@@ -304,6 +322,8 @@ class _Reader(Nodes):
         description = self.attempt(self.description, top)
         world_background = self.attempt(self.world, top)
         settings = self.attempt(self.model, top)
+        if world_background is not FAILED and settings is not FAILED:
+            self.attempt(self.check_world_physics, self.physics, settings.kind)
         ticks = FAILED
         if world_background is not FAILED:
             world, background = world_background
@@ -320,7 +340,7 @@ class _Reader(Nodes):
         world_in = world if world_background is not FAILED else None
         rules = None
         if settings is not FAILED:
-            model, substeps, geometry, cap = settings
+            model, geometry = settings.kind, settings.geometry
             rules = ModelRules.of(model, geometry, self.model_from)
         objects.check(listed, blocks, world_in, rules, self.fps_from)
         if table is not FAILED:
@@ -349,7 +369,7 @@ class _Reader(Nodes):
             background=background,
             palette=palette,
             model=model,
-            substeps=substeps,
+            substeps=settings.substeps,
             geometry=geometry,
             ticks=ticks,
             bodies=bodies,
@@ -358,8 +378,9 @@ class _Reader(Nodes):
             output=output,
             golden=golden,
             text_sha256=digest,
-            max_events_per_tick=cap,
+            max_events_per_tick=settings.max_events_per_tick,
             generated=tuple(b.spec for b in blocks),
+            **settings.stepped,
         )
 
     def description(self, top: dict) -> str:
@@ -439,95 +460,9 @@ class _Reader(Nodes):
         background = DEFAULT_BACKGROUND
         if "background" in m:
             background = self.color(m["background"][1], "world.background")
-        return WorldSpec(side["width"], side["height"], fps), background
-
-    def model(self, top: dict) -> tuple[str, int, str, int]:
-        """(kind, substeps, geometry, max_events_per_tick) from `model` and the overrides."""
-        kind, substeps, geometry, cap = "paper", 1, None, DEFAULT_MAX_EVENTS_PER_TICK
-        sub_node = geo_node = cap_node = None
-        if "model" not in top:
-            kind = self.defaults.get("kind", kind)
-        if "model" in top:
-            node = top["model"][1]
-            if isinstance(node, yaml.MappingNode):
-                m = self.mapping(node, "model", MODEL_KEYS)
-                if "kind" not in m:
-                    raise self.error(node, "model is missing 'kind' (paper | stepped | exact)")
-                kind = self.choice(m["kind"][1], "model", MODEL_NAMES)
-                if "substeps" in m:
-                    sub_node = m["substeps"][1]
-                    lo, hi = MODEL_BOUNDS["substeps"]
-                    substeps = self.integer(sub_node, "model.substeps", lo=lo, hi=hi)
-                    if kind != "stepped":
-                        raise self.error(
-                            sub_node, f"substeps applies to the stepped model only, not to {kind}"
-                        )
-                if "max_events_per_tick" in m:
-                    cap_node = m["max_events_per_tick"][1]
-                    lo, hi = MODEL_BOUNDS["max_events_per_tick"]
-                    cap = self.integer(cap_node, "model.max_events_per_tick", lo=lo, hi=hi)
-                    if kind != "exact":
-                        raise self.error(
-                            cap_node,
-                            f"max_events_per_tick applies to the exact model only, not to {kind}",
-                        )
-                if "geometry" in m:
-                    geo_node = m["geometry"][1]
-                    geometry = self.choice(geo_node, "geometry", GEOMETRIES)
-                    if geometry == "exact" and kind == "paper":
-                        raise self.error(
-                            geo_node,
-                            "geometry 'exact' is not available with the "
-                            "paper model, where every shape collides as its box",
-                        )
-            else:
-                kind = self.choice(node, "model", MODEL_NAMES)
-        if "model" in self.overrides:
-            v = self.overrides["model"]
-            origin = f"--model {v}"
-            if not isinstance(v, str) or v not in MODEL_NAMES:
-                near = difflib.get_close_matches(str(v), MODEL_NAMES, n=1)
-                hint = (
-                    f"did you mean '{near[0]}'?" if near else "expected " + " | ".join(MODEL_NAMES)
-                )
-                raise self.error(None, f"{origin}: unknown model {v!r}; {hint}")
-            if v != kind:
-                self.model_from = origin
-                kind, substeps, geometry = v, 1, None
-                cap = DEFAULT_MAX_EVENTS_PER_TICK
-        if "max_events_per_tick" in self.overrides:  # any model: only the exact one uses it
-            v = self.overrides["max_events_per_tick"]
-            if isinstance(v, bool) or not isinstance(v, int) or not 1 <= v <= MAX_EVENT_CAP:
-                raise self.error(
-                    None,
-                    f"--max-events-per-tick {v}: must be a whole number from 1 to {MAX_EVENT_CAP}",
-                )
-            cap = v
-        if self.model_from:  # the file's settings went with its model
-            sub_node = cap_node = None
-        substeps, geometry, cap = self.model_defaults(
-            kind, sub_node, geometry, cap_node, substeps, cap
-        )
-        if geometry is None:
-            geometry = "exact" if kind == "exact" else "box"
-        return kind, substeps, geometry, cap
-
-    def model_defaults(self, kind, sub_node, geometry, cap_node, substeps, cap):
-        """The project's model defaults (runner.command.settings) where neither the file nor the
-        command line set a value and the model takes it."""
-        d = self.defaults
-        if kind == "stepped" and sub_node is None and "substeps" in d:
-            substeps = d["substeps"]
-        if geometry is None and kind != "paper" and "geometry" in d:
-            geometry = d["geometry"]
-        if (
-            kind == "exact"
-            and cap_node is None
-            and "max_events_per_tick" in d
-            and "max_events_per_tick" not in self.overrides
-        ):
-            cap = d["max_events_per_tick"]
-        return substeps, geometry, cap
+        self.physics = p = self.world_physics(m)
+        world = WorldSpec(side["width"], side["height"], fps, p.gravity, p.restitution, p.friction)
+        return world, background
 
     def table(self, top, fast):
         """The `objects: {file}` table read (runner.scenario.table), or None; with `fast` (the
@@ -545,9 +480,10 @@ class _Reader(Nodes):
         """The fast lane's rows, or the table read by `table` (or None), every rule held that
         the world and the model (None when refused) allow to check."""
         if fast is not None and world is not None and rules is not None:
-            return yamlfast.table(fast, world, rules.paper_rates, self.limits.max_objects)
+            return yamlfast.table(fast, world, rules, self.limits.max_objects)
         if table is not None:
-            table = tables.checked(table, world, rules is not None and rules.paper_rates)
+            paper, elastic = (rules.paper_rates, rules.elastic) if rules else (False, False)
+            table = tables.checked(table, world, paper, elastic)
         return table
 
     def ticks(self, top: dict, fps: int) -> int:

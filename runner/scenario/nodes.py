@@ -25,7 +25,60 @@ from collide2d.runner.scenario.parse import ScenarioError
 MAX_INTEGER = 2**63 - 1  # the largest whole number a field takes unless it has its own bound
 MAX_ERRORS = 20  # errors of one file reported at once
 # Keys users write for a key of the format, and why: said with the did-you-mean.
-KEY_HINTS = {"radius": ("diameter", "a circle is given by its diameter in px, twice the radius")}
+KEY_HINTS = {
+    "radius": ("diameter", "a circle is given by its diameter in px, twice the radius"),
+    **{
+        word: ("restitution", "collide2d calls it restitution: 1 elastic, 0 no bounce")
+        for word in ("elasticity", "bounce", "bounciness", "coefficient_of_restitution")
+    },
+}
+# Keys of a physics collide2d does not have: said in place of a did-you-mean, which would point
+# at an unrelated key ("rotation" is not "position").
+_ROTATION = "collide2d has no rotation: objects keep their orientation and only move"
+_DAMPING = (
+    "collide2d has no damping: objects keep their velocity between contacts (friction acts in "
+    "contacts, under model: stepped)"
+)
+NO_SUCH_PHYSICS = {
+    **{
+        word: _ROTATION
+        for word in (
+            "angle", "rotation", "orientation", "angular_velocity", "angular_speed", "spin",
+            "omega", "torque", "inertia", "moment", "moment_of_inertia", "angular_damping",
+        )
+    },  # fmt: skip
+    **{
+        word: _DAMPING
+        for word in ("damping", "linear_damping", "drag", "air_resistance", "air_friction")
+    },
+    "density": "collide2d has no density: give an object's mass (default 1)",
+    "charge": "collide2d has no forces between objects: they meet only by contact",
+}
+# Keys of another section: where they belong (a model's settings, the world's keys).
+_MODEL_SETTINGS = ("substeps", "geometry", "max_events_per_tick", "iterations", "slop",
+                   "rest_speed", "sleep", "sleep_after")  # fmt: skip
+ELSEWHERE = {
+    **{key: "world" for key in ("width", "height", "fps", "background", "gravity")},
+    **{key: "model" for key in _MODEL_SETTINGS},
+}
+
+
+def key_hint(key: str, keys: tuple[str, ...]) -> str:
+    """What to say of the unknown `key` among `keys`: where it belongs, or that collide2d lacks
+    its physics, or a did-you-mean, or the keys expected."""
+    if key in KEY_HINTS and KEY_HINTS[key][0] in keys:
+        return f"did you mean '{KEY_HINTS[key][0]}'? ({KEY_HINTS[key][1]})"
+    if key in NO_SUCH_PHYSICS:
+        return NO_SUCH_PHYSICS[key]
+    section = ELSEWHERE.get(key)
+    if section == "model" and "kind" not in keys:
+        return f"{key} is a model setting: model: {{kind: ..., {key}: ...}}"
+    if section == "world" and "width" not in keys:
+        return f"{key} belongs to the world: world: {{{key}: ...}}"
+    if key in ("restitution", "friction") and "kind" in keys:
+        return f"{key} belongs to each object, or to world.{key} for the walls"
+    near = difflib.get_close_matches(key, keys, n=1)
+    return f"did you mean '{near[0]}'?" if near else "expected one of " + ", ".join(keys)
 
 
 def is_number(v) -> bool:
@@ -138,12 +191,7 @@ class Nodes:
                 )
                 continue
             if key not in keys:
-                near = difflib.get_close_matches(key, keys, n=1)
-                hint = (
-                    f"did you mean '{near[0]}'?" if near else "expected one of " + ", ".join(keys)
-                )
-                if key in KEY_HINTS and KEY_HINTS[key][0] in keys:
-                    hint = f"did you mean '{KEY_HINTS[key][0]}'? ({KEY_HINTS[key][1]})"
+                hint = key_hint(key, keys)
                 refused.add(self.error(knode, f"unknown key '{key}' in {where}; {hint}"))
                 continue
             out[key] = (knode, vnode)

@@ -1,21 +1,19 @@
 """The `objects` and `generate` sections: each listed object and generate block, read and checked.
 
 `ObjectReader` reads every object field at its place (shape and its size key, position, velocity or
-speed, colour, mass, static, fill, name) whatever the world and the model, and returns `Listed`
-objects and `Block`s, from which `runner.scenario.assemble` builds the arrays; each remembers the
-node of every value a rule may refuse. Once the world and the model are known, `check` and
-`check_blocks` put those values in columns and ask `runner.scenario.rules`, where every rule of
-objects is written once for lists, blocks, tables and the fast lane alike (sizes, masses within
-[MIN_MASS, MAX_MASS], velocity components within [-MAX_SPEED, MAX_SPEED], static objects, the paper
-model's whole numbers and rates, inside the world), and report each object's first fault at its
-node. What differs between models is one `ModelRules` value: under the paper model positions are
-whole pixels, every velocity component of a moving object is a rate the model can take at the
-world's fps (`engine.motion.paper_rate`) and generated velocities are drawn as whole numbers; under
-geometry `exact` a polygon must be convex with some area (`polygon_problem`). Polygon points lie
-within MAX_POINT_OFFSET px of the object's position.
-
-An object's name follows the one rule for names wherever it is written
-(`runner.scenario.rules.object_names`).
+speed, colour, mass, static, fill, name, restitution, friction) whatever the world and the model,
+and returns `Listed` objects and `Block`s, from which `runner.scenario.assemble` builds the arrays;
+each remembers the node of every value a rule may refuse. Once the world and the model are known,
+`check` and `check_blocks` put those values in columns and ask `runner.scenario.rules`, where every
+rule of objects is written once for lists, blocks, tables and the fast lane alike, and report each
+object's first fault at its node. What differs between models is one `ModelRules` value: under the
+paper model positions are whole pixels, every velocity component of a moving object is a rate the
+model can take at the world's fps (`engine.motion.paper_rate`), generated velocities are drawn as
+whole numbers and restitution and friction are refused; the exact model takes only their defaults.
+A polygon must be convex under every model, and have some area under geometry `exact`
+(`polygon_problem`); its points lie within MAX_POINT_OFFSET px of the object's position. An object
+is named in messages by its `name` beside its place (`objects[3] (ball)`), its name following the
+one rule for names wherever it is written (`runner.scenario.rules.object_names`).
 """
 
 from __future__ import annotations
@@ -32,7 +30,7 @@ from collide2d.runner.scenario import generate as gen
 from collide2d.runner.scenario import parse as ys
 from collide2d.runner.scenario import rules as rule
 from collide2d.runner.scenario.limits import Limits
-from collide2d.runner.scenario.nodes import FAILED, Nodes, fmt, is_number
+from collide2d.runner.scenario.nodes import FAILED, Nodes, _raise, fmt, is_number
 from collide2d.runner.scenario.rules import DEFAULT_MASS, NameRefused, object_names
 
 DEFAULT_COLOR = (255, 255, 255)
@@ -55,6 +53,8 @@ OBJECT_KEYS = (
     "static",
     "fill",
     "name",
+    "restitution",
+    "friction",
 )
 BLOCK_KEYS = (
     "count",
@@ -69,6 +69,8 @@ BLOCK_KEYS = (
     "fill",
     "static",
     "name",
+    "restitution",
+    "friction",
 )
 RANGE_KEYS = ("min", "max")
 
@@ -80,8 +82,11 @@ class ModelRules:
     # positions are whole pixels and a moving object's velocity is a paper rate at the fps (paper)
     paper_rates: bool = False
     whole_velocities: bool = False  # generated velocities are whole numbers (paper)
-    convex_polygons: bool = False  # polygons are convex with some area (geometry exact)
+    polygon_area: bool = False  # polygons have some area (geometry exact)
     origin: str | None = None  # "--model M" when the model came from the command line
+    # restitution 1 and friction 0 only (the exact model, elastic and frictionless for now); the
+    # paper model takes neither (paper_rates)
+    elastic: bool = False
 
     @classmethod
     def of(cls, model: str, geometry: str, origin: str | None = None) -> ModelRules:
@@ -89,26 +94,28 @@ class ModelRules:
         return cls(
             paper_rates=paper,
             whole_velocities=paper,
-            convex_polygons=geometry == "exact",
+            polygon_area=geometry == "exact",
             origin=origin,
+            elastic=model == "exact",
         )
 
 
 _NO_MODEL = ModelRules()  # the model was refused: its rules wait
 
 
-def polygon_problem(points: np.ndarray) -> str | None:
+def polygon_problem(points: np.ndarray, area: bool = True) -> str | None:
     """Why the closed polygon `points` (k, 2) int is not convex, or None when it is.
 
-    Consecutive repeated points and collinear points are allowed; zero area, a turn back along the
-    same line, turns both ways and winding around more than once are not.
+    Consecutive repeated points and collinear points are allowed; zero area (unless `area` is
+    False: points on one line, drawn as a line), a turn back along the same line, turns both ways
+    and winding around more than once are not.
     """
     p = np.asarray(points, np.int64)
     keep = np.any(p != np.roll(p, 1, axis=0), axis=1)
     p = p[keep] if keep.any() else p[:1]
     d = p - p[0]
     if not np.any(d[:, 0] * np.roll(d[:, 1], -1) - np.roll(d[:, 0], -1) * d[:, 1]):
-        return "it has zero area (its points lie on one line)"
+        return "it has zero area (its points lie on one line)" if area else None
     area2 = int(np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1]))
     if area2 == 0:
         return "it is not convex: it crosses itself"
@@ -146,6 +153,7 @@ class Listed:
     node: object
     written: tuple[float, float]  # the position as written (a polygon's box starts elsewhere)
     at: dict  # {(field, axis): (node, what)} of each value a rule may refuse (rules.Fault)
+    contact: tuple[float, float] = (math.nan, math.nan)  # restitution, friction (NaN: not given)
 
     @property
     def line(self) -> int:
@@ -167,6 +175,7 @@ class Block:
     node: object
     at: dict  # {(field, axis): (node, what)}, as Listed.at
     index: int = 0
+    contact: tuple[float, float] = (math.nan, math.nan)  # restitution, friction (NaN: not given)
 
     @property
     def line(self) -> int:
@@ -189,6 +198,8 @@ def _columns(items, pos, vel) -> rule.Columns:
         vel=np.asarray(vel, np.float64).reshape(n, 2),
         mass=np.array([o.mass if ("mass", 0) in o.at else np.nan for o in items], np.float64),
         static=np.array([o.static for o in items], bool).reshape(n),
+        restitution=np.array([o.contact[0] for o in items], np.float64).reshape(n),
+        friction=np.array([o.contact[1] for o in items], np.float64).reshape(n),
     )
 
 
@@ -244,6 +255,18 @@ class ObjectReader(Nodes):
             raise self.error(node, f"{what} ({shape}) is missing '{wanted}'")
         return shape
 
+    def contact(self, m: dict, what: str, at: dict) -> tuple[float, float]:
+        """(restitution, friction) of an object or a block as written, NaN where not given: their
+        bounds and what the model takes of them are rules (runner.scenario.rules)."""
+        out = []
+        for key in ("restitution", "friction"):
+            v = math.nan
+            if key in m:
+                v = float(self.number(m[key][1], f"{what}.{key}")) + 0.0
+                at[(key, 0)] = (m[key][1], f"{what}.{key}")
+            out.append(v)
+        return out[0], out[1]
+
     def common(self, m: dict, what: str, at: dict):
         """color, mass, static, fill, name of an object or a block."""
         color_node = m["color"][1] if "color" in m else None
@@ -278,9 +301,9 @@ class ObjectReader(Nodes):
         return self.each(self.listed, items)
 
     def listed(self, i: int, node) -> Listed:
-        what = f"objects[{i}]"
         at: dict = {}
         m = self.mapping(node, "object", OBJECT_KEYS)
+        what = f"objects[{i}]" + _named(m)
         shape = self.shape_of(m, node, what, SHAPES)
         verts = None
         offset = (0, 0)
@@ -332,7 +355,7 @@ class ObjectReader(Nodes):
         kind = _KIND_OF_SHAPE[shape]
         return Listed(
             i, kind, pos, size, vel, mass, static, color, color_node, fill, verts, name, node,
-            written, at,
+            written, at, self.contact(m, what, at),
         )  # fmt: skip
 
     # -- the rules, once the world and the model are known
@@ -354,23 +377,22 @@ class ObjectReader(Nodes):
         refused = set()
         for row, o in enumerate(listed):
             problem = None
-            if model.convex_polygons and o.verts is not None:
-                problem = polygon_problem(o.verts)
+            if o.verts is not None:
+                problem = polygon_problem(o.verts, model.polygon_area)
             if problem is not None:
                 refused.add(row)
                 node, what = o.at[("size", 0)]
-                self.attempt(
-                    _raise,
-                    self.error(
-                        node,
+                said = f"{what}: a polygon must be convex, but {problem}"
+                if model.polygon_area:
+                    said = (
                         f"{self.prefix(model.origin)}{what}: under geometry 'exact' a polygon "
-                        f"must be convex with some area, but {problem}",
-                    ),
-                )
+                        f"must be convex with some area, but {problem}"
+                    )
+                self.attempt(_raise, self.error(node, said))
         cols = _columns(listed, [o.written for o in listed], [o.vel for o in listed])
         cols.corner = np.array([o.pos for o in listed], np.float64).reshape(-1, 2)
         fps, bounds = (world.fps, (world.width, world.height)) if world else (None, None)
-        found = rule.faults(cols, model.paper_rates, fps, bounds)
+        found = rule.faults(cols, model.paper_rates, fps, bounds, model.elastic)
         for f in rule.first_per_row(found):
             if f.row not in refused:
                 self.attempt(_raise, self.fault(listed, f, model, fps_from, "objects"))
@@ -450,7 +472,8 @@ class ObjectReader(Nodes):
             velocity_range=velocity_range,
         )
         kind = _KIND_OF_SHAPE[shape]
-        return Block(spec, kind, mass, static, color, color_node, fill, name, node, at, k)
+        contact = self.contact(m, what, at)
+        return Block(spec, kind, mass, static, color, color_node, fill, name, node, at, k, contact)
 
     def velocity_range(self, vnode, what: str, at: dict):
         """((vx0, vy0), (vx1, vy1)) of `velocity: {min: [vx, vy], max: [vx, vy]}`."""
@@ -501,7 +524,7 @@ class ObjectReader(Nodes):
             b.spec = dataclasses.replace(b.spec, whole=model.whole_velocities)
         speed = [(b.spec.speed or 0.0,) * 2 for b in blocks]
         cols = _columns(blocks, np.zeros((len(blocks), 2)), speed)
-        found = rule.first_per_row(rule.faults(cols, model.paper_rates, fps))
+        found = rule.first_per_row(rule.faults(cols, model.paper_rates, fps, None, model.elastic))
         refused = {f.row for f in found}
         for f in found:
             self.attempt(_raise, self.fault(blocks, f, model, fps_from, "generate"))
@@ -551,21 +574,25 @@ def fault_error(reader: Nodes, items, f: rule.Fault, kind: str, origin=None, fps
     """The ScenarioError of Fault `f` of `items` (listed objects or blocks, `kind` "objects" or
     "generate"), at the node of the value it is about: `--model M: objects[3].size w must be
     ...`; a fault of the whole object (its box) is at the object, and an object it overlaps is
-    named with its line."""
+    named with its line; each by its name too when it has one (`objects[3] (ball, line 7)`)."""
     o = items[f.row]
-    if f.field == "box":
-        node, what = o.node, f"{kind}[{o.index}]"
-    else:
-        node, what = o.at[(f.field, f.axis)]
+
+    def who(x, line=False) -> str:
+        said = [getattr(x, "name", None)] + [f"line {x.line}"] * line
+        return f"{kind}[{x.index}]" + (f" ({', '.join(filter(None, said))})" if any(said) else "")
+
+    box = f.field == "box"
+    node, what = (o.node, who(o, f.other is not None)) if box else o.at[(f.field, f.axis)]
     text = f.text
     if f.other is not None:
-        a = items[f.other]
-        text = text.format(other=f"{kind}[{a.index}] (line {a.line})")
-        what = f"{what} (line {o.line})"
+        text = text.format(other=who(items[f.other], True))
     origins = (origin if "model" in f.by else None, fps_from if "fps" in f.by else None)
     said = f"{what} {text}" if f.named else text
     return reader.error(node, f"{reader.prefix(*origins)}{said}")
 
 
-def _raise(exc: Exception):
-    raise exc
+def _named(m: dict) -> str:
+    """" (NAME)" of an object mapping whose `name` is plain text, for its messages; else ""."""
+    node = m["name"][1] if "name" in m else None
+    text = ys.value(node) if isinstance(node, yaml.ScalarNode) else None
+    return f" ({text.strip()})" if isinstance(text, str) and text.strip() else ""

@@ -14,6 +14,10 @@ The rules (docs/scenario-format.md, docs/limits.md):
 - a size is a whole number of pixels from 1 to MAX_SIZE;
 - a mass, when given, lies in [MIN_MASS, MAX_MASS], and a static object has none (it is infinite);
 - a velocity component lies in [-MAX_SPEED, MAX_SPEED], and a static object's is 0;
+- a restitution, when given, lies in [0, 1], and a friction in [0, MAX_FRICTION]; the paper model
+  takes neither (the paper has no restitution, friction or gravity), and the exact model, elastic
+  and frictionless for now, takes only restitution 1 and friction 0
+  (docs/scenario-format.md#gravity-restitution-and-friction);
 - under the paper model a position is a whole number of pixels and a moving object's velocity
   component is a rate the model can take at the world's fps (`engine.motion.paper_rate`);
 - with the world known, every object's box lies inside it, and at the start no two objects overlap
@@ -45,7 +49,12 @@ MAX_MASS = 1e15  # mass units, the heaviest movable object (`static: true` is he
 MAX_SPEED = 1e9  # px/s, largest velocity component (a larger one crosses any world in a tick)
 MAX_OBJECT_NAME_CHARS = 100  # characters in an object's name (it labels the object in every output)
 MAX_SIZE = 2**53  # px, the largest side of an object (every whole number up to it is a float64)
-FIELDS = ("size", "position", "mass", "velocity", "box")
+DEFAULT_RESTITUTION = 1.0  # e of an object: elastic
+DEFAULT_FRICTION = 0.0  # Coulomb's mu of an object: frictionless
+# The largest mu: far past any real pair of materials (rubber on concrete is about 1), small
+# enough that mu times any impulse a scenario can give stays many orders inside float64.
+MAX_FRICTION = 1e6
+FIELDS = ("size", "position", "mass", "velocity", "restitution", "friction", "box")
 MAX_FAULTS = 20  # rows reported per rule (runner.scenario.nodes.MAX_ERRORS are reported at once)
 
 
@@ -86,7 +95,8 @@ def object_names(texts) -> list[str | None]:
 class Columns:
     """The values of n objects, read but not yet checked: sizes (n, 2) px, positions (n, 2) px as
     written, velocities (n, 2) px/s, masses (n,) (NaN where none is given), static (n,) bool;
-    `corner` (n, 2) the top-left corner when it is not the position written (a polygon's)."""
+    `corner` (n, 2) the top-left corner when it is not the position written (a polygon's);
+    restitution and friction (n,) (NaN where none is given; None: given for none)."""
 
     size: np.ndarray
     pos: np.ndarray
@@ -94,6 +104,8 @@ class Columns:
     mass: np.ndarray
     static: np.ndarray
     corner: np.ndarray | None = None
+    restitution: np.ndarray | None = None
+    friction: np.ndarray | None = None
 
     @property
     def n(self) -> int:
@@ -134,10 +146,13 @@ def _cells(bad: np.ndarray) -> list[tuple[int, int]]:
     return [(r, a) for r in rows for a in (0, 1) if bad[r, a]]
 
 
-def faults(cols: Columns, paper: bool, fps: int | None, world=None) -> list[Fault]:
+def faults(
+    cols: Columns, paper: bool, fps: int | None, world=None, elastic: bool = False
+) -> list[Fault]:
     """Every rule broken by `cols` (at most MAX_FAULTS rows a rule), in no particular order: those
-    of each object alone under the model (`paper`) at `fps` (None: the paper model's rates wait
-    for it), and, when `world` (width, height) is given, the world's bounds."""
+    of each object alone under the model (`paper`; `elastic`: the exact model, which takes no
+    restitution below 1 nor friction) at `fps` (None: the paper model's rates wait for it), and,
+    when `world` (width, height) is given, the world's bounds."""
     out: list[Fault] = []
     size = cols.size
     fraction = size != np.floor(size)
@@ -159,6 +174,7 @@ def faults(cols: Columns, paper: bool, fps: int | None, world=None) -> list[Faul
             out.append(Fault(r, "position", a, text, ("model",)))
     _mass_faults(cols, out)
     _velocity_faults(cols, paper, fps, out)
+    _contact_faults(cols, paper, elastic, out)
     if world is not None:
         out += outside(cols, *world)
     return out
@@ -204,6 +220,43 @@ def _velocity_faults(cols: Columns, paper: bool, fps: int, out: list) -> None:
             out.append(
                 Fault(r, "velocity", a, said[float(vel[r, a])], ("model", "fps"), named=False)
             )
+
+
+# What a model without gravity, restitution or friction says of an object's restitution or
+# friction (the subject is the value: `objects[2].restitution cannot be given: ...`).
+PAPER_REFUSES = (
+    "cannot be given: the paper model has no {key} (the paper's objects bounce by its flip rule, "
+    "elastic and weightless); {key} needs model: stepped"
+)
+EXACT_REFUSES = {
+    "restitution": "must be 1 under the exact model, which is elastic for now; a restitution "
+    "below 1 needs model: stepped",
+    "friction": "must be 0 under the exact model, which is frictionless for now; friction needs "
+    "model: stepped",
+}
+
+
+def _contact_faults(cols: Columns, paper: bool, elastic: bool, out: list) -> None:
+    """Restitution in [0, 1], friction in [0, MAX_FRICTION], each where given, and what the
+    model takes of them."""
+    for key, hi, default in (
+        ("restitution", 1.0, DEFAULT_RESTITUTION),
+        ("friction", MAX_FRICTION, DEFAULT_FRICTION),
+    ):
+        v = getattr(cols, key)
+        if v is None:
+            continue
+        given = ~np.isnan(v)
+        low, high = given & (v < 0), given & (v > hi)
+        for r in _rows(low | high):
+            bound = "at least 0" if low[r] else f"at most {fmt(hi)}"
+            out.append(Fault(r, key, 0, f"must be {bound}, not {fmt(float(v[r]))}"))
+        refused = given if paper else given & (v != default) if elastic else None
+        if refused is None:
+            continue
+        text = PAPER_REFUSES.format(key=key) if paper else EXACT_REFUSES[key]
+        for r in _rows(refused & ~low & ~high):
+            out.append(Fault(r, key, 0, text, ("model",)))
 
 
 def outside(cols: Columns, width: int, height: int) -> list[Fault]:

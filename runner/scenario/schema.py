@@ -22,6 +22,9 @@ from collide2d.runner.scenario.load import (
     GEOMETRIES,
     MAX_EVENT_CAP,
     MAX_FPS,
+    MAX_FRICTION,
+    MAX_GRAVITY,
+    MAX_ITERATIONS,
     MAX_MASS,
     MAX_NAME_LENGTH,
     MAX_OBJECT_NAME_CHARS,
@@ -32,6 +35,7 @@ from collide2d.runner.scenario.load import (
     NAME_PATTERN,
     SHAPES,
 )
+from collide2d.runner.scenario.physics import MODEL_BOUNDS
 from collide2d.runner.scenario.sections import OVERLAY_NAMES
 
 
@@ -43,6 +47,55 @@ def json_schema() -> dict:
     paper-model velocities, frame numbers up to `ticks`, convex polygons under `geometry: exact`.
     """
     number = {"type": "number"}
+    contact = {
+        "restitution": {
+            "type": "number",
+            "minimum": 0,
+            "maximum": 1,
+            "description": "e: 1 elastic (default), 0 no bounce; a contact takes the smaller e "
+            "of its two sides (stepped model; not under paper; only 1 under exact)",
+        },
+        "friction": {
+            "type": "number",
+            "minimum": 0,
+            "maximum": MAX_FRICTION,
+            "description": "Coulomb's mu, default 0; a contact takes the larger mu of its two "
+            "sides (stepped model; not under paper; only 0 under exact)",
+        },
+    }
+    stepped = {
+        "iterations": {
+            "type": "integer",
+            "minimum": 1,
+            "maximum": MAX_ITERATIONS,
+            "description": "stepped model only: velocity passes over a step's contacts, default 8",
+        },
+        "slop": {
+            "type": "number",
+            "minimum": 0,
+            "maximum": MODEL_BOUNDS["slop"][1],
+            "description": "stepped model only: overlap left in place, px, default 0.1",
+        },
+        "rest_speed": {
+            "type": "number",
+            "minimum": 0,
+            "maximum": MODEL_BOUNDS["rest_speed"][1],
+            "description": "stepped model only, under gravity: a contact approaching slower "
+            "(px/s) does not bounce; default 2 |g| times a substep",
+        },
+        "sleep": {
+            "type": "boolean",
+            "description": "stepped model only: slow bodies sleep; default true",
+        },
+        "sleep_after": {
+            "type": "number",
+            "minimum": 0,
+            "maximum": MODEL_BOUNDS["sleep_after"][1],
+            "description": "stepped model only: seconds below the rest speed before a body "
+            "sleeps, default 0.5",
+        },
+    }
+    gravity_component = {"type": "number", "minimum": -MAX_GRAVITY, "maximum": MAX_GRAVITY}
     whole_px = {"type": "integer", "minimum": 1, "description": "whole pixels"}
     xy = {"type": "array", "items": number, "minItems": 2, "maxItems": 2}
     common = {
@@ -62,6 +115,7 @@ def json_schema() -> dict:
             "maxLength": MAX_OBJECT_NAME_CHARS,
             "description": "a label in logs and reports; no two objects share one",
         },
+        **contact,
     }
     size = {
         "anyOf": [whole_px, {"type": "array", "items": whole_px, "minItems": 2, "maxItems": 2}],
@@ -165,6 +219,27 @@ def json_schema() -> dict:
                         "description": f"whole ticks per second, default {DEFAULT_FPS}",
                     },
                     "background": {"$ref": "#/$defs/color"},
+                    "gravity": {
+                        "anyOf": [
+                            gravity_component,
+                            {
+                                "type": "array",
+                                "items": gravity_component,
+                                "minItems": 2,
+                                "maxItems": 2,
+                            },
+                        ],
+                        "description": "px/s², y down: g (meaning [0, g]) or [gx, gy]; default 0 "
+                        "(stepped model; not under paper; only 0 under exact)",
+                    },
+                    "restitution": {
+                        **contact["restitution"],
+                        "description": "the walls' restitution, default 1",
+                    },
+                    "friction": {
+                        **contact["friction"],
+                        "description": "the walls' friction, default 0",
+                    },
                 },
                 "additionalProperties": False,
             },
@@ -184,6 +259,7 @@ def json_schema() -> dict:
                                 "description": "exact model only: the most wall and pair events "
                                 f"one tick may take, default {DEFAULT_MAX_EVENTS_PER_TICK:,}",
                             },
+                            **stepped,
                         },
                         "required": ["kind"],
                         "additionalProperties": False,
@@ -200,12 +276,19 @@ def json_schema() -> dict:
                                     "properties": {"kind": {"enum": ["paper", "stepped"]}},
                                     "required": ["kind", "max_events_per_tick"],
                                 },
+                                *(
+                                    {
+                                        "properties": {"kind": {"enum": ["paper", "exact"]}},
+                                        "required": ["kind", key],
+                                    }
+                                    for key in ("substeps", *stepped)
+                                ),
                             ]
                         },
                     },
                 ],
                 "description": "paper (default) | stepped | exact, or {kind, substeps, geometry, "
-                "max_events_per_tick}",
+                "max_events_per_tick, iterations, slop, rest_speed, sleep, sleep_after}",
             },
             "ticks": {"type": "integer", "minimum": 0},
             "duration": {

@@ -11,6 +11,8 @@ parsed. Columns, by name (any order; only id, shape, w, h, x, y are required):
     x, y   the top-left corner, px (whole pixels under the paper model)
     vx, vy px/s (default 0)
     mass   MIN_MASS ... MAX_MASS (default 1; empty for a static object)
+    restitution  0 ... 1 (default 1; not under the paper model, only 1 under the exact model)
+    friction     0 ... MAX_FRICTION (default 0; not under paper, only 0 under exact)
     color  a CSS name or #rrggbb (default white)
     name   text, MAX_OBJECT_NAME_CHARS at most (default none)
     static true | false (default false)
@@ -90,14 +92,18 @@ class Table:
     lines: tuple | None = None  # each object's line in the scenario, when it has its own
     sha256: str | None = None  # of the table file's bytes (None: the rows are the scenario's text)
     problems: tuple = ()  # cells at fault when read: (row, column index, order, column, text)
+    restitution: np.ndarray | None = None  # (n,) NaN where not given (None: no column)
+    friction: np.ndarray | None = None  # (n,) NaN where not given (None: no column)
 
     @property
     def n(self) -> int:
         return int(self.kind.shape[0])
 
     def error(self, row: int, column: str, message: str):
-        """The ScenarioError at the cell of `row` (from 0) and `column`."""
-        return self.where(row, column, message)
+        """The ScenarioError at the cell of `row` (from 0) and `column`, the row named by its
+        object's name when it has one (but in a message about the name itself)."""
+        name = self.names[row] if column != "name" and row < len(self.names) else None
+        return self.where(row, column, message, name)
 
 
 def table_path(scenario_path: str | None, given: str) -> tuple[str, str]:
@@ -243,6 +249,9 @@ def _check(data, place) -> Table:
     mass = _mass(data, refuse)
     rgb, color_of = _colors(data, refuse)
     names_out = _names(data, refuse)
+    contact = {
+        key: number(key, np.nan) if key in names else None for key in ("restitution", "friction")
+    }
     return Table(
         path=place.shown,
         kind=kind,
@@ -257,6 +266,7 @@ def _check(data, place) -> Table:
         names=names_out,
         where=place,
         problems=tuple(problems),
+        **contact,
     )
 
 
@@ -267,24 +277,30 @@ _COLUMN_OF = {
     "box": ("x", "y"),
     "velocity": ("vx", "vy"),
     "mass": ("mass", "mass"),
+    "restitution": ("restitution", "restitution"),
+    "friction": ("friction", "friction"),
 }
 
 
-def checked(table: Table, world, paper: bool) -> Table:
+def checked(table: Table, world, paper: bool, elastic: bool = False) -> Table:
     """The table with every rule of objects checked (runner.scenario.rules) in `world` (None:
-    its bounds and rates wait for a good world), under the paper model's rules when `paper`:
-    the first fault of a cell, in row order and then the file's column order, raised at its
-    cell; else the table, static objects still and of infinite mass."""
-    cols = rule.Columns(table.size, table.pos, table.vel, table.mass, table.static)
+    its bounds and rates wait for a good world), under the paper model's rules when `paper` (the
+    exact model's when `elastic`): the first fault of a cell, in row order and then the file's
+    column order, raised at its cell; else the table, static objects still and of infinite
+    mass."""
+    cols = rule.Columns(
+        table.size, table.pos, table.vel, table.mass, table.static,
+        restitution=table.restitution, friction=table.friction,
+    )  # fmt: skip
     problems = list(table.problems)
     header = table.where.header
     fps, bounds = (world.fps, (world.width, world.height)) if world is not None else (None, None)
-    for f in rule.faults(cols, paper, fps, bounds):
+    for f in rule.faults(cols, paper, fps, bounds, elastic):
         column = _COLUMN_OF[f.field][f.axis]
         problems.append((f.row, header.index(column), len(problems), column, f.text))
     if problems:
         r, _, _, column, message = min(problems)
-        raise table.where(r, column, message)
+        raise table.error(r, column, message)
     static = table.static
     return dataclasses.replace(
         table,

@@ -37,9 +37,12 @@ from collide2d.runner.scenario.limits import Limits
 from collide2d.runner.scenario.parse import ScenarioError
 from collide2d.runner.scenario.rules import MAX_OBJECT_NAME_CHARS
 
-COLUMNS = ("id", "shape", "w", "h", "x", "y", "vx", "vy", "mass", "color", "name", "static", "fill")
+COLUMNS = (
+    "id", "shape", "w", "h", "x", "y", "vx", "vy", "mass", "color", "name", "static", "fill",
+    "restitution", "friction",
+)  # fmt: skip
 REQUIRED = ("id", "shape", "w", "h", "x", "y")
-NUMBERS = ("id", "w", "h", "x", "y", "vx", "vy")
+NUMBERS = ("id", "w", "h", "x", "y", "vx", "vy", "restitution", "friction")
 # Longest text a cell may hold, per text column (characters, as written); wider columns would cost
 # memory for every row. A name's bound is the one every object name has (runner.scenario.rules).
 TEXT_CHARS = {
@@ -67,9 +70,12 @@ class Place:
         self.header = header
         self.text = text
 
-    def __call__(self, row: int, column: str, message: str) -> ScenarioError:
+    def __call__(self, row: int, column: str, message: str, name=None) -> ScenarioError:
+        """The error `message` at the cell of `row` (from 0) and `column`, the row named by the
+        object's `name` when it has one: `row 4 (ball), column w: ...`."""
         col = self.header.index(column) if column in self.header else 0
-        message = f"row {row + 1}, column {column}: {message}" if column else message
+        named = f" ({name})" if name else ""
+        message = f"row {row + 1}{named}, column {column}: {message}" if column else message
         if self.text is None:  # .npy: row counted from 1, the field's number
             return ScenarioError(self.shown, row + 1, col + 1, message)
         line, char = _csv_cell(self.text, row, col)
@@ -96,7 +102,8 @@ def header_error(shown: str, header: list[str]) -> None:
             1,
             1,
             f"the table lacks the column(s) {', '.join(missing)} (header: id, shape, "
-            "w, h, x, y and optionally vx, vy, mass, color, name, static, fill)",
+            "w, h, x, y and optionally vx, vy, mass, color, name, static, fill, restitution, "
+            "friction)",
         )
 
 

@@ -118,3 +118,54 @@ def test_duplicate_object_names_are_refused():
     )
     assert (err.line, err.col) == (4, 5)
     assert "objects[1] is named 'a', like object 0 (line 3); names must differ" in err.message
+
+
+def test_an_object_with_a_name_is_named_in_its_messages():
+    text = (
+        "version: 1\nobjects:\n  - {name: floor, shape: box, size: 20, position: [1, 1]}\n"
+        "  - {name: ball, shape: box, size: 2, position: [50, 5], mass: -1}\n"
+        "  - {shape: box, size: 4, position: [15, 15]}\n"
+    )
+    assert "objects[1] (ball).mass must be at least 1e-15, not -1" in str(refused(text))
+    # an object it overlaps is named too, and an object without a name by its place alone
+    err = refused(text.replace("mass: -1", "mass: 1"))
+    assert "objects[2] (line 5) overlaps objects[0] (floor, line 3) at the start" in str(err)
+
+
+def test_a_runaway_names_the_objects_it_stopped_on():
+    from collide2d.engine.errors import NoRoom
+    from collide2d.runner.run import _names_of
+
+    said = _names_of(NoRoom("objects 1 and 2 have no room", (1, 2)), ("a", "cup", None))
+    assert said == " (object 1 is cup)"
+    assert _names_of(NoRoom("object 2", (2,)), ("a", "cup", None)) == ""
+
+
+@pytest.mark.parametrize(
+    "text, said",
+    [
+        # a physics collide2d lacks: said so, never "did you mean 'position'?"
+        ("objects:\n  - {shape: box, size: 2, position: [1, 1], rotation: 45}",
+         "unknown key 'rotation' in object; collide2d has no rotation"),
+        ("objects:\n  - {shape: box, size: 2, position: [1, 1], angular_velocity: 1}",
+         "collide2d has no rotation: objects keep their orientation"),
+        ("objects:\n  - {shape: box, size: 2, position: [1, 1], damping: 0.1}",
+         "collide2d has no damping"),
+        ("objects:\n  - {shape: box, size: 2, position: [1, 1], density: 3}",
+         "collide2d has no density: give an object's mass"),
+        ("generate:\n  - {count: 2, shape: box, size: 2, torque: 3}", "collide2d has no rotation"),
+        # a key of another section: where it belongs
+        ("gravity: 980", "unknown key 'gravity' in the scenario; gravity belongs to the world"),
+        ("model: paper\nsubsteps: 4", "substeps is a model setting: model: {kind: ..., substeps"),
+        ("world: {iterations: 4}", "unknown key 'iterations' in world; iterations is a model"),
+        ("model: {kind: stepped, gravity: 9}", "in model; gravity belongs to the world"),
+        ("model: {kind: stepped, friction: 1}", "friction belongs to each object, or to world"),
+        # a key of another name
+        ("objects:\n  - {shape: box, size: 2, position: [1, 1], elasticity: 0.5}",
+         "did you mean 'restitution'? (collide2d calls it restitution"),
+    ],
+)  # fmt: skip
+def test_a_key_collide2d_lacks_or_keeps_elsewhere_says_so(text, said):
+    err = refused("version: 1\n" + text + "\n")
+    assert said in str(err)
+    assert "did you mean 'position'" not in str(err)

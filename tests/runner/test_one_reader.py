@@ -189,11 +189,13 @@ def test_the_same_mistake_is_refused_in_the_same_words_at_its_object(
     col = written.index(key) + len(key) + 1 if key else written.index("{") + 1
     assert (err["list"].line, err["list"].col) == (line, col)
     field = {"size: [": ".size w", "mass: ": ".mass", "velocity: [": ".velocity x"}
-    subject = f"objects[{K}]" + field.get(key, ".position x" if key else "")
+    name = objects[K]["name"]  # a named object is named beside its place
+    subject = f"objects[{K}] ({name})" + field.get(key, ".position x" if key else "")
     other = None
     if "{other}" in words:
-        subject += f" (line {line})"
-        other = f"objects[{K - 1}] (line {line - 1})"
+        subject = f"objects[{K}] ({name}, line {line})"
+        before = f"{objects[K - 1]['name']}, " if objects[K - 1]["name"] else ""
+        other = f"objects[{K - 1}] ({before}line {line - 1})"
     said = {"list": _after(err["list"].message, subject + " ", other)}
 
     # the tables: at the cell of row K + 1 and the column, after "row R, column C: "
@@ -203,8 +205,9 @@ def test_the_same_mistake_is_refused_in_the_same_words_at_its_object(
     assert (err["csv"].line, err["csv"].col) == (K + 2, cell)
     assert (err["npy"].line, err["npy"].col) == (K + 1, at + 1)
     for form in ("csv", "npy"):
-        other = f"object {K - 1} (row {K})" if "{other}" in words else None
-        said[form] = _after(err[form].message, f"row {K + 1}, column {column}: ", other)
+        before = f"{objects[K - 1]['name']}, " if objects[K - 1]["name"] else ""
+        other = f"object {K - 1} ({before}row {K})" if "{other}" in words else None
+        said[form] = _after(err[form].message, f"row {K + 1} ({name}), column {column}: ", other)
     assert said == {"list": words, "csv": words, "npy": words}
 
 

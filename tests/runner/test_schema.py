@@ -97,6 +97,13 @@ GOOD_DOCS = [
     ),
     BASE + "generate:\n  - {count: 3, shape: circle, diameter: 4, velocity: {min: [-1, -1], "
     "max: [1, 1]}, seed: 2}\n",
+    # gravity, restitution and friction (docs/scenario-format.md#gravity-restitution-and-friction)
+    "version: 1\nworld: {gravity: [0, 980], restitution: 0.5, friction: 0.1}\n"
+    "model: {kind: stepped, iterations: 8, slop: 0.1, rest_speed: 2, sleep: true, "
+    "sleep_after: 0.5}\nobjects:\n  - {shape: box, size: 5, position: [0, 0], restitution: 0.2, "
+    "friction: 0.3}\ngenerate:\n  - {count: 3, shape: circle, diameter: 4, restitution: 0}\n",
+    "version: 1\nworld: {gravity: 980}\nmodel: stepped\n",
+    "version: 1\nworld: {gravity: 0, restitution: 1, friction: 0}\nmodel: exact\n",
 ]
 
 
@@ -122,6 +129,16 @@ def test_schema_accepts_good_documents(text):
         BASE + "model: {kind: exact, max_events_per_tick: 0}\n",
         BASE + "golden: {color_threshold: 300}\n",
         BASE + "name: ../x\n",
+        "version: 1\nworld: {gravity: [1, 2, 3]}\nmodel: stepped\n",
+        "version: 1\nworld: {restitution: 2}\nmodel: stepped\n",
+        "version: 1\nworld: {gravity: 2e12}\nmodel: stepped\n",
+        objects("{shape: box, size: 3, position: [0, 0], friction: -1}"),
+        objects("{shape: box, size: 3, position: [0, 0], restitution: 1.5}"),
+        BASE + "model: {kind: exact, iterations: 3}\n",
+        BASE + "model: {kind: paper, sleep: true}\n",
+        BASE + "model: {kind: stepped, iterations: 0}\n",
+        BASE + "model: {kind: stepped, sleep: 3}\n",
+        BASE + "model: {kind: stepped, slop: -1}\n",
         BASE + "generate:\n  - {count: 3, shape: box, size: 3, speed: 1, velocity: {min: [0, 0], "
         "max: [0, 0]}}\n",
     ],

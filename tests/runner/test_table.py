@@ -133,7 +133,7 @@ def refusal(tmp_path, rows, limits=None, **kw) -> ScenarioError:
         ("3,box,10,10,150,80,5,-10,0,red,,false,false", "mass", "mass: must be at least 1e-15"),
         ("3,box,10,10,150,80,5,-10,1,red,,maybe,false", "static", "must be true or false"),
         ("3,box,10,10,150,80,5,-10,1,red,,true,false", "vx", "static, so it cannot move"),
-        ("3,box,10,10,5,5,5,-10,1,red,,false,false", "x", "x: overlaps object 0 (row 1)"),
+        ("3,box,10,10,5,5,5,-10,1,red,,false,false", "x", "x: overlaps object 0 (left, row 1)"),
         ("3,box,10,10,150,80,5", "id", "row 4 has 7 fields; the header names 13"),
         ("3,circle,10,8,150,80,5,-10,1,red,,false,false", "h", "diameter and must be equal"),
     ],

@@ -89,7 +89,8 @@ def general(source: str, **kw):
 
 
 def same(a, b):
-    for field in ("kind", "pos", "size", "vel", "mass", "static", "vert_start", "verts"):
+    fields = ("kind", "pos", "size", "vel", "mass", "static", "vert_start", "verts")
+    for field in (*fields, "restitution", "friction"):
         x, y = getattr(a.bodies, field), getattr(b.bodies, field)
         assert x.dtype == y.dtype and x.tobytes() == y.tobytes(), field
     assert a.bodies.looks.color.tobytes() == b.bodies.looks.color.tobytes()
