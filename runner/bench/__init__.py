@@ -40,7 +40,7 @@ The parts, each selectable with `--part`:
 
 One module per concept: `scenes` (the standard scene and where the benchmark scenarios are),
 `timing` (how a run is timed), one module per part (`scaling`, `peers`, `error`, `skips`,
-`targets`, `paper`, `exact`, `raster`, `coldstart` for jit), `report` (bench.csv and bench.md),
+`targets` (and jit), `paper`, `exact`, `raster`), `report` (bench.csv and bench.md),
 `plots` (the PNG plots) and `cli` (the subcommand; it loads the parts only when `collide2d bench`
 runs).
 

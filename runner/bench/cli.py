@@ -22,7 +22,7 @@ from collide2d.engine import models
 from collide2d.runner.command.exitcodes import EXIT_BAD_INPUT, EXIT_DIFFERENCE, EXIT_OK
 
 PARTS = ("scaling", "error", "peers", "skips", "targets", "paper", "exact", "raster")
-PARTS += ("stages", "load", "jit")  # runner/bench/stages.py, load.py, coldstart.py
+PARTS += ("stages", "load", "jit")  # runner/bench/stages.py, load.py, targets.py
 DEFAULT_PARTS = ("scaling", "error", "skips", "targets")
 FILE_PARTS = ("error", "skips", "targets", "paper", "raster", "jit")  # read scenarios/*.yaml
 REPORT_DIR = "bench"
@@ -153,9 +153,7 @@ def _run_parts(args, parts, ns, models_, quick, in_process, folder, echo) -> tup
         rows += load.load(quick, echo)
     if "jit" in parts:
         echo.part("jit")
-        from collide2d.runner.bench import coldstart
-
-        rows += coldstart.coldstart(quick, echo, folder)
+        rows += targets.cold_start(quick, echo, folder)
     return rows, time.perf_counter() - began
 
 

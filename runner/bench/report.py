@@ -19,6 +19,7 @@ from collide2d.runner.bench.scenes import (
     STANDARD_SIZE_PX,
     STANDARD_SPEEDS,
 )
+from collide2d.runner.bench.targets import AUTO_WITHIN
 from collide2d.runner.output import escape
 
 # The parts whose rows are one figure each (`value`, described by `note`), and their titles.
@@ -312,9 +313,7 @@ def markdown(rows: list[dict], args_line: str, seconds: float) -> str:
         lines += _table(header, [[r.get(k) for k in keys] for r in part]) + [""]
     part = [r for r in rows if r["part"] == "jit"]
     if part:
-        from collide2d.runner.bench import coldstart
-
-        lines += coldstart.markdown(part)
+        lines += _jit_section(part)
     for name, title in FIGURE_PARTS.items():
         part = [r for r in rows if r["part"] == name]
         if part:
@@ -323,6 +322,24 @@ def markdown(rows: list[dict], args_line: str, seconds: float) -> str:
             keys = ["note", "scene", "n", "value"]
             lines += _table(header, [[r.get(k) for k in keys] for r in part]) + [""]
     return "\n".join(lines) + "\n"
+
+
+def _jit_section(rows: list[dict]) -> list[str]:
+    """bench.md's section of the jit part."""
+    lines = ["## Compiled, interpreted or auto, from an empty kernel cache", ""]
+    lines.append(
+        "`collide2d run FILE --jit MODE`, each in a fresh process with an empty NUMBA_CACHE_DIR, "
+        "wall seconds; `off` stopped once past the slower of the other two (> s). auto/faster: "
+        f"`auto` over the faster of `on` and `off` (target <= {AUTO_WITHIN:g})."
+    )
+    lines.append("")
+    header = ["scene", "bodies", "ticks", "on s", "off s", "auto s", "auto took", "auto/faster"]
+    body = []
+    for r in rows:
+        off = f"> {r['off_s']:.1f}" if r["off_stopped"] else f"{r['off_s']:.2f}"
+        body.append([r["scene"], r["n"], r["ticks"], f"{r['on_s']:.2f}", off,
+                     f"{r['auto_s']:.2f}", r["note"], f"{r['ratio']:.2f}"])  # fmt: skip
+    return lines + _table(header, body) + [""]
 
 
 def _machine() -> str:

@@ -1,11 +1,12 @@
-"""runner.bench.coldstart, the jit part: its scenes (the bundled scenarios, the bench's, a grid of
-10 to 5,000 bodies and 10 to 100,000 ticks), a lane run in a fresh process from an empty kernel
-cache, `off` stopped once it cannot be the faster, and auto against the faster lane in the rows,
-the headline and bench.md."""
+"""runner.bench.targets.cold_start, the jit part: its scenes (the bundled scenarios, the bench's,
+a grid of 10 to 5,000 bodies and 10 to 100,000 ticks), a lane run in a fresh process from an
+empty kernel cache, `off` stopped once it cannot be the faster, and auto against the faster lane
+in the rows, the headline and bench.md."""
 
 from __future__ import annotations
 
-from collide2d.runner.bench import coldstart, report
+from collide2d.runner.bench import report
+from collide2d.runner.bench import targets as coldstart
 from collide2d.runner.bench.scenes import PROJECT_SCENARIOS
 
 
@@ -17,7 +18,7 @@ def test_the_scenes_span_the_bundled_ones_and_the_grid(tmp_path):
     found = coldstart.scene_files(PROJECT_SCENARIOS, tmp_path, quick=False)
     names = [name for name, *_ in found]
     bundled = sorted(p.stem for p in PROJECT_SCENARIOS.glob("*.yaml"))
-    assert names[: len(bundled)] == bundled
+    assert names[-len(bundled) :] == bundled
     assert "two-body-chain" in names and any(n.startswith("standard-") for n in names)
     grid = [(n, ticks) for name, _, n, ticks in found if name.startswith("grid-")]
     assert min(n for n, _ in grid) == 10 and max(n for n, _ in grid) == 5_000
@@ -44,11 +45,11 @@ def test_rows_compare_auto_with_the_faster_lane(monkeypatch, tmp_path):
         return (limit, "stopped") if limit is not None and wall > limit else (wall, lane)
 
     monkeypatch.setattr(coldstart, "run_cold", fake)
-    rows = coldstart.coldstart(True, quiet)
+    rows = coldstart.cold_start(True, quiet)
     assert rows and all(r["ratio"] == 3.0 / 2.5 and r["met"] for r in rows)
     times["off"] = (99.0, "interpreted")  # stopped at the slower of on and auto: on is the faster
     times["auto"] = (16.0, "interpreted, then compiled")
-    rows = coldstart.coldstart(True, quiet)
+    rows = coldstart.cold_start(True, quiet)
     assert all(r["off_stopped"] and r["off_s"] == 17.0 and r["ratio"] == 1.6 for r in rows)
     assert not any(r["met"] for r in rows)
     what, figure, target, met = [h for h in report.headline(rows) if "--jit auto" in h[0]][0]
