@@ -86,8 +86,9 @@ def cold_seconds(kernel) -> float:
 
 
 def lower_bound(kernels) -> float:
-    """The least `seconds(kernels)` can be, every kernel cached; loads nothing."""
-    return start_seconds() + CACHED_LOAD_S * len(kernels)
+    """The least `seconds(kernels)` can be (numba's start, when it has not started: the kernels
+    may all be compiled in this process already); loads nothing."""
+    return start_seconds()
 
 
 def start_seconds() -> float:
