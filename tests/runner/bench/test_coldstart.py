@@ -46,13 +46,16 @@ def test_rows_compare_auto_with_the_faster_lane(monkeypatch, tmp_path):
 
     monkeypatch.setattr(coldstart, "run_cold", fake)
     rows = coldstart.cold_start(True, quiet)
+    # on stopped once past both others (3.0 + 1 s): it cannot be the faster
     assert rows and all(r["ratio"] == 3.0 / 2.5 and r["met"] for r in rows)
-    times["off"] = (99.0, "interpreted")  # stopped at the slower of on and auto: on is the faster
+    assert all(r["on_stopped"] and r["on_s"] == 4.0 and not r["off_stopped"] for r in rows)
+    times["off"] = (99.0, "interpreted")  # stopped past 3 x auto + 2 s: on is the faster
     times["auto"] = (16.0, "interpreted, then compiled")
     rows = coldstart.cold_start(True, quiet)
-    assert all(r["off_stopped"] and r["off_s"] == 17.0 and r["ratio"] == 1.6 for r in rows)
+    assert all(r["off_stopped"] and r["off_s"] == 50.0 and r["ratio"] == 1.6 for r in rows)
+    assert not any(r["on_stopped"] for r in rows)
     assert not any(r["met"] for r in rows)
     what, figure, target, met = [h for h in report.headline(rows) if "--jit auto" in h[0]][0]
     assert (figure, target, met) == ("1.60", "<= 1.5", "✗")
     md = report.markdown(rows, "collide2d bench --part jit", 1.0)
-    assert "## Compiled, interpreted or auto" in md and "> 17.0" in md
+    assert "## Compiled, interpreted or auto" in md and "> 50.0" in md
