@@ -13,7 +13,7 @@ import sys
 from pathlib import Path
 
 # (name, model, shape, bodies, ticks): a mix of what a project's regression suite holds, a few
-# bodies over many ticks for most, a few gases; about 360,000 object-ticks in all.
+# bodies over many ticks for most, a few gases; 202,500 object-ticks in all.
 SUITE = (
     ("pair_head_on", "paper", "box", 2, 200),
     ("pair_glancing", "exact", "circle", 2, 300),

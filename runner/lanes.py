@@ -15,9 +15,10 @@ compares
   compilation as it slows the ticks) plus the ticks left at COMPILED_SPEEDUP times the pace,
 
 and goes on compiled, for good, between two ticks (the state is the same arrays; both lanes give
-the same bytes) as soon as compiling pays. So a run never pays for more than its work: a small
-one, or a long one whose kernels would take longer to compile than it takes to interpret, is done
-interpreted, numba never loaded; a big one compiles after a short look (PROBE_S); one whose
+the same bytes) as soon as compiling pays, by SWITCH_MARGIN (the estimate's error on a busy
+machine). So a run never pays for much more than its work: a small one, or a long one whose
+kernels would take longer to compile than it takes to interpret, is done interpreted, numba never
+loaded; a big one compiles after a short look (PROBE_S); one whose
 kernels numba's cache holds goes compiled after a tick or two, for the cost of loading them. The
 kernels a run needs are the ones it calls (engine.jit.recording), not every kernel. The first
 chunks are short (1, 1, 2, 4, ... ticks) so that a slow scene is measured after a tick or two.
@@ -57,6 +58,10 @@ COMPILED_SPEEDUP = 20
 PROBE_S = 0.1
 # The least share of a core a run is taken to get (a compile estimate is divided by its share).
 MIN_SHARE = 0.1
+# A switch must save this many times the compile estimate: on a busy machine (load 15 on 2 cores)
+# the paper model's kernels for 1,000 boxes took 1.6 to 2 times their estimate to compile, while
+# interpreting went at the measured pace; past the margin, compiling wins even then.
+SWITCH_MARGIN = 1.5
 # Seconds a switch must save, at the least, to be looked at (a tiny run never looks).
 MIN_SAVED_S = 0.05
 # Seconds an interpreted exact-model event takes (about 0.4 ms on this project's machine), for
@@ -176,7 +181,7 @@ class RunLane:
         cost = self.ready_seconds()
         if spent < PROBE_S and cost > spent:
             return  # measure longer before paying more than has been measured
-        if saved > cost:
+        if saved > SWITCH_MARGIN * cost:
             self.compiled, self.may_switch = True, False
 
     def ready_seconds(self) -> float:
