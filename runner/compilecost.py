@@ -85,15 +85,16 @@ def cold_seconds(kernel) -> float:
     return table()["kernels"].get(name(kernel), UNKNOWN_KERNEL_S)
 
 
-def lower_bound(kernels) -> float:
-    """The least `seconds(kernels)` can be (numba's start, when it has not started: the kernels
-    may all be compiled in this process already); loads nothing."""
-    return start_seconds()
+def lower_bound(kernels, share: float = 1.0) -> float:
+    """The least `seconds(kernels, share)` can be (numba's start, when it has not started: the
+    kernels may all be compiled in this process already); loads nothing."""
+    return start_seconds(share)
 
 
-def start_seconds() -> float:
-    """Seconds to start numba: NUMBA_START_S, or nothing once it is loaded."""
-    return 0.0 if jit.loaded() else NUMBA_START_S
+def start_seconds(share: float = 1.0) -> float:
+    """Wall seconds to start numba getting `share` of a core: NUMBA_START_S / share, or nothing
+    once it is loaded."""
+    return 0.0 if jit.loaded() else NUMBA_START_S / share
 
 
 def parts(kernel, cache_empty: bool = False) -> tuple[float, float]:
@@ -113,12 +114,12 @@ def seconds(kernels, share: float = 1.0) -> float:
     cached loads, compilations (loads numba to look at its cache, unless it surely holds
     nothing)."""
     empty = not jit.loaded() and jit.cache_empty()
-    total = start_seconds()
+    total = start_seconds(share)
     load = cold = 0.0
     for kernel in kernels:
         loading, compiling = parts(kernel, empty)
         load, cold = load + loading, cold + compiling
-    return total + load + (cold * speed_factor() / share if cold else 0.0)
+    return total + (load + (cold * speed_factor() if cold else 0.0)) / share
 
 
 # The kernels a model's run calls, by the prefixes of their names (for `model_seconds`, before a
@@ -134,9 +135,9 @@ MODEL_KERNELS = {
 
 def model_seconds(model: str) -> float:
     """CPU seconds to start numba and compile the kernels of `model`'s runs ("load": of loading a
-    scenario) from an empty cache (the table's kernels under MODEL_KERNELS' prefixes, scaled to
-    the machine now), for a comparison with the CPU time of interpreting."""
+    scenario) from an empty cache, on the table's machine (the table's kernels under
+    MODEL_KERNELS' prefixes), for a comparison with interpreting measured on that machine too (a
+    slower or busier machine slows both alike)."""
     prefixes = MODEL_KERNELS[model]
     kernels = table()["kernels"]
-    cold = sum(s for name, s in kernels.items() if name.startswith(prefixes))
-    return NUMBA_START_S + cold * speed_factor()
+    return NUMBA_START_S + sum(s for name, s in kernels.items() if name.startswith(prefixes))

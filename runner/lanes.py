@@ -176,30 +176,34 @@ class RunLane:
         spent = _clock() - self.began
         left = spent / self.done * (self.ticks - self.done)
         saved = left * (1 - 1 / COMPILED_SPEEDUP)  # by going on compiled, once ready
-        if saved <= max(MIN_SAVED_S, compilecost.lower_bound(self.called)):
+        share = self.share(spent)
+        if saved <= max(MIN_SAVED_S, compilecost.lower_bound(self.called, share)):
             return
-        cost = self.ready_seconds()
+        if spent < PROBE_S and not jit.loaded():
+            return  # measure longer before looking at numba's cache (which loads numba)
+        cost = self.ready_seconds(share)
         if spent < PROBE_S and cost > spent:
             return  # measure longer before paying more than has been measured
         if saved > SWITCH_MARGIN * cost:
             self.compiled, self.may_switch = True, False
 
-    def ready_seconds(self) -> float:
-        """Seconds to get the kernels called so far ready to run compiled (runner.compilecost);
-        each kernel is looked up once per run."""
+    def share(self, spent: float) -> float:
+        """The share of a core this run's ticks have had (its CPU time over its wall time): a
+        compilation, and numba's start, get about as much."""
+        cpu = _cpu() - self.began_cpu
+        return min(max(cpu / max(spent, 1e-9), MIN_SHARE), 1.0)
+
+    def ready_seconds(self, share: float = 1.0) -> float:
+        """Wall seconds to get the kernels called so far ready to run compiled, getting `share`
+        of a core (runner.compilecost); each kernel is looked up once per run."""
         if self._empty is None:
             self._empty = not jit.loaded() and jit.cache_empty()
         for kernel in [k for k in self.called if k not in self._ready]:
             self._ready[kernel] = compilecost.parts(kernel, self._empty)
         load = sum(part[0] for part in self._ready.values())
         cold = sum(part[1] for part in self._ready.values())
-        if not cold:
-            return compilecost.start_seconds() + load
-        # the share of a core this run's ticks got: a compilation gets about as much
-        wall = max(_clock() - self.began, 1e-9) if self.began is not None else 1.0
-        cpu = _cpu() - self.began_cpu if self.began is not None else 1.0
-        share = min(max(cpu / wall, MIN_SHARE), 1.0)
-        return compilecost.start_seconds() + load + cold * compilecost.speed_factor() / share
+        scaled = cold * compilecost.speed_factor() if cold else 0.0
+        return compilecost.start_seconds(share) + (load + scaled) / share
 
     def name(self) -> str:
         """How the summary names the lanes the run took."""

@@ -61,7 +61,7 @@ def auto_mode(monkeypatch):
 
 def _ready_in(monkeypatch, seconds: float, probe_s: float = 0.0) -> None:
     """Every run's kernels take `seconds` to get ready; decisions from `probe_s` on."""
-    monkeypatch.setattr(lanes.RunLane, "ready_seconds", lambda self: seconds)
+    monkeypatch.setattr(lanes.RunLane, "ready_seconds", lambda self, share=1.0: seconds)
     monkeypatch.setattr(lanes, "PROBE_S", probe_s)
     monkeypatch.setattr(lanes, "MIN_SAVED_S", 0.0)
 
@@ -82,10 +82,11 @@ def _looked_at(monkeypatch, spent: float, cost: float, loaded: bool = True) -> b
     to get ready."""
     lane = lanes.RunLane(loads(GAS), 0)
     assert lane.may_switch and not lane.compiled
-    monkeypatch.setattr(lanes.RunLane, "ready_seconds", lambda self: cost)
+    monkeypatch.setattr(lanes.RunLane, "ready_seconds", lambda self, share=1.0: cost)
     monkeypatch.setattr(compilecost.jit, "loaded", lambda: loaded)
     monkeypatch.setattr(lanes, "_clock", lambda: 100.0 + spent)
-    lane.began, lane.done = 100.0, 10
+    monkeypatch.setattr(lanes, "_cpu", lambda: 100.0 + spent)  # a whole core
+    lane.began, lane.began_cpu, lane.done = 100.0, 100.0, 10
     lane._decide()
     return lane.compiled
 
@@ -109,7 +110,7 @@ def test_the_switch_weighs_the_ticks_left_against_compiling(monkeypatch):
 def test_the_cost_counts_the_kernels_the_run_called_not_every_kernel(monkeypatch):
     seen = []
 
-    def ready(self):
+    def ready(self, share=1.0):
         seen.append({compilecost.name(k) for k in self.called})
         return 1e9
 
@@ -171,7 +172,7 @@ def test_a_run_that_switches_mid_run_gives_the_same_bytes(monkeypatch, after):
     lanes.set_mode(None)
     looks = []
 
-    def ready(self):
+    def ready(self, share=1.0):
         looks.append(self.done)
         return 0.0 if len(looks) >= after else 1e9
 
