@@ -8,9 +8,11 @@ each with `--jit auto` (the default) and `--jit on` (every kernel compiled, as b
 interleaved, medians with the spread; every command runs from an empty temporary folder (`check`
 with `--root` this repository), Python's bytecode cached there as an installation has it
 (collide2d.runner.bench.targets.user_env). `--python PY` runs another installation's collide2d
-(a fresh virtualenv holding a wheel, say). Usage:
+(a fresh virtualenv holding a wheel, say); `--modes auto,off` compares other modes, `--root DIR`
+checks another project's scenarios, `--check-only` times the cold check alone. Usage:
 
     python benchmarks/first_run.py [--repeats 3] [--warm-repeats 9] [--python PY]
+        [--modes auto,on] [--root DIR] [--check-only]
 """
 
 from __future__ import annotations
@@ -58,24 +60,34 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=3, help="cold runs of each (default 3)")
     parser.add_argument("--warm-repeats", type=int, default=9, help="warm runs (default 9)")
     parser.add_argument("--python", default=sys.executable, help="the Python to run collide2d")
+    parser.add_argument(
+        "--modes", default="auto,on", help="--jit modes compared, comma-separated (default auto,on)"
+    )
+    parser.add_argument(
+        "--root", type=Path, default=ROOT, help="the project `check` runs (default: this one)"
+    )
+    parser.add_argument("--check-only", action="store_true", help="only the cold `check`")
     args = parser.parse_args()
+    modes = args.modes.split(",")
     COMMAND[0] = args.python
     results: dict[str, list[float]] = {}
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
         out = str(work / "out")
         small = str(ROOT / "scenarios" / "tunnelling_1fps.yaml")
+        root = str(args.root.resolve())
         for _ in range(args.repeats):
-            for mode in ("auto", "on"):
-                demo = cold(["run", "--out", out, "--quiet", "--jit", mode], work, work)
-                results.setdefault(f"demo, empty cache, --jit {mode}", []).append(demo)
-                check = cold(["check", "--root", str(ROOT), "--quiet", "--jit", mode], work, work)
+            for mode in modes:
+                if not args.check_only:
+                    demo = cold(["run", "--out", out, "--quiet", "--jit", mode], work, work)
+                    results.setdefault(f"demo, empty cache, --jit {mode}", []).append(demo)
+                check = cold(["check", "--root", root, "--quiet", "--jit", mode], work, work)
                 results.setdefault(f"check, empty cache, --jit {mode}", []).append(check)
         warm = work / "warm"
-        for mode in ("auto", "on"):  # fill the cache first
+        for mode in modes if not args.check_only else ():  # fill the cache first
             timed(["run", small, "--out", out, "--quiet", "--jit", mode], warm, work)
-        for _ in range(args.warm_repeats):
-            for mode in ("auto", "on"):
+        for _ in range(args.warm_repeats if not args.check_only else 0):
+            for mode in modes:
                 took = timed(["run", small, "--out", out, "--quiet", "--jit", mode], warm, work)
                 results.setdefault(f"small run, cached, --jit {mode}", []).append(took)
     load = os.getloadavg()[0]

@@ -15,7 +15,11 @@ source of their package is as it was (`_package_cache`): numba itself checks onl
 file, though the code it keeps has the kernels it calls compiled in.
 
 The lane is a context variable: `compiled()` says which lane this thread runs, and
-`lane(compiled)` sets it for a `with` block (the runner picks one per run, `runner.lanes`). The
+`lane(compiled)` sets it for a `with` block (the runner picks one per run and may switch it
+between two chunks of ticks, `runner.lanes`). What the runner weighs comes from here too:
+`recording()` collects the kernels a block calls interpreted (the kernels a run needs, not all),
+`readiness(kernel)` says whether one is compiled in this process, cached on disk or cold, and
+`cache_empty()` whether numba's cache surely holds none, without loading numba. The
 default is compiled, unless the environment says `COLLIDE2D_JIT=0` (or numba's own
 `NUMBA_DISABLE_JIT=1`). Both lanes give the same bytes: the kernels' arithmetic is int64 and
 float64 in both, and the golden tests run every scenario in both lanes.
@@ -64,11 +68,67 @@ def _default_compiled() -> bool:
 
 _DEFAULT = _default_compiled()
 _compiled: ContextVar[bool] = ContextVar("collide2d_compiled", default=_DEFAULT)
+# While a `recording()` block is open in this thread: the kernels called interpreted in it.
+_called: ContextVar[set | None] = ContextVar("collide2d_called", default=None)
 
 
 def compiled() -> bool:
     """Whether kernels called from this thread now run compiled."""
     return _compiled.get()
+
+
+@contextlib.contextmanager
+def recording():
+    """A `with` block that yields the set of kernels called interpreted inside it (the set grows
+    as they are called; a kernel called only from compiled code is not seen)."""
+    called: set = set()
+    token = _called.set(called)
+    try:
+        yield called
+    finally:
+        _called.reset(token)
+
+
+def loaded() -> bool:
+    """Whether numba is loaded in this process (engine.jit loads it on the first compiled call)."""
+    return _numba is not None
+
+
+def cache_empty() -> bool:
+    """True when numba's cache surely holds no kernel of collide2d: NUMBA_CACHE_DIR is set and
+    holds no index file, or it is not set and the package's own cache folders (beside the sources,
+    where numba writes while it may) hold none; False when it may hold one. Loads nothing."""
+    folder = os.environ.get("NUMBA_CACHE_DIR", "")
+    if folder:
+        return not _has_index(folder)
+    engine = os.path.dirname(os.path.abspath(__file__))
+    roots = [engine, os.path.join(os.path.dirname(engine), "runner")]
+    if not all(os.access(root, os.W_OK) for root in roots):
+        return False  # numba writes to its user-wide folder instead: not looked at here
+    return not any(_has_index(root) for root in roots)
+
+
+def _has_index(folder: str) -> bool:
+    """Whether a numba cache index (*.nbi) lies anywhere under `folder`."""
+    for _, _, files in os.walk(folder):
+        if any(name.endswith(".nbi") for name in files):
+            return True
+    return False
+
+
+def readiness(kernel: Kernel) -> str:
+    """How far `kernel` is from running compiled: "compiled" (this process has compiled or loaded
+    it), "cached" (numba's cache on disk has code of it, fresh for these sources) or "cold" (it
+    would compile). Imports numba."""
+    dispatcher = kernel.dispatcher
+    if dispatcher.overloads:
+        return "compiled"
+    cache = getattr(dispatcher, "_cache", None)
+    index = getattr(cache, "_cache_file", None)
+    try:
+        return "cached" if index is not None and index._load_index() else "cold"
+    except Exception:  # an unreadable index: numba would compile
+        return "cold"
 
 
 @contextlib.contextmanager
@@ -149,6 +209,9 @@ class Kernel:
     def __call__(self, *args, **kwargs):
         if _compiled.get():
             return (self._dispatcher or self.dispatcher)(*args, **kwargs)
+        called = _called.get()
+        if called is not None:
+            called.add(self)
         return self.py_func(*args, **kwargs)
 
     def __getattr__(self, name: str):

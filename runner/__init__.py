@@ -1,8 +1,9 @@
 """collide2d's runner: everything a user touches — scenarios, runs, outputs, goldens, the CLI.
 
 One package or module per concern, each importing only those listed before it (and the engine):
-- `lanes` (whether a run's kernels are compiled or interpreted) and `compiling` (compile time kept
-  apart, the first-run notice), beside the engine;
+- `lanes` (whether a run's kernels are compiled or interpreted, weighing what `compilecost` says
+  compiling them would take) and `compiling` (compile time kept apart, the first-run notice),
+  beside the engine;
 - `scenario`: reading and checking a scenario file;
 - `output`: what the runner writes and shows, and where;
 - `run`: a model driven over a scenario's ticks, its frames and events handed to the writers;

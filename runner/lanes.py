@@ -1,32 +1,39 @@
 """Which lane a run's kernels take: compiled by numba, or interpreted as plain Python (engine.jit).
 
-A compiled kernel is a hundred times faster per step, but a process pays about half a second to
-import numba and load its first cached kernel, and seconds per kernel the first time it compiles.
-A small scene is done interpreted before numba has even started, so every run chooses (mode
-`auto`, the default): interpreted while its work is at most INTERPRETED_MAX_WORK, compiled above.
+A compiled kernel runs 20 to 100 times faster per step, but numba takes about half a second to
+start and load cached kernels, and tens of seconds to compile a model's kernels the first time
+(from an empty cache: a CI job's). Mode `auto`, the default, decides from a measured model of both
+costs, as the run goes: every run starts interpreted, and at the end of each chunk of ticks it
+compares
+
+- what the ticks left would take interpreted: the run's own pace so far (its ticks and the frames
+  drawn between them, wall time) times the ticks left, with
+- what they would take compiled: the seconds to get the kernels the run has called so far ready
+  (runner.compilecost: numba's start, the cached ones loaded, each other one compiled, from a
+  table of each kernel's measured compile CPU seconds, scaled to how fast a core of this machine
+  runs Python and divided by the share of a core the run's ticks have had: a busy machine slows a
+  compilation as it slows the ticks) plus the ticks left at COMPILED_SPEEDUP times the pace,
+
+and goes on compiled, for good, between two ticks (the state is the same arrays; both lanes give
+the same bytes) as soon as compiling pays, by SWITCH_MARGIN (the estimate's error on a busy
+machine). So a run never pays for much more than its work: a small one, or a long one whose
+kernels would take longer to compile than it takes to interpret, is done interpreted, numba never
+loaded; a big one compiles after a short look (PROBE_S); one whose
+kernels numba's cache holds goes compiled after a tick or two, for the cost of loading them. The
+kernels a run needs are the ones it calls (engine.jit.recording), not every kernel. The first
+chunks are short (1, 1, 2, 4, ... ticks) so that a slow scene is measured after a tick or two.
+What no pace sees, the bounces of a huge mass ratio within one tick of the exact model, is
+estimated up front: a run whose bounces would take longer interpreted (EVENT_INTERPRETED_S each)
+than compiling the exact model's kernels starts compiled.
+
 Mode `on` compiles every run and `off` interprets every run (slow for big scenes); the command
 line's `--jit MODE` sets it (`set_mode`), else `COLLIDE2D_JIT` in the environment, else `auto`.
-Both lanes give the same bytes.
-
-A run's work is counted in object-ticks (one object advanced one tick; a stepped substep counts as
-a tick), plus its drawing: the frames drawn times the pixels of the objects' boxes (each at most
-the world's area), PIXELS_PER_OBJECT_TICK pixels to an object-tick, plus, for the exact model,
-its events at EVENT_WORK object-ticks each: wall events (each object's crossings of the room it
-has, |v| / fps / room per tick per axis) and the bounces of its largest mass ratio (a light object
-between a wall and a heavy one bounces about pi * sqrt(ratio) times).
-
-What no estimate sees, a run that starts interpreted also watches: once its ticks have taken
-INTERPRETED_BUDGET_S and the ticks left would take more than INTERPRETED_LEFT_S at the pace so far,
-it goes on compiled (between two ticks: the state is the same arrays). A busy machine slows both
-lanes alike, and a run near its end is not worth a compilation.
-
-Measured interpreted on this project's 2-core machine: the paper model's section IV demo (50
-boxes, 100 ticks, every frame drawn for the GIF) takes 0.19 s; a gas of 300 boxes over 120 ticks,
-2.6 s (36,000 object-ticks), where numba loads its cached kernels in about 0.5 s.
 
 Loading a scenario runs kernels too (the start-overlap check, `generate` blocks, the starting
 room check): interpreted up to LOAD_INTERPRETED_MAX_OBJECTS objects (`objects(n)`), counting the
-objects of every load of a `loads(k)` block (a sweep's check draws one scene for each seed).
+objects of every load of a `loads(k)` block (a sweep's check draws one scene for each seed), and
+above that from an empty kernel cache while interpreting them costs less than compiling the
+loading kernels would; compiled otherwise.
 """
 
 from __future__ import annotations
@@ -40,24 +47,34 @@ from contextvars import ContextVar
 import numpy as np
 
 from collide2d.engine import jit
+from collide2d.runner import compilecost
 
 MODES = ("auto", "on", "off")
-# Work (object-ticks) up to which `auto` interprets a run (about a second interpreted).
-INTERPRETED_MAX_WORK = 20_000
-# Pixels drawn interpreted in about the time of one object-tick.
-PIXELS_PER_OBJECT_TICK = 100
-# Objects up to which loading a scenario runs its kernels interpreted under `auto`.
+# How many times faster compiled kernels run a tick than interpreted ones, at the least (measured
+# on the bench's standard scene: 25x for 1,000 boxes under paper, more for bigger scenes).
+COMPILED_SPEEDUP = 20
+# Seconds of interpreted ticks an `auto` run measures before it pays more than that to compile
+# (going on with kernels this process has ready needs no such look).
+PROBE_S = 0.1
+# The least share of a core a run is taken to get (a compile estimate is divided by its share).
+MIN_SHARE = 0.1
+# A switch must save this many times the compile estimate: on a busy machine (load 15 on 2 cores)
+# the paper model's kernels for 1,000 boxes took 1.6 to 2 times their estimate to compile, while
+# interpreting went at the measured pace; past the margin, compiling wins even then.
+SWITCH_MARGIN = 1.5
+# Seconds a switch must save, at the least, to be looked at (a tiny run never looks).
+MIN_SAVED_S = 0.05
+# Seconds an interpreted exact-model event takes (about 0.4 ms on this project's machine), for
+# the bounces a mass ratio makes within one tick, which the pace of the ticks before cannot see.
+EVENT_INTERPRETED_S = 4e-4
+# Objects up to which loading a scenario runs its kernels interpreted under `auto`; above, from an
+# empty kernel cache, while interpreting them (LOAD_INTERPRETED_S an object: 0.65 s for the
+# standard scene's 5,000 boxes) takes less than compiling the loading kernels.
 LOAD_INTERPRETED_MAX_OBJECTS = 2_000
-# Object-ticks of work an exact-model event counts for (measured interpreted: about 0.4 ms an
-# event, 40 us an object-tick).
-EVENT_WORK = 10
-# Seconds of interpreted ticks after which an `auto` run goes on compiled, if the ticks left would
-# take more than INTERPRETED_LEFT_S more.
-INTERPRETED_BUDGET_S = 1.0
-INTERPRETED_LEFT_S = 3.0
-# Ticks per model call while a run may still switch (how often the budget is looked at).
-INTERPRETED_CHUNK_TICKS = 8
+LOAD_INTERPRETED_S = 1.3e-4
 
+_clock = time.perf_counter
+_cpu = time.process_time
 _mode: str | None = None  # set by the command line; None: the environment's, else auto
 _loads: ContextVar[int] = ContextVar("collide2d_loads", default=1)
 
@@ -89,29 +106,20 @@ def mode() -> str:
         return "auto"
 
 
-def work(scenario, frames: int) -> float:
-    """The work of running `scenario` drawing `frames` frames, in object-ticks."""
-    bodies = scenario.bodies
-    world = scenario.world
-    steps = scenario.ticks * (scenario.substeps if scenario.model == "stepped" else 1)
-    area = (bodies.size[:, 0] * bodies.size[:, 1]).clip(0.0, float(world.width * world.height))
-    drawn = float(frames) * float(area.sum()) if bodies.n else 0.0
-    total = float(bodies.n) * steps + drawn / PIXELS_PER_OBJECT_TICK
-    if scenario.model == "exact" and bodies.n:
-        room = np.maximum(np.array([world.width, world.height], float) - bodies.size, 1.0)
-        crossings = np.abs(np.nan_to_num(bodies.vel, posinf=0.0, neginf=0.0)) / room
-        walls = float(crossings.sum()) / world.fps * scenario.ticks
-        bounces = math.pi * math.sqrt(_mass_ratio(bodies))
-        total += EVENT_WORK * (walls + bounces)
-    return total
-
-
 def compiled_for_run(scenario, frames: int) -> bool:
-    """Whether a run of `scenario` drawing `frames` frames starts with its kernels compiled."""
-    chosen = mode()
-    if chosen != "auto":
-        return chosen == "on"
-    return work(scenario, frames) > INTERPRETED_MAX_WORK
+    """Whether a run of `scenario` drawing `frames` frames starts with its kernels compiled: under
+    `auto` no run does (RunLane decides as it goes)."""
+    return mode() == "on"
+
+
+def bursts_past_compiling(scenario) -> bool:
+    """Whether the bounces of the exact model's largest mass ratio (a light object between a wall
+    and a heavy one bounces about pi * sqrt(ratio) times, most of them within one tick) would take
+    longer interpreted than compiling the exact model's kernels from an empty cache."""
+    if scenario.model != "exact" or not scenario.bodies.n:
+        return False
+    bounces = math.pi * math.sqrt(_mass_ratio(scenario.bodies))
+    return bounces * EVENT_INTERPRETED_S > compilecost.model_seconds("exact")
 
 
 def _mass_ratio(bodies) -> float:
@@ -120,33 +128,82 @@ def _mass_ratio(bodies) -> float:
 
 
 class RunLane:
-    """The lane of one run as it goes: `compiled`, and whether it may still switch (an `auto` run
-    that starts interpreted). `step(ticks)` caps a model call's ticks while it may; `timed(ticks)`
-    wraps each call of that many ticks and switches to compiled for good as the module docstring
-    says."""
+    """The lane of one run as it goes: `compiled`, and whether it may still switch (an `auto` run,
+    until it has switched). `opened()` is the `with` block of the whole run (it records the
+    kernels called); `step(ticks)` caps a model call's ticks while it may switch; `timed(ticks)`
+    wraps each call of that many ticks and, after it, switches to compiled for good when that
+    pays, as the module docstring says."""
 
     def __init__(self, scenario, frames: int):
-        self.compiled = compiled_for_run(scenario, frames)
-        self.started_compiled = self.compiled
-        self.may_switch = not self.compiled and mode() == "auto"
-        self.spent = 0.0
-        self.done = 0
+        chosen = mode()
+        self.compiled = self.started_compiled = chosen == "on"
+        self.may_switch = chosen == "auto"
         self.ticks = scenario.ticks
+        self.done = 0
+        self.began: float | None = None
+        self.began_cpu = 0.0
+        self.called: set = set()
+        self._ready: dict = {}  # kernel -> seconds to get it ready, once asked
+        self._empty: bool | None = None
+        if self.may_switch and bursts_past_compiling(scenario):
+            self.compiled = self.started_compiled = True
+            self.may_switch = False
+
+    @contextlib.contextmanager
+    def opened(self):
+        with jit.lane(self.compiled):
+            if not self.may_switch:
+                yield self
+                return
+            with jit.recording() as called:
+                self.called = called
+                yield self
 
     def step(self, ticks: int) -> int:
-        return min(ticks, INTERPRETED_CHUNK_TICKS) if self.may_switch else ticks
+        return min(ticks, max(1, self.done)) if self.may_switch else ticks
 
     @contextlib.contextmanager
     def timed(self, ticks: int):
-        began = time.perf_counter()
+        if self.began is None:
+            self.began, self.began_cpu = _clock(), _cpu()
         with jit.lane(self.compiled):
             yield
-        if self.may_switch:
-            self.spent += time.perf_counter() - began
-            self.done += ticks
-            left = self.spent / max(self.done, 1) * (self.ticks - self.done)
-            if self.spent > INTERPRETED_BUDGET_S and left > INTERPRETED_LEFT_S:
-                self.compiled, self.may_switch = True, False
+        self.done += ticks
+        if self.may_switch and self.done < self.ticks:
+            self._decide()
+
+    def _decide(self) -> None:
+        spent = _clock() - self.began
+        left = spent / self.done * (self.ticks - self.done)
+        saved = left * (1 - 1 / COMPILED_SPEEDUP)  # by going on compiled, once ready
+        share = self.share(spent)
+        if saved <= max(MIN_SAVED_S, compilecost.lower_bound(self.called, share)):
+            return
+        if spent < PROBE_S and not jit.loaded():
+            return  # measure longer before looking at numba's cache (which loads numba)
+        cost = self.ready_seconds(share)
+        if spent < PROBE_S and cost > spent:
+            return  # measure longer before paying more than has been measured
+        if saved > SWITCH_MARGIN * cost:
+            self.compiled, self.may_switch = True, False
+
+    def share(self, spent: float) -> float:
+        """The share of a core this run's ticks have had (its CPU time over its wall time): a
+        compilation, and numba's start, get about as much."""
+        cpu = _cpu() - self.began_cpu
+        return min(max(cpu / max(spent, 1e-9), MIN_SHARE), 1.0)
+
+    def ready_seconds(self, share: float = 1.0) -> float:
+        """Wall seconds to get the kernels called so far ready to run compiled, getting `share`
+        of a core (runner.compilecost); each kernel is looked up once per run."""
+        if self._empty is None:
+            self._empty = not jit.loaded() and jit.cache_empty()
+        for kernel in [k for k in self.called if k not in self._ready]:
+            self._ready[kernel] = compilecost.parts(kernel, self._empty)
+        load = sum(part[0] for part in self._ready.values())
+        cold = sum(part[1] for part in self._ready.values())
+        scaled = cold * compilecost.speed_factor() if cold else 0.0
+        return compilecost.start_seconds(share) + (load + scaled) / share
 
     def name(self) -> str:
         """How the summary names the lanes the run took."""
@@ -165,7 +222,12 @@ def objects(n: int):
     chosen = mode()
     if chosen != "auto":
         return jit.lane(chosen == "on")
-    return jit.lane(n * _loads.get() > LOAD_INTERPRETED_MAX_OBJECTS)
+    count = n * _loads.get()
+    if count <= LOAD_INTERPRETED_MAX_OBJECTS:
+        return jit.lane(False)
+    if not jit.loaded() and jit.cache_empty():  # compiled, the loading kernels would compile
+        return jit.lane(count * LOAD_INTERPRETED_S > compilecost.model_seconds("load"))
+    return jit.lane(True)
 
 
 @contextlib.contextmanager

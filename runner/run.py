@@ -13,13 +13,14 @@ as a runaway (an `engine.errors.Runaway`: the exact model's event cap or an obje
 move, the stepped model's fold limit) raises `RunStopped` with a message for the user. The summary
 counts the wall and pair events whether or not they are logged (the models count them as they
 happen), and gives the kinetic, potential and total energy at the start and the end
-(`engine.invariants.energies`). Each run's kernels run compiled or interpreted (`runner.lanes`, by
-the size of the run; the summary's `kernels` says which). Kernels compiled during a run (a first
-run, before numba has cached them) are timed apart (`runner.compiling`): the summary's
-`compile_time_s` holds them and `run_time_s` leaves them out. Ctrl-C during `run_to_dir` stops the
-run at the end of the current chunk of ticks: what was written so far (events, PNG frames, the final
-state at that tick, a summary with `interrupted_at_tick`) becomes OUT/NAME, without the GIF, which
-would be an animation of part of the run.
+(`engine.invariants.energies`). Each run's kernels run compiled or interpreted (`runner.lanes`:
+under `auto`, a run starts interpreted and goes on compiled between two chunks once compiling pays;
+the summary's `kernels` says which). Kernels compiled during a run (a first run, before numba has
+cached them) are timed apart (`runner.compiling`): the summary's `compile_time_s` holds them and
+`run_time_s` leaves them out. Ctrl-C during `run_to_dir` stops the run at the end of the current
+chunk of ticks: what was written so far (events, PNG frames, the final state at that tick, a
+summary with `interrupted_at_tick`) becomes OUT/NAME, without the GIF, which would be an animation
+of part of the run.
 """
 
 from __future__ import annotations
@@ -106,7 +107,7 @@ def drive(
     if not isinstance(frames, FrameRule):
         frames = FrameRule.of(frames, scenario.ticks)
     lane = lanes.RunLane(scenario, len(frames))
-    with jit.lane(lane.compiled):
+    with lane.opened():
         model, summary = _drive(
             scenario, frames, on_frame, log_events, on_events, progress, on_tick, overlay,
             interruptible, lane,

@@ -34,11 +34,15 @@ The parts, each selectable with `--part`:
   headless with and without the event log and through `runner.run.drive`; the exact model's
   events/s on a two-body chain and on the standard scene; `Renderer.draw` frames/s, a GIF's and a
   PNG frame's time on the section IV demo's boxes.
+- jit (only with `--part jit`): `collide2d run` under `--jit on`, `off` and `auto`, each in a fresh
+  process from an empty kernel cache, on the bundled scenarios, the bench's scenes and scenes of
+  10 to 5,000 bodies over 10 to 100,000 ticks: wall times and `auto` over the faster lane.
 
 One module per concept: `scenes` (the standard scene and where the benchmark scenarios are),
 `timing` (how a run is timed), one module per part (`scaling`, `peers`, `error`, `skips`,
-`targets`, `paper`, `exact`, `raster`), `report` (bench.csv and bench.md), `plots` (the PNG plots)
-and `cli` (the subcommand; it loads the parts only when `collide2d bench` runs).
+`targets` (and jit), `paper`, `exact`, `raster`), `report` (bench.csv and bench.md),
+`plots` (the PNG plots) and `cli` (the subcommand; it loads the parts only when `collide2d bench`
+runs).
 
 Timings that are compared (error, skips, targets) go through `timing.measure`: calibrated so
 that each measure lasts at least 0.5 s, medians of 5 interleaved repeats (A/B/A) with min-max,

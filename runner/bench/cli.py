@@ -22,9 +22,9 @@ from collide2d.engine import models
 from collide2d.runner.command.exitcodes import EXIT_BAD_INPUT, EXIT_DIFFERENCE, EXIT_OK
 
 PARTS = ("scaling", "error", "peers", "skips", "targets", "paper", "exact", "raster")
-PARTS += ("stages", "load")  # runner/bench/stages.py, load.py
+PARTS += ("stages", "load", "jit")  # runner/bench/stages.py, load.py, targets.py
 DEFAULT_PARTS = ("scaling", "error", "skips", "targets")
-FILE_PARTS = ("error", "skips", "targets", "paper", "raster")  # read scenarios/*.yaml
+FILE_PARTS = ("error", "skips", "targets", "paper", "raster", "jit")  # read scenarios/*.yaml
 REPORT_DIR = "bench"
 
 
@@ -151,6 +151,9 @@ def _run_parts(args, parts, ns, models_, quick, in_process, folder, echo) -> tup
         from collide2d.runner.bench import load
 
         rows += load.load(quick, echo)
+    if "jit" in parts:
+        echo.part("jit")
+        rows += targets.cold_start(quick, echo, folder)
     return rows, time.perf_counter() - began
 
 
@@ -171,8 +174,9 @@ def register(subparsers) -> None:
         "`collide2d run`, events/s, time per stage), the benchmark scenarios at a ladder of fps "
         "and substeps against the exact model (run time against error, Pareto plot), what each "
         "skip saves, and the section IV targets; with --peers, pymunk on the same scene; with "
-        "--part, also the paper model three ways, the exact model's events/s and the drawing and "
-        "writing of frames. Writes OUT/bench/bench.csv, bench.md and, with matplotlib, "
+        "--part, also the paper model three ways, the exact model's events/s, the drawing and "
+        "writing of frames, and (jit) each --jit mode's wall time from an empty kernel cache. "
+        "Writes OUT/bench/bench.csv, bench.md and, with matplotlib, "
         "scaling.png and runtime_vs_error.png.",
     )
     p.add_argument("--out", default="out", metavar="DIR", help="output folder (default: out)")

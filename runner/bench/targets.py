@@ -1,15 +1,32 @@
 """The targets part of `collide2d bench`: the paper's section IV demo headless (ticks/s through the
 model's `advance`), and the wall time of `collide2d run` on a small scenario as a user runs it
 (interpreted: runner.lanes) and with its kernels compiled and cached.
+
+Also the jit part (`cold_start`): `collide2d run` under `--jit on`, `off` and `auto`, each in a
+fresh process (`python -m collide2d run FILE --jit MODE --quiet`, the scenario's own outputs)
+with its own empty NUMBA_CACHE_DIR, as a CI job starts, Python's bytecode cached as an
+installation has it (`user_env`), wall time. The scenes: GRID, scenes of 10 to 5,000 bodies over
+10 to 100,000 ticks, the bench's standard scene (STANDARD: N boxes under each model) and two-body
+chain, and every scenario of the scenarios folder. `auto` runs whole; `off` is stopped past
+OFF_PAST_AUTO times `auto`'s time, and `on` once it has taken longer than both (it can no longer
+be the faster lane): the row then says "> s", a time shorter than the lane's, so the ratio of
+`auto` to the faster is at most the one shown. Each row: the three wall times, the lane `auto`
+took (the summary's `kernels`) and `auto` over the faster of `on` and `off`, against AUTO_WITHIN.
+`--quick` runs QUICK_SCENES only.
 """
 
 from __future__ import annotations
 
+import json
 import os
+import subprocess
 import sys
+import tempfile
+import time
 from pathlib import Path
 
 from collide2d.engine import models
+from collide2d.runner.bench import scenes
 from collide2d.runner.bench.paper import demo_row
 from collide2d.runner.bench.scenes import DEMO_SCENARIO, PROJECT_SCENARIOS, SMALL_SCENARIO
 from collide2d.runner.bench.timing import measure
@@ -85,4 +102,112 @@ def small_runs(path: Path, echo) -> list[dict]:
         row.update(timing.row())
         rows.append(row)
         echo(f"targets  collide2d run --jit {mode} {SMALL_SCENARIO} {wall:.3f} s")
+    return rows
+
+
+# `auto`'s wall time at most this many times the faster of `on` and `off`, on every scene.
+AUTO_WITHIN = 1.5
+# `off` is stopped past this many times `auto`'s time (and 2 s): `auto` compiled, and so can
+# `on`, whose time then shows whether it should have.
+OFF_PAST_AUTO = 3
+MODES = ("on", "auto", "off")
+# The standard scene: (N, model, ticks).
+STANDARD = ((1_000, "paper", 120), (1_000, "stepped", 120), (1_000, "exact", 120))
+CHAIN_TICKS = 20
+# (bodies, ticks, model) of the grid: a generated gas (the standard scene's boxes and density).
+GRID = (
+    (10, 10, "paper"),
+    (10, 100_000, "paper"),
+    (100, 10_000, "exact"),
+    (500, 1_000, "stepped"),
+    (1_000, 1_000, "paper"),
+    (5_000, 10, "exact"),
+    (5_000, 1_000, "paper"),
+)
+QUICK_SCENES = ("tunnelling_1fps", "grid-10x10-paper")  # --quick: seconds, for tests
+
+
+def scene_files(folder: Path, tmp: Path, quick: bool) -> list[tuple[str, Path, int, int]]:
+    """(name, file, bodies, ticks) of each scene, the built ones written into `tmp`."""
+    from collide2d.runner import lanes
+    from collide2d.runner.scenario.load import load
+
+    found = []
+    built = [(f"grid-{n}x{t}-{m}", n, t, m) for n, t, m in GRID]
+    built += [(f"standard-{n}-{m}", n, t, m) for n, m, t in STANDARD]
+    for name, n, ticks, model in built:
+        text = scenes.standard_scene(n, model, ticks)
+        path = tmp / f"{name}.yaml"
+        path.write_text(text.replace(f"name: standard-{n}\n", f"name: {name}\n"))
+        found.append((name, path, n, ticks))
+    path = tmp / "two-body-chain.yaml"
+    path.write_text(scenes.chain_scene(CHAIN_TICKS))
+    found.append(("two-body-chain", path, 2, CHAIN_TICKS))
+    previous = lanes.mode()
+    lanes.set_mode("off")  # read here only for their sizes: no kernel compiled for that
+    try:
+        for path in sorted(folder.glob("*.yaml")):
+            scenario = load(path)
+            found.append((path.stem, path, scenario.bodies.n, scenario.ticks))
+    finally:
+        lanes.set_mode(previous)
+    if quick:
+        found = [f for f in found if f[0] in QUICK_SCENES]
+    return found
+
+
+def run_cold(path: Path, mode: str, tmp: Path, limit: float | None = None) -> tuple[float, str]:
+    """(wall s, the summary's `kernels`) of `collide2d run PATH --jit MODE` from an empty kernel
+    cache; (limit, "stopped") when it passes `limit` seconds."""
+    with tempfile.TemporaryDirectory(prefix="cache-", dir=tmp) as cache:
+        env = user_env(str(tmp / "pycache"))
+        env["NUMBA_CACHE_DIR"] = cache
+        env.pop("COLLIDE2D_JIT", None)
+        env.pop("NUMBA_DISABLE_JIT", None)
+        out = tmp / f"out-{mode}"
+        cmd = [sys.executable, "-m", "collide2d", "run", str(path), "--quiet", "--out", str(out)]
+        cmd += ["--jit", mode]
+        began = time.perf_counter()
+        try:
+            subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, env=env, timeout=limit)
+        except subprocess.TimeoutExpired:
+            return float(limit), "stopped"
+        wall = time.perf_counter() - began
+    summaries = sorted(out.glob("*/summary.json"), key=os.path.getmtime)
+    kernels = json.loads(summaries[-1].read_text()).get("kernels", "") if summaries else ""
+    return wall, kernels
+
+
+def cold_start(quick: bool, echo, folder: Path = scenes.PROJECT_SCENARIOS) -> list[dict]:
+    """One row per scene: wall s of each lane from an empty cache, and auto / the faster."""
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="collide2d-jit-") as name:
+        tmp = Path(name)
+        run_cold(folder / f"{scenes.SMALL_SCENARIO}.yaml", "off", tmp)  # bytecode cached
+        for scene, path, n, ticks in scene_files(folder, tmp, quick):
+            auto, auto_lane = run_cold(path, "auto", tmp)
+            off, off_lane = run_cold(path, "off", tmp, limit=OFF_PAST_AUTO * auto + 2.0)
+            on, on_lane = run_cold(path, "on", tmp, limit=max(auto, off) + 1.0)
+            stopped = {"on": on_lane == "stopped", "off": off_lane == "stopped"}
+            # a stopped lane's time is less than its own: the ratio is at most this
+            ratio = auto / min(on, off)
+            rows.append({
+                "part": "jit",
+                "scene": scene,
+                "n": n,
+                "ticks": ticks,
+                "on_s": on,
+                "on_stopped": stopped["on"],
+                "off_s": off,
+                "off_stopped": stopped["off"],
+                "auto_s": auto,
+                "ratio": ratio,
+                "note": auto_lane,
+                "target": f"<= {AUTO_WITHIN:g}",
+                "met": ratio <= AUTO_WITHIN,
+            })  # fmt: skip
+            shown = {k: f"> {v:.1f}" if stopped[k] else f"{v:.1f}" for k, v in
+                     (("on", on), ("off", off))}  # fmt: skip
+            echo(f"jit      {scene:32s} on {shown['on']:>7} s  off {shown['off']:>7} s  auto "
+                 f"{auto:6.1f} s ({auto_lane})  auto/faster {ratio:.2f}")  # fmt: skip
     return rows

@@ -118,9 +118,10 @@ def add_jit_argument(p: argparse.ArgumentParser) -> None:
         "--jit",
         choices=("auto", "on", "off"),
         default=None,
-        help="compile the kernels with numba: auto (default: a small run is done interpreted "
-        "before numba would have loaded), on (every run), off (never: plain Python, slow for big "
-        "scenes); the results are the same bytes",
+        help="compile the kernels with numba: auto (default: each run starts interpreted and "
+        "compiles once the ticks left would take longer than compiling the kernels it calls), "
+        "on (every run), off (never: plain Python, slow for big scenes); the results are the "
+        "same bytes",
     )
 
 

@@ -153,3 +153,52 @@ def test_a_source_that_cannot_be_read_still_gives_a_package_digest(tmp_path, mon
     before = jit._package_fingerprint.__wrapped__(str(tmp_path))
     (tmp_path / "locked.py").write_text("y = 22\n")
     assert jit._package_fingerprint.__wrapped__(str(tmp_path)) != before
+
+
+def test_a_recording_block_collects_the_kernels_called_interpreted_nested_ones_too():
+    rng = np.random.default_rng(3)
+    lo = rng.uniform(0, 200, (60, 2))
+    hi = lo + rng.uniform(1, 25, (60, 2))
+    movable = np.ones(60, bool)
+    with jit.lane(False), jit.recording() as called:
+        round_positions(lo)
+        find_pairs(METHODS["sweep"], lo, hi, movable, 30.0)
+    assert _round_into in called
+    names = {k.__name__ for k in called}
+    assert len(names) >= 3, names  # find_pairs' kernels and the kernels they call
+    kept = set(called)
+    with jit.lane(False):
+        round_positions(lo)  # no block open: nothing recorded
+    assert called == kept
+    if COMPILING:
+        with jit.lane(True), jit.recording() as compiled_calls:
+            find_pairs(METHODS["sweep"], lo, hi, movable, 30.0)
+        assert compiled_calls == set()  # compiled calls are numba's: a run that switched stops
+        # adding to what it needs
+
+
+@pytest.mark.skipif(os.environ.get("NUMBA_DISABLE_JIT") == "1", reason="nothing compiles")
+def test_readiness_says_cold_cached_or_compiled_and_an_empty_cache_is_seen_without_numba(
+    tmp_path,
+):
+    package = tmp_path / "pkg"
+    package.mkdir()
+    (package / "__init__.py").write_text("")
+    (package / "caller.py").write_text(CALLER)
+    (package / "callee.py").write_text(CALLEE.format(factor=2))
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), PYTHONPATH=str(tmp_path))
+    env.pop("COLLIDE2D_JIT", None)
+    code = (
+        "import sys\nfrom collide2d.engine import jit\nfrom pkg.caller import f\n"
+        "empty = jit.cache_empty()\nloaded = 'numba' in sys.modules\n"
+        "before = jit.readiness(f)\nf(3)\nprint(empty, loaded, before, jit.readiness(f))\n"
+    )
+
+    def run() -> list[str]:
+        done = subprocess.run(
+            [sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True
+        )
+        return done.stdout.split()
+
+    assert run() == ["True", "False", "cold", "compiled"]  # compiled, then cached on disk
+    assert run() == ["False", "False", "cached", "compiled"]

@@ -1,15 +1,23 @@
-"""Which lane a run takes (runner.lanes): interpreted for a small run, compiled for a big one or a
-huge mass ratio, what `--jit`, `[tool.collide2d] jit` and COLLIDE2D_JIT say, and the switch of a
-run that outgrows its interpreted budget, with the same bytes in every case."""
+"""Which lane a run takes (runner.lanes): under `auto` interpreted until the ticks left would take
+longer than compiling the kernels the run called (runner.compilecost), compiled from the start for
+a huge mass ratio, what `--jit`, `[tool.collide2d] jit` and COLLIDE2D_JIT say, and the switch in
+mid-run, with the same bytes in every case."""
 
 from __future__ import annotations
 
 import json
+import os
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from collide2d.runner import lanes
+from collide2d.engine import jit
+from collide2d.engine.models.exact import model as exact_model
+from collide2d.engine.models.paper import model as paper_model
+from collide2d.runner import compilecost, lanes
 from collide2d.runner.command.main import main
 from collide2d.runner.run import simulate
 from collide2d.runner.scenario.load import loads
@@ -51,19 +59,95 @@ def auto_mode(monkeypatch):
     lanes.set_mode(None)
 
 
-def test_a_small_run_is_interpreted_and_a_big_one_compiled():
-    small, gas = loads(SMALL), loads(GAS)
-    assert lanes.work(small, 31) < lanes.INTERPRETED_MAX_WORK < lanes.work(gas, 0)
-    assert simulate(small).summary["kernels"] == "interpreted"
+def _ready_in(monkeypatch, seconds: float, probe_s: float = 0.0) -> None:
+    """Every run's kernels take `seconds` to get ready; decisions from `probe_s` on."""
+    monkeypatch.setattr(lanes.RunLane, "ready_seconds", lambda self, share=1.0: seconds)
+    monkeypatch.setattr(lanes, "PROBE_S", probe_s)
+    monkeypatch.setattr(lanes, "MIN_SAVED_S", 0.0)
+
+
+def test_a_run_goes_on_compiled_once_the_ticks_left_would_take_longer_than_compiling(monkeypatch):
+    gas = loads(GAS)
+    _ready_in(monkeypatch, 0.0)  # compiling costs nothing: the first look switches
+    switched = simulate(gas)
+    assert switched.summary["kernels"] == "interpreted, then compiled"
+    _ready_in(monkeypatch, 1e9)  # compiling never pays: the whole run is interpreted
+    assert simulate(gas).summary["kernels"] == "interpreted"
+    lanes.set_mode("on")
     assert simulate(gas).summary["kernels"] == "compiled"
 
 
-def test_the_exact_model_compiles_for_a_mass_ratio_that_makes_many_bounces():
-    chain = loads(CHAIN)  # 1e10: about 314,000 bounces
-    assert lanes.compiled_for_run(chain, 0)
+def _looked_at(monkeypatch, spent: float, cost: float, loaded: bool = True) -> bool:
+    """Whether a run 10 ticks into its 100, `spent` s in, switches when its kernels take `cost` s
+    to get ready."""
+    lane = lanes.RunLane(loads(GAS), 0)
+    assert lane.may_switch and not lane.compiled
+    monkeypatch.setattr(lanes.RunLane, "ready_seconds", lambda self, share=1.0: cost)
+    monkeypatch.setattr(compilecost.jit, "loaded", lambda: loaded)
+    monkeypatch.setattr(lanes, "_clock", lambda: 100.0 + spent)
+    monkeypatch.setattr(lanes, "_cpu", lambda: 100.0 + spent)  # a whole core
+    lane.began, lane.began_cpu, lane.done = 100.0, 100.0, 10
+    lane._decide()
+    return lane.compiled
+
+
+def test_the_switch_weighs_the_ticks_left_against_compiling(monkeypatch):
+    # 90 ticks left at spent / 10 s a tick: 9 x spent interpreted, 9 x spent / 20 compiled,
+    # 8.55 s saved for 1.0 s spent: a switch when that is past SWITCH_MARGIN (1.5) times the cost
+    assert _looked_at(monkeypatch, spent=1.0, cost=5.6)
+    assert not _looked_at(monkeypatch, spent=1.0, cost=5.8)
+    # numba not loaded yet: a switch that cannot save its start is not looked at
+    assert not _looked_at(monkeypatch, spent=0.05, cost=0.0, loaded=False)
+    # kernels ready in this process: after the first chunk
+    assert _looked_at(monkeypatch, spent=0.05, cost=0.0)
+    # kernels to compile: measured for PROBE_S before paying more than was measured
+    assert not _looked_at(monkeypatch, spent=0.05, cost=0.3)
+    assert _looked_at(monkeypatch, spent=1.5 * lanes.PROBE_S, cost=0.3)
+    # a tiny run never looks
+    assert not _looked_at(monkeypatch, spent=0.004, cost=0.0)
+
+
+def test_the_cost_counts_the_kernels_the_run_called_not_every_kernel(monkeypatch):
+    seen = []
+
+    def ready(self, share=1.0):
+        seen.append({compilecost.name(k) for k in self.called})
+        return 1e9
+
+    monkeypatch.setattr(lanes.RunLane, "ready_seconds", ready)
+    monkeypatch.setattr(lanes, "PROBE_S", 0.0)
+    simulate(loads(GAS))  # the paper model
+    called = seen[-1]
+    assert "collide2d.engine.models.paper.model._run" in called
+    assert not any(".models.exact." in k or ".models.stepped." in k for k in called)
+    seen.clear()
+    simulate(loads(GAS.replace("ticks: 100", "model: exact\nticks: 40")))
+    assert "collide2d.engine.models.exact.model._run" in seen[-1]
+    assert not any(".models.paper." in k for k in seen[-1])
+
+
+def test_compiling_is_estimated_from_the_table_and_the_cache(monkeypatch, tmp_path):
+    kernels = [paper_model._run, exact_model._run]
+    table = compilecost.table()["kernels"]
+    cold = sum(table[compilecost.name(k)] for k in kernels)
+    monkeypatch.setattr(compilecost, "speed_factor", lambda: 2.0)
+    monkeypatch.setattr(compilecost.jit, "loaded", lambda: False)
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))  # empty: every kernel compiles
+    assert jit.cache_empty()
+    estimate = compilecost.seconds(kernels)
+    assert estimate == pytest.approx(compilecost.NUMBA_START_S + 2.0 * cold)
+    assert estimate > compilecost.lower_bound(kernels)
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "sub" / "k-1.py311.nbi").write_bytes(b"")  # something cached: look closer
+    assert not jit.cache_empty()
+
+
+def test_a_huge_mass_ratio_starts_compiled_a_small_one_interpreted():
+    chain = loads(CHAIN)  # 1e10: about 314,000 bounces within a tick or two
+    assert lanes.bursts_past_compiling(chain)
     assert simulate(chain).summary["kernels"] == "compiled"
     for ratio in ("2", "1e4"):  # about 4 and 314 bounces
-        assert not lanes.compiled_for_run(loads(CHAIN.replace("mass: 1e10", f"mass: {ratio}")), 0)
+        assert not lanes.bursts_past_compiling(loads(CHAIN.replace("mass: 1e10", f"mass: {ratio}")))
 
 
 def test_the_mode_comes_from_the_flag_then_the_environment(monkeypatch):
@@ -78,23 +162,35 @@ def test_the_mode_comes_from_the_flag_then_the_environment(monkeypatch):
         lanes.set_mode("sometimes")
 
 
-def test_a_run_over_its_interpreted_budget_goes_on_compiled_with_the_same_bytes(monkeypatch):
+@pytest.mark.parametrize("after", [1, 3])  # the first look; a later one (a longer probe)
+def test_a_run_that_switches_mid_run_gives_the_same_bytes(monkeypatch, after):
     scenario = loads(SMALL.replace("ticks: 30", "ticks: 60"))
     lanes.set_mode("on")
     compiled = simulate(scenario, keep_frames=range(0, 61, 5))
+    lanes.set_mode("off")
+    interpreted = simulate(scenario, keep_frames=range(0, 61, 5))
     lanes.set_mode(None)
-    monkeypatch.setattr(lanes, "INTERPRETED_BUDGET_S", 0.0)  # switch after the first call
-    monkeypatch.setattr(lanes, "INTERPRETED_LEFT_S", 0.0)
+    looks = []
+
+    def ready(self, share=1.0):
+        looks.append(self.done)
+        return 0.0 if len(looks) >= after else 1e9
+
+    monkeypatch.setattr(lanes.RunLane, "ready_seconds", ready)
+    monkeypatch.setattr(lanes, "PROBE_S", 0.0)
+    monkeypatch.setattr(lanes, "MIN_SAVED_S", 0.0)  # a run of microseconds looks too
     switched = simulate(scenario, keep_frames=range(0, 61, 5))
     assert switched.summary["kernels"] == "interpreted, then compiled"
+    assert 0 < looks[-1] < 60  # switched mid-run, between two chunks
     assert compiled.summary["kernels"] == "compiled"
-    assert switched.events.tobytes() == compiled.events.tobytes()
-    assert np.array_equal(switched.final_pos, compiled.final_pos)
-    assert switched.frames.keys() == compiled.frames.keys()
-    for k, frame in compiled.frames.items():
-        assert np.array_equal(switched.frames[k], frame), k
-    monkeypatch.setattr(lanes, "INTERPRETED_LEFT_S", 1e9)  # never worth it: stays interpreted
-    assert simulate(scenario).summary["kernels"] == "interpreted"
+    assert interpreted.summary["kernels"] == "interpreted"
+    for other in (compiled, interpreted):
+        assert switched.events.tobytes() == other.events.tobytes()
+        assert np.array_equal(switched.final_pos, other.final_pos)
+        assert np.array_equal(switched.final_vel, other.final_vel)
+        assert switched.frames.keys() == other.frames.keys()
+        for k, frame in other.frames.items():
+            assert np.array_equal(switched.frames[k], frame), k
 
 
 def test_run_writes_the_same_files_under_each_mode_and_says_which_lane(tmp_path):
@@ -128,3 +224,23 @@ def test_the_projects_table_sets_the_mode(tmp_path, monkeypatch):
     )
     (tmp_path / "pyproject.toml").write_text('[tool.collide2d]\njit = "fast"\n')
     assert main(["run", "small.yaml", "--quiet"]) == 2
+
+
+def test_a_cold_check_of_small_scenarios_never_starts_numba(tmp_path):
+    # a CI job's first check: an empty kernel cache; the gases (300 boxes over 120 ticks, 40
+    # circles under exact) would each take tens of seconds to compile and take about a second
+    # interpreted, so nothing compiles and numba is never imported
+    root = Path(__file__).resolve().parents[2]
+    names = ["bench_dense_gas", "circles_gas", "tunnelling_1fps"]
+    code = (
+        "import sys\nfrom collide2d.runner.command.main import main\n"
+        f"status = main(['check', '--root', {str(root)!r}, '--quiet', *{names!r}])\n"
+        "print(status, 'numba' in sys.modules)"
+    )
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    for name in ("COLLIDE2D_JIT", "NUMBA_DISABLE_JIT", "CI"):
+        env.pop(name, None)
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env,
+                          cwd=tmp_path)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.splitlines()[-1].split() == ["0", "False"]

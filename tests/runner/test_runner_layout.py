@@ -32,7 +32,8 @@ MAX_MODULES = 16
 # its packages, each only those below it. The package docstrings say the same (checked below).
 BELOW_COMMAND = {"engine", "lanes", "compiling", "scenario", "output", "run"}
 MAY_IMPORT = {
-    "lanes": {"engine"},
+    "compilecost": {"engine"},
+    "lanes": {"engine", "compilecost"},
     "compiling": {"engine"},
     "scenario": {"engine", "lanes"},
     "output": {"engine", "scenario"},
