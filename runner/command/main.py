@@ -158,6 +158,7 @@ def overlay_names(text: str) -> tuple[str, ...]:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
+    import collide2d
     from collide2d.runner.command import settings as config
     from collide2d.runner.command.options import (
         apply_jit,
@@ -165,8 +166,6 @@ def cmd_run(args: argparse.Namespace) -> int:
         limits_from_args,
         overrides_from_args,
     )
-    from collide2d.runner.run import RunOptions, run_to_dir
-    from collide2d.runner.scenario.load import load
 
     project = config.find()
     if args.out and (project.file or project.scenarios.is_dir()):
@@ -180,24 +179,23 @@ def cmd_run(args: argparse.Namespace) -> int:
     apply_jit(args, project)
     path = args.scenario or demo_path()
     limits = limits_from_args(args, project)
-    scenario = load(
-        path,
-        overrides=overrides_from_args(args),
-        limits=limits,
-        defaults=project.model_defaults(),
-    )
-    out = scenario.output
-    options = RunOptions(
-        png=bool(out.frames) if args.png is None else args.png,
-        gif=out.gif if args.gif is None else args.gif,
-        events=out.events if args.events is None else args.events,
-        scale=args.scale,
-        quiet=args.quiet,
-        viewer=out.viewer if args.viewer is None else args.viewer,
-        overlay=out.overlay if args.overlay is None else args.overlay,
+    scenario = collide2d.load(
+        path, **overrides_from_args(args), limits=limits, defaults=project.model_defaults()
     )
     out_root = args.out or (project.folder("out") if project.file else "out")
-    target, summary = run_to_dir(scenario, out_root, options, limits)
+    result = collide2d.run(
+        scenario,
+        events=scenario.output.events if args.events is None else args.events,
+        out=out_root,
+        png=args.png,
+        gif=args.gif,
+        viewer=args.viewer,
+        overlay=args.overlay,
+        scale=args.scale,
+        quiet=args.quiet,
+        limits=limits,
+    )
+    target, summary = result.folder, result.summary
     if not args.quiet:
         counts = summary["events"]
         compiled = summary.get("compile_time_s", 0.0)
