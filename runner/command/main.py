@@ -7,7 +7,8 @@ runner.stress.cli, runner.bench.cli and runner.sweep.cli; `init` in runner.comma
 only the module of its command (`REGISTRARS`), so a run starts without loading the golden, stress,
 bench or sweep code; `--help` and an unknown command load them all. Exit status: 0 fine, 1 a check
 found a difference, 2 bad input or usage, 3 an unexpected error (one line naming the scenario; the
-traceback too with `--debug`). A refused scenario prints `FILE:LINE:COL: error: MESSAGE` on stderr
+traceback too with `--debug`), a model plugin's crash or protocol break among them (the line names
+the model). A refused scenario prints `FILE:LINE:COL: error: MESSAGE` on stderr
 and writes nothing.
 """
 
@@ -368,6 +369,9 @@ def unexpected(err: Exception, args: argparse.Namespace) -> int:
     if isinstance(what, list):
         what = " ".join(what)
     where = f" while running {what or args.command}"
+    if type(err).__name__ == "ModelError":  # a model plugin's fault (engine.models.protocol)
+        print(f"collide2d: error{where}: {err} (--debug shows where)", file=sys.stderr)
+        return EXIT_UNEXPECTED
     print(
         f"collide2d: unexpected error{where}: {type(err).__name__}: {err} "
         "(this is a bug; --debug shows where)",

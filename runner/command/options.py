@@ -74,7 +74,11 @@ def limits_from_args(args: argparse.Namespace, project=None) -> Limits:
 
 def add_override_arguments(parser: argparse.ArgumentParser) -> None:
     """Add --model, --fps and --ticks, which override the scenario file."""
-    parser.add_argument("--model", choices=MODEL_NAMES, help="model to use instead of the file's")
+    parser.add_argument(
+        "--model",
+        metavar="MODEL",
+        help=f"model to use instead of the file's: {', '.join(MODEL_NAMES)} or a plugin's",
+    )
     parser.add_argument("--fps", type=whole, metavar="F", help="ticks per second instead")
     parser.add_argument("--ticks", type=whole, metavar="N", help="ticks to run instead")
 

@@ -26,8 +26,10 @@ def two_boxes(model: str = "paper", fps: int = 1, ticks: int = 12) -> dict:
         "model": model,
         "ticks": ticks,
         "objects": [
-            {"name": "left", "shape": "box", "size": 10, "position": [100, 115], "velocity": [10, 0]},
-            {"name": "right", "shape": "box", "size": 10, "position": [210, 115], "velocity": [-10, 0]},
+            {"name": "left", "shape": "box", "size": 10, "position": [100, 115]}
+            | {"velocity": [10, 0]},
+            {"name": "right", "shape": "box", "size": 10, "position": [210, 115]}
+            | {"velocity": [-10, 0]},
         ],
         "output": {"frames": "none", "gif": False, "events": True},
         "golden": {"frames": [0, 6, ticks]},
