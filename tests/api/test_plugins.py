@@ -6,6 +6,7 @@ module a scenario names by path.
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -203,3 +204,13 @@ def test_the_kit_passes_the_built_in_models_state_shapes():
     scene = head_on("paper", fps=10, ticks=20)
     assert problems("paper", scenes=[scene]) == []
     assert np.array_equal(collide2d.run(scene).final["vx"], [10.0, -10.0])
+
+
+def test_the_example_project_checks_against_its_goldens(register, monkeypatch):
+    """examples/boxflip's scenarios name the plugin; its goldens were blessed with it (CI checks
+    them again from a fresh virtualenv with the plugin installed)."""
+    register(BOXFLIP)
+    monkeypatch.setenv("CI", "true")  # compare only
+    found = collide2d.check(root=Path(__file__).resolve().parents[2] / "examples" / "boxflip")
+    assert [s.name for s in found.scenarios] == ["boxflip_gas", "boxflip_head_on"]
+    assert found.ok, [s.message for s in found.scenarios]
