@@ -342,7 +342,20 @@ def run_to_dir(
     options: RunOptions,
     limits: Limits | None = None,
 ) -> tuple[Path, dict]:
-    """Run and write the files of docs/outputs.md as OUT/NAME; returns (that folder, the summary).
+    """Run and write the files of docs/outputs.md as OUT/NAME; returns (that folder, the summary)
+    (`write_run`, which also returns the final state)."""
+    target, result = write_run(scenario, out_root, options, limits)
+    return target, result.summary
+
+
+def write_run(
+    scenario: Scenario,
+    out_root: str | os.PathLike,
+    options: RunOptions,
+    limits: Limits | None = None,
+) -> tuple[Path, RunResult]:
+    """Run and write the files of docs/outputs.md as OUT/NAME; returns (that folder, a RunResult
+    holding the final state and the summary; its events and frames are in the folder, not here).
 
     The frames are planned and checked against the limits first; then, holding OUT/NAME's lock,
     everything is written into a staging folder that replaces OUT/NAME whole at the end (see
@@ -361,7 +374,7 @@ def run_to_dir(
             output_dir(root, scenario)  # again, now that no other run can change it
             stage = rundir.new_stage(root, scenario.name)
             try:
-                summary = _write_run(scenario, stage, options, plan)
+                result = _write_run(scenario, stage, options, plan)
                 rundir.swap_in(stage, target)
             except BaseException as exc:
                 shutil.rmtree(stage, ignore_errors=True)
@@ -370,7 +383,7 @@ def run_to_dir(
                 raise
     except rundir.OutputBusy as exc:
         raise ScenarioError(scenario.path or "<scenario>", 1, 1, str(exc)) from None
-    return target, summary
+    return target, result
 
 
 def _shown(filename, stage: Path, target: Path) -> str:
@@ -384,13 +397,13 @@ def _shown(filename, stage: Path, target: Path) -> str:
     return str(target / final)
 
 
-def _write_run(scenario: Scenario, folder: Path, options: RunOptions, plan) -> dict:
-    """Run the scenario, writing its files into the empty `folder`; returns the summary."""
+def _write_run(scenario: Scenario, folder: Path, options: RunOptions, plan) -> RunResult:
+    """Run the scenario, writing its files into the empty `folder`; returns what it ended with."""
     with lanes.run(scenario, len(plan.draw)):  # the lane `drive` takes, for the viewer's too
         return _write_files(scenario, folder, options, plan)
 
 
-def _write_files(scenario: Scenario, folder: Path, options: RunOptions, plan) -> dict:
+def _write_files(scenario: Scenario, folder: Path, options: RunOptions, plan) -> RunResult:
     frames_dir = folder / "frames"  # made with its first frame: never an empty folder
     layer = None
     if options.overlay or options.viewer:
@@ -455,7 +468,7 @@ def _write_files(scenario: Scenario, folder: Path, options: RunOptions, plan) ->
     if recorder is not None and "interrupted_at_tick" not in summary:
         outputs.atomic_write_bytes(folder / viewer.VIEWER_FILE, recorder.page())
     outputs.write_json(folder / "summary.json", summary)
-    return summary
+    return RunResult(scenario, empty_events(), model.positions(), model.velocities(), {}, summary)
 
 
 def _log_full(scenario: Scenario, full, plan) -> ScenarioError:

@@ -192,7 +192,11 @@ def register(subparsers) -> None:
         "--n", action="append", type=_positive, metavar="N", help="scaling at this N (repeat)"
     )
     p.add_argument(
-        "--model", action="append", choices=models.MODEL_NAMES, help="only this model (repeat)"
+        "--model",
+        action="append",
+        type=_model,
+        metavar="MODEL",
+        help=f"only this model (repeat): {', '.join(models.MODEL_NAMES)} or a plugin's",
     )
     p.add_argument(
         "--in-process",
@@ -206,6 +210,15 @@ def register(subparsers) -> None:
     )
     p.add_argument("--quiet", action="store_true", help="no progress, no summary")
     p.set_defaults(func=cmd_bench)
+
+
+def _model(text: str) -> str:
+    """A model's name: a built-in one or a registered plugin's (engine.models)."""
+    if text not in models.names_for(text):
+        raise argparse.ArgumentTypeError(
+            f"unknown model {text!r}; expected one of {', '.join(models.names())}"
+        )
+    return text
 
 
 def _positive(text: str) -> int:

@@ -1,10 +1,11 @@
 """The error part of `collide2d bench`: run time against error, against the exact model.
 
-Each benchmark scenario under each model at the ladder of `ladder()` (paper and exact at every fps
-of FPS_LADDER; stepped at every fps with 1 substep, and at the scenario's fps with every count of
-SUBSTEPS), against the exact model at the scenario's fps. A model's rows run the scenario as
-`collide2d run --model M` would load it: `generate` draws whole px/s under `paper` and real ones
-under `stepped` and `exact`, so each row's reference is the exact model on that row's own bodies.
+Each benchmark scenario under each model at the ladder of `ladder()` (paper, exact and a model
+plugin at every fps of FPS_LADDER; stepped at every fps with 1 substep, and at the scenario's fps
+with every count of SUBSTEPS), against the exact model at the scenario's fps. A model's rows run the
+scenario as `collide2d run --model M` would load it: `generate` draws whole px/s under `paper` and
+real ones under `stepped` and `exact`, so each row's reference is the exact model on that row's own
+bodies.
 
 The measures of a row:
 - position error at each of HORIZONS_S (quick: QUICK_HORIZONS_S): the mean distance to the
@@ -50,6 +51,8 @@ QUICK_LADDER = {
     "stepped": [(60, 1), (60, 4), (60, 16), (60, 64)],
     "exact": [(60, 1)],
 }
+# A model plugin's rows in a quick run (engine.models.protocol: it takes no substeps).
+PLUGIN_QUICK_LADDER = [(30, 1), (60, 1)]
 # The sensitivity rows nudge every velocity by up to this much, px/s (seeded).
 NUDGE_PX_S = 1e-9
 NUDGE_SEED = 1
@@ -73,9 +76,10 @@ def position_error(pos: np.ndarray, ref: np.ndarray) -> float:
 
 
 def ladder(model: str, fps: int, quick: bool) -> list[tuple[int, int]]:
-    """The (fps, substeps) a model runs at on a scenario of `fps`."""
+    """The (fps, substeps) a model runs at on a scenario of `fps` (a plugin's: every fps of
+    FPS_LADDER, quick: PLUGIN_QUICK_LADDER)."""
     if quick:
-        return QUICK_LADDER.get(model, [])
+        return QUICK_LADDER.get(model, PLUGIN_QUICK_LADDER)
     rows = [(f, 1) for f in FPS_LADDER]
     if model == "stepped":
         rows += [(fps, s) for s in SUBSTEPS if s > 1]

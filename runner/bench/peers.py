@@ -1,7 +1,9 @@
 """The peers part of `collide2d bench`: pymunk steps the same standard scene (the `bench` extra).
 
-pymunk's space steps at 1/STANDARD_FPS s with boxes of mass 1 and infinite moment, elasticity 1,
-friction 0 and four static walls; the faster of its bounding-box tree and its spatial hash is
+pymunk steps at 1/STANDARD_FPS s with boxes of mass 1 and infinite moment, elasticity 1, friction 0
+and four static walls: the standard scene run by the pymunk model (`engine.models.pymunk`, the
+adapter behind `model: pymunk`, with no collision callback), so the bench times what a scenario
+runs; the faster of its bounding-box tree and its spatial hash is
 kept (`PymunkTimer`). The scaling part times pymunk in turn with the stepped model (`timer`,
 `scaling`'s `peer`): each round one pymunk run between the stepped model's two, so that a
 machine whose speed drifts over minutes (a shared virtual machine's does, by a quarter) slows
@@ -11,7 +13,6 @@ drift in); `peers` then divides the stepped model's steps/s by pymunk's.
 
 from __future__ import annotations
 
-import math
 import time
 
 from collide2d.runner.bench.scenes import STANDARD_FPS, STANDARD_SIZE_PX, standard_scene
@@ -31,37 +32,20 @@ def pymunk_available() -> bool:
     return True
 
 
-def _pymunk_space(scenario, hashed: bool):
-    """The standard scene as a pymunk space: boxes of mass 1 and infinite moment (no rotation),
-    elasticity 1, friction 0, four static walls, no gravity."""
-    import pymunk
+def _pymunk_model(scenario, hashed: bool):
+    """The standard scene as the pymunk model (`engine.models.pymunk`, the adapter `model:
+    pymunk` runs): boxes of mass 1 and infinite moment (no rotation), elasticity 1, friction 0,
+    four static walls, no gravity; no collision callback (pymunk's own speed)."""
+    from collide2d.engine.models.pymunk import Model
 
-    space = pymunk.Space()
-    space.gravity = (0.0, 0.0)
-    n = scenario.bodies.n
+    spatial_hash = None
     if hashed:
-        space.use_spatial_hash(
-            PYMUNK_HASH_SIDES * STANDARD_SIZE_PX, max(1000, PYMUNK_HASH_CELLS_PER_OBJECT * n)
+        n = scenario.bodies.n
+        spatial_hash = (
+            PYMUNK_HASH_SIDES * STANDARD_SIZE_PX,
+            max(1000, PYMUNK_HASH_CELLS_PER_OBJECT * n),
         )
-    w, h = scenario.world.width, scenario.world.height
-    corners = ((0, 0), (w, 0), (w, h), (0, h))
-    for k in range(4):
-        wall = pymunk.Segment(space.static_body, corners[k], corners[(k + 1) % 4], 0.0)
-        wall.elasticity = 1.0
-        wall.friction = 0.0
-        space.add(wall)
-    b = scenario.bodies
-    for (x, y), (bw, bh), (vx, vy) in zip(
-        b.pos.tolist(), b.size.tolist(), b.vel.tolist(), strict=True
-    ):
-        body = pymunk.Body(1.0, math.inf)
-        body.position = (x + bw / 2, y + bh / 2)
-        body.velocity = (vx, vy)
-        shape = pymunk.Poly.create_box(body, (bw, bh))
-        shape.elasticity = 1.0
-        shape.friction = 0.0
-        space.add(body, shape)
-    return space
+    return Model(scenario.world, scenario.bodies, spatial_hash=spatial_hash, events=False)
 
 
 class PymunkTimer:
@@ -77,26 +61,24 @@ class PymunkTimer:
         self.dt = 1.0 / STANDARD_FPS
         best = 0.0
         for hashed in (False, True):
-            space = _pymunk_space(scenario, hashed)
-            for _ in range(PYMUNK_WARMUP_STEPS):
-                space.step(self.dt)
+            model = _pymunk_model(scenario, hashed)
+            model.advance(PYMUNK_WARMUP_STEPS, log=False)
             began = time.perf_counter()
             steps = 0
             while time.perf_counter() - began < min(target, PROBE_S) or steps < 2:
-                space.step(self.dt)
+                model.advance(1, log=False)
                 steps += 1
             rate = steps / (time.perf_counter() - began)
             if rate > best:
                 best = rate
-                self.space = space
+                self.model = model
                 self.how = "spatial hash" if hashed else "bounding-box tree"
         self.ticks = max(2, int(target * best))
 
     def sample(self) -> float:
         """Steps/s of one timed run."""
         began = time.perf_counter()
-        for _ in range(self.ticks):
-            self.space.step(self.dt)
+        self.model.advance(self.ticks, log=False)
         return self.ticks / (time.perf_counter() - began)
 
 

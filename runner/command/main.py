@@ -7,7 +7,8 @@ runner.stress.cli, runner.bench.cli and runner.sweep.cli; `init` in runner.comma
 only the module of its command (`REGISTRARS`), so a run starts without loading the golden, stress,
 bench or sweep code; `--help` and an unknown command load them all. Exit status: 0 fine, 1 a check
 found a difference, 2 bad input or usage, 3 an unexpected error (one line naming the scenario; the
-traceback too with `--debug`). A refused scenario prints `FILE:LINE:COL: error: MESSAGE` on stderr
+traceback too with `--debug`), a model plugin's crash or protocol break among them (the line names
+the model). A refused scenario prints `FILE:LINE:COL: error: MESSAGE` on stderr
 and writes nothing.
 """
 
@@ -158,6 +159,7 @@ def overlay_names(text: str) -> tuple[str, ...]:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
+    import collide2d
     from collide2d.runner.command import settings as config
     from collide2d.runner.command.options import (
         apply_jit,
@@ -165,8 +167,6 @@ def cmd_run(args: argparse.Namespace) -> int:
         limits_from_args,
         overrides_from_args,
     )
-    from collide2d.runner.run import RunOptions, run_to_dir
-    from collide2d.runner.scenario.load import load
 
     project = config.find()
     if args.out and (project.file or project.scenarios.is_dir()):
@@ -180,24 +180,23 @@ def cmd_run(args: argparse.Namespace) -> int:
     apply_jit(args, project)
     path = args.scenario or demo_path()
     limits = limits_from_args(args, project)
-    scenario = load(
-        path,
-        overrides=overrides_from_args(args),
-        limits=limits,
-        defaults=project.model_defaults(),
-    )
-    out = scenario.output
-    options = RunOptions(
-        png=bool(out.frames) if args.png is None else args.png,
-        gif=out.gif if args.gif is None else args.gif,
-        events=out.events if args.events is None else args.events,
-        scale=args.scale,
-        quiet=args.quiet,
-        viewer=out.viewer if args.viewer is None else args.viewer,
-        overlay=out.overlay if args.overlay is None else args.overlay,
+    scenario = collide2d.load(
+        path, **overrides_from_args(args), limits=limits, defaults=project.model_defaults()
     )
     out_root = args.out or (project.folder("out") if project.file else "out")
-    target, summary = run_to_dir(scenario, out_root, options, limits)
+    result = collide2d.run(
+        scenario,
+        events=scenario.output.events if args.events is None else args.events,
+        out=out_root,
+        png=args.png,
+        gif=args.gif,
+        viewer=args.viewer,
+        overlay=args.overlay,
+        scale=args.scale,
+        quiet=args.quiet,
+        limits=limits,
+    )
+    target, summary = result.folder, result.summary
     if not args.quiet:
         counts = summary["events"]
         compiled = summary.get("compile_time_s", 0.0)
@@ -370,6 +369,9 @@ def unexpected(err: Exception, args: argparse.Namespace) -> int:
     if isinstance(what, list):
         what = " ".join(what)
     where = f" while running {what or args.command}"
+    if type(err).__name__ == "ModelError":  # a model plugin's fault (engine.models.protocol)
+        print(f"collide2d: error{where}: {err} (--debug shows where)", file=sys.stderr)
+        return EXIT_UNEXPECTED
     print(
         f"collide2d: unexpected error{where}: {type(err).__name__}: {err} "
         "(this is a bug; --debug shows where)",

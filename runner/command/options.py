@@ -12,8 +12,9 @@ the scenario file (the loader checks the result again); `add_cap_argument` adds
 from __future__ import annotations
 
 import argparse
+import difflib
 
-from collide2d.engine.models import MAX_EVENTS_PER_TICK, MODEL_NAMES
+from collide2d.engine.models import MAX_EVENTS_PER_TICK, MODEL_NAMES, names, names_for
 from collide2d.runner.scenario.limits import Limits
 
 _LIMIT_OPTIONS = (
@@ -74,9 +75,24 @@ def limits_from_args(args: argparse.Namespace, project=None) -> Limits:
 
 def add_override_arguments(parser: argparse.ArgumentParser) -> None:
     """Add --model, --fps and --ticks, which override the scenario file."""
-    parser.add_argument("--model", choices=MODEL_NAMES, help="model to use instead of the file's")
+    parser.add_argument(
+        "--model",
+        type=model_name,
+        metavar="MODEL",
+        help=f"model to use instead of the file's: {', '.join(MODEL_NAMES)} or a plugin's",
+    )
     parser.add_argument("--fps", type=whole, metavar="F", help="ticks per second instead")
     parser.add_argument("--ticks", type=whole, metavar="N", help="ticks to run instead")
+
+
+def model_name(text: str) -> str:
+    """`--model M`: a built-in model or a registered plugin (engine.models; the plugins are looked
+    up only for a name that is not built in)."""
+    if text not in names_for(text):
+        near = difflib.get_close_matches(text, names_for(text), n=1)
+        hint = f"did you mean '{near[0]}'?" if near else "expected " + " | ".join(names())
+        raise argparse.ArgumentTypeError(f"unknown model {text!r}; {hint}")
+    return text
 
 
 def add_cap_argument(parser: argparse.ArgumentParser) -> None:

@@ -16,8 +16,9 @@ checked, named by its path in the JUnit file and the JSON summaries); `bless` re
 anything runs.
 
 `register(subparsers)` adds both commands to the `collide2d` parser; each sets `func(args) -> int`.
-The scenario loader and the simulator can be handed in (tests use synthetic ones); by default they
-are `runner.scenario.load.load` and `runner.run.simulate`.
+Each scenario is checked or blessed by `collide2d.api.check_scenario`, the step the public
+`collide2d.check` takes too. The scenario loader and the simulator can be handed in (tests use
+synthetic ones); by default they are `runner.scenario.load.load` and `runner.run.simulate`.
 """
 
 from __future__ import annotations
@@ -28,13 +29,14 @@ import traceback
 from functools import partial
 from pathlib import Path
 
+from collide2d.api import check_scenario
 from collide2d.runner.command.exitcodes import (
     EXIT_BAD_INPUT,
     EXIT_DIFFERENCE,
     EXIT_OK,
     EXIT_UNEXPECTED,
 )
-from collide2d.runner.golden import bless_run, check_run, golden_frames, report, shown_path
+from collide2d.runner.golden import golden_frames, report, shown_path
 from collide2d.runner.golden.formats import Output, add_check_formats
 from collide2d.runner.golden.fromreport import add_from_report, bless_from_report
 from collide2d.runner.golden.store import (
@@ -214,13 +216,16 @@ def check_command(args, *, load=default_load, simulate=default_simulate) -> int:
     for i, (path, scn) in enumerate(scenarios, start=1):
         _progress(args, f"[{i}/{len(scenarios)}] checking {scn.name}")
         try:
-            if runs is not None:  # run on a Dask cluster (--workers, --scheduler)
-                result = runs[i - 1]()
-            else:
-                result = run_scenario(scn, simulate, progress=_show_progress(args))
-            outcome = check_run(
-                scn, result, store, path=path, report_dir=report_dir, viewer=viewer_of(simulate)
-            )
+            outcome = check_scenario(
+                scn,
+                store,
+                path=path,
+                report=report_dir,
+                simulate=simulate,
+                run=runs[i - 1] if runs is not None else None,  # on Dask (--workers, --scheduler)
+                viewer=viewer_of(simulate),
+                progress=_show_progress(args),
+            )._record
         except Exception as exc:  # one scenario never stops the others
             status = max(status, _scenario_failed(args, "checking", path, scn.name, exc))
             errors.append((scn.name, f"{type(exc).__name__}: {exc}"))
@@ -312,8 +317,9 @@ def bless_command(args, *, load=default_load, simulate=default_simulate) -> int:
     for i, (path, scn) in enumerate(scenarios, start=1):
         _progress(args, f"[{i}/{len(scenarios)}] running {scn.name}")
         try:
-            result = run_scenario(scn, simulate, progress=_show_progress(args))
-            line = bless_run(scn, result, store).line()
+            line = check_scenario(
+                scn, store, path=path, bless=True, simulate=simulate, progress=_show_progress(args)
+            ).message
         except Exception as exc:  # one scenario never stops the others
             status = max(status, _scenario_failed(args, "blessing", path, scn.name, exc))
             continue

@@ -14,8 +14,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from collide2d.engine.models import MODEL_NAMES, options_of, shapes_of
 from collide2d.engine.noroom import no_room, no_room_message
-from collide2d.engine.world import Bodies, Looks, WorldSpec
+from collide2d.engine.world import KIND_NAMES, Bodies, Looks, WorldSpec
 from collide2d.runner import lanes
 from collide2d.runner.scenario import generate as gen
 from collide2d.runner.scenario import rules
@@ -266,3 +267,27 @@ def check_table_placement(table, geometry: str = "box") -> None:
         named = f"{table.names[a]}, " if table.names[a] else ""
         other = f"object {a} ({named}row {a + 1})"
         raise table.error(found.row, "x", found.text.format(other=other))
+
+
+def check_plugin(reader: Nodes, model: str, geometry: str, bodies: Bodies, lines, top) -> None:
+    """Under a model plugin (engine.models.protocol), the scenario holds only what the model says
+    it takes: `geometry: exact` only when it takes `geometry`, objects only of its `SHAPES` (the
+    first of another shape is refused at its line)."""
+    if model in MODEL_NAMES:
+        return
+    if geometry != "box" and "geometry" not in options_of(model):
+        raise reader.error(
+            top["model"][1], f"the model '{model}' does not take geometry '{geometry}'"
+        )
+    takes = shapes_of(model)
+    kinds = [KIND_NAMES.index(s) for s in takes]
+    bad = np.flatnonzero(~np.isin(bodies.kind, kinds))
+    if len(bad):
+        i = int(bad[0])
+        raise ScenarioError(
+            reader.path,
+            lines[i],
+            1,
+            f"object {i} is a {KIND_NAMES[bodies.kind[i]]}, a shape the model '{model}' does not "
+            f"take (it takes {', '.join(takes) or 'none'})",
+        )

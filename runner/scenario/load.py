@@ -359,6 +359,7 @@ class _Reader(ModelReader):
         )
         if table is not None and table.sha256 is not None:
             digest = tables.with_table(digest, table.sha256)
+        assemble.check_plugin(self, model, geometry, bodies, lines, top)  # engine.models.protocol
         if model == "exact":
             assemble.check_room(self, world, bodies, geometry, names, listed, lines, table)
         return Scenario(

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 
 import yaml
 
-from collide2d.engine.models import MAX_EVENTS_PER_TICK, MODEL_NAMES
+from collide2d.engine.models import MAX_EVENTS_PER_TICK, names_for
 from collide2d.engine.shapes import GEOMETRIES
 from collide2d.runner.scenario.nodes import Nodes, _raise
 from collide2d.runner.scenario.rules import EXACT_REFUSES, MAX_FRICTION, MAX_SPEED, PAPER_REFUSES
@@ -152,7 +152,7 @@ class ModelReader(Nodes):
                 m = self.mapping(node, "model", MODEL_KEYS)
                 if "kind" not in m:
                     raise self.error(node, "model is missing 'kind' (paper | stepped | exact)")
-                kind = self.choice(m["kind"][1], "model", MODEL_NAMES)
+                kind = self.choice(m["kind"][1], "model", names_for(m["kind"][1].value))
                 if "substeps" in m:
                     sub_node = m["substeps"][1]
                     substeps = self._setting(m, "substeps", kind, "stepped")
@@ -172,14 +172,14 @@ class ModelReader(Nodes):
                             "paper model, where every shape collides as its box",
                         )
             else:
-                kind = self.choice(node, "model", MODEL_NAMES)
+                kind = self.choice(node, "model", names_for(node.value))
         if "model" in self.overrides:
             v = self.overrides["model"]
             origin = f"--model {v}"
-            if not isinstance(v, str) or v not in MODEL_NAMES:
-                near = difflib.get_close_matches(str(v), MODEL_NAMES, n=1)
+            if not isinstance(v, str) or v not in names_for(v):
+                near = difflib.get_close_matches(str(v), names_for(v), n=1)
                 hint = (
-                    f"did you mean '{near[0]}'?" if near else "expected " + " | ".join(MODEL_NAMES)
+                    f"did you mean '{near[0]}'?" if near else "expected " + " | ".join(names_for(v))
                 )
                 raise self.error(None, f"{origin}: unknown model {v!r}; {hint}")
             if v != kind:

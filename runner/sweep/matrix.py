@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import yaml
 
-from collide2d.engine.models import MODEL_NAMES, SCENARIO_OPTIONS
+from collide2d.engine.models import names, names_for, options_of
 from collide2d.runner.scenario import parse as ys
 from collide2d.runner.scenario.limits import Limits
 from collide2d.runner.scenario.load import Scenario, ScenarioError, load
@@ -300,9 +300,10 @@ def check_axes(scenarios: list[str], axes: list[Axis], seeds) -> int:
             raise SweepError(f"{axis.origin}: a value is given twice")
         if axis.key == "model":
             for node, text in zip(axis.nodes, axis.texts, strict=True):
-                if not isinstance(node, yaml.ScalarNode) or ys.value(node) not in MODEL_NAMES:
+                known = names_for(ys.value(node)) if isinstance(node, yaml.ScalarNode) else ()
+                if not isinstance(node, yaml.ScalarNode) or ys.value(node) not in known:
                     raise SweepError(
-                        f"{axis.origin}: unknown model {text!r}; expected {' | '.join(MODEL_NAMES)}"
+                        f"{axis.origin}: unknown model {text!r}; expected {' | '.join(names())}"
                     )
     count = 1
     for axis in axes:
@@ -321,7 +322,7 @@ def choices(path: str, axes: list[Axis], seed: int | None, limits: Limits):
         chosen = {a.key: (a.nodes[i], a.texts[i]) for a, i in zip(axes, combo, strict=True)}
         model = ys.value(chosen["model"][0]) if "model" in chosen else base_model
         for key in ("substeps", "geometry"):
-            if key in chosen and key not in SCENARIO_OPTIONS[model]:
+            if key in chosen and key not in options_of(model):
                 del chosen[key]  # this model does not take it: the runs count once
         yield chosen, model
 
@@ -382,7 +383,7 @@ def combo_of(path, chosen, model, dotted, seed, limits) -> tuple[Combo, Scenario
         text = chosen[axis.key][1]
         params[axis.key] = text
         head.append(_sort_value(text))
-    takes = SCENARIO_OPTIONS[scenario.model]
+    takes = options_of(scenario.model)
     settings = {
         "model": scenario.model,
         "fps": str(scenario.world.fps),

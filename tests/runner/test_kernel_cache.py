@@ -88,7 +88,7 @@ def poke(a, i):
 def crash(*args, **kwargs):
     poke(np.zeros(1), 1 << 40)
 
-run.run_to_dir = crash
+run.write_run = crash  # the run path of `collide2d run` (collide2d.run)
 sys.argv = ["collide2d", "run", "--out", "out"]
 sys.exit(cli.main())
 """

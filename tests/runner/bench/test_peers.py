@@ -13,7 +13,9 @@ from collide2d.runner.scenario.load import loads
 def test_pymunk_steps_the_same_standard_scene():
     pymunk = pytest.importorskip("pymunk")
     scenario = loads(scenes.standard_scene(30, "stepped"))
-    space = peers._pymunk_space(scenario, hashed=False)
+    model = peers._pymunk_model(scenario, hashed=False)
+    assert type(model).__module__ == "collide2d.engine.models.pymunk.model"  # model: pymunk's
+    space = model.space
     assert len(space.bodies) == 30 and len(space.shapes) == 30 + 4
     body = list(space.bodies)[0]
     assert body.moment == math.inf and body.mass == 1.0
