@@ -32,7 +32,7 @@ MAX_EVENTS_PER_TICK = 1_000_000
 # none.
 SCENARIO_OPTIONS = {
     "paper": (),
-    "stepped": ("substeps", "geometry"),
+    "stepped": ("substeps", "geometry", "iterations", "slop", "rest_speed", "sleep", "sleep_after"),
     "exact": ("geometry", "max_events_per_tick"),
 }
 

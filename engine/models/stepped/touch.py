@@ -1,0 +1,247 @@
+"""The settling path's contacts (docs/models.md#stepped-gravity): which objects touch after a
+step's move, the walls included, each with its normal, depth, restitution and friction; which
+sleeping objects a moving one wakes; and the impulses last step's contacts ended with.
+
+Input: the state (`records.Fall`), the constants (`records.Physics`) and the candidate list and
+contact buffers (`records.Touch`). Output: this step's contacts, written into `Touch.pairs` (a key
+each) and `Touch.floats` (columns C_*), in ascending key order: the walls first (by object, then
+side), then the pairs (by ids). Their order is a total order of ids, so the solver's passes, and
+with them every result, are the same whatever order the broad phase found the pairs in.
+
+The candidate list (a Verlet list) holds the pairs whose boxes, each grown by half a margin, overlap,
+at least one of them awake; it is made anew once an awake object has drifted half the margin
+from where it was when the list was made (then no two objects can have closed the margin since,
+so every pair that touches now is listed), and whenever an object wakes (its pairs with the
+sleeping were not listed). A contact of a sleeping object with an awake one that moves at the
+rest speed or faster wakes it; with a slower one, the sleeping object holds like a static one.
+Two sleeping objects are never paired.
+
+A contact's normal runs from its first object to its second (to the wall, for a wall). Boxes: the
+axis along which the pair started overlapping in the step, when it did (contact.box_sweep, swept
+back along the relative velocity), else the axis of the smaller overlap (contact.box_penetration);
+exact shapes (`geometry: exact`): the minimum-penetration normal (contact.penetration). It keeps
+`C_GAP`, the depth plus the offset of the two objects along the normal, so that the solver reads
+the depth left after any push as C_GAP - (p_b - p_a)·n.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from collide2d.engine.broadphase import KEY_MASK, KEY_SHIFT, find_split
+from collide2d.engine.contact import box_penetration, box_sweep, penetration
+from collide2d.engine.events import AXIS_NORMAL, AXIS_X, AXIS_XY, AXIS_Y, EV_PAIR, log_event
+from collide2d.engine.jit import njit
+from collide2d.engine.models.stepped.move import B_H, B_VX, B_VY, B_W, B_X, B_Y
+from collide2d.engine.sort import sort_keys
+
+# The columns of a contact's row of floats: the normal, the depth plus the offset along it (px),
+# the two sides' inverse masses (0 for a static, sleeping or wall side), the contact's e and mu,
+# the speed it approached at when found (px/s, > 0 approaching), and the normal and friction
+# impulses so far (per unit of inverse mass: px/s x mass).
+C_NX, C_NY, C_GAP, C_WA, C_WB, C_E, C_MU, C_U0, C_LN, C_LT = range(10)
+C_COLUMNS = 10
+# The model's counts: listed keys (-1: no list), contacts, last step's contacts, wall events,
+# pair events, whether the list must be made anew, awake objects.
+N_KEYS, N_CONTACTS, N_LAST, N_WALLS, N_PAIRS, N_RELIST, N_AWAKE = range(7)
+N_SIZE = 7
+# A wall contact's key: below every pair's key (which are >= 0), by object, then side (SIDE_*).
+WALL_KEY_BASE = -(1 << 62)
+# An object this close to a wall (px) touches it.
+WALL_TOUCH_PX = 1e-9
+# Contacts and keys to start with per object (the buffers double when full).
+CONTACTS_PER_OBJECT = 4
+
+
+@njit(cache=True)
+def relist(F, P, T, keys):
+    """Make the candidate list anew (module docstring) and anchor every object where it is;
+    returns the key buffer (grown when it was too small)."""
+    body, anchor, lo, hi = F.body, F.anchor, T.lo, T.hi
+    n = body.shape[0]
+    for i in range(n):
+        lo[i, 0] = body[i, B_X] - P.half
+        lo[i, 1] = body[i, B_Y] - P.half
+        hi[i, 0] = body[i, B_X] + body[i, B_W] + P.half
+        hi[i, 1] = body[i, B_Y] + body[i, B_H] + P.half
+        anchor[i, 0] = body[i, B_X]
+        anchor[i, 1] = body[i, B_Y]
+    found = np.zeros(1, np.int64)
+    k = find_split(T.finder, lo, hi, F.awake, T.cell, T.order, keys, T.ws, found)
+    while k > keys.shape[0]:
+        keys = np.empty(2 * k, np.int64)
+        k = find_split(T.finder, lo, hi, F.awake, T.cell, T.order, keys, T.ws, found)
+    sort_keys(keys, k)
+    T.counts[N_KEYS] = k
+    T.counts[N_RELIST] = 0
+    return keys
+
+
+@njit(cache=True, inline="always")
+def _speed2(body, i):
+    return body[i, B_VX] * body[i, B_VX] + body[i, B_VY] * body[i, B_VY]
+
+
+@njit(cache=True)
+def _room(pairs, floats, m):
+    """The contact buffers with room for row m (doubled when full)."""
+    if m < pairs.shape[0]:
+        return pairs, floats
+    more_pairs = np.empty(2 * pairs.shape[0] + 16, np.int64)
+    more_floats = np.empty((more_pairs.shape[0], C_COLUMNS))
+    for r in range(m):
+        more_pairs[r] = pairs[r]
+        for c in range(C_COLUMNS):
+            more_floats[r, c] = floats[r, c]
+    return more_pairs, more_floats
+
+
+@njit(cache=True, inline="always")
+def _put(floats, m, nx, ny, gap, wa, wb, e, mu, u0):
+    row = floats[m]
+    row[C_NX], row[C_NY], row[C_GAP], row[C_WA], row[C_WB] = nx, ny, gap, wa, wb
+    row[C_E], row[C_MU], row[C_U0], row[C_LN], row[C_LT] = e, mu, u0, 0.0, 0.0
+
+
+@njit(cache=True)
+def walls(F, P, sides, pairs, floats):
+    """The contacts of awake objects with the walls they touch, in id order (x sides first);
+    returns (buffers, how many)."""
+    body = F.body
+    m = 0
+    for i in range(body.shape[0]):
+        if not F.awake[i]:
+            continue
+        e = min(F.restitution[i], P.restitution)
+        mu = max(F.friction[i], P.friction)
+        for axis in range(2):
+            span = sides[axis] - body[i, B_W + axis]
+            p = body[i, B_X + axis]
+            v = body[i, B_VX + axis]
+            for high in range(2):
+                if high == 0 and not p <= WALL_TOUCH_PX:
+                    continue
+                if high == 1 and not (span > 0.0 and p >= span - WALL_TOUCH_PX):
+                    continue
+                sign = 1.0 if high else -1.0
+                pairs, floats = _room(pairs, floats, m)
+                pairs[m] = WALL_KEY_BASE + 4 * i + 2 * axis + high
+                nx, ny = (sign, 0.0) if axis == 0 else (0.0, sign)
+                _put(floats, m, nx, ny, 0.0, F.inv_mass[i], 0.0, e, mu, max(sign * v, 0.0))
+                m += 1
+    return pairs, floats, m
+
+
+@njit(cache=True)
+def _normal(F, T, a, b, dt):
+    """(depth, code, nx, ny) of objects a and b (ids) after the step: module docstring."""
+    body = F.body
+    qx = body[b, B_X] - body[a, B_X]
+    qy = body[b, B_Y] - body[a, B_Y]
+    wa, ha, wb, hb = body[a, B_W], body[a, B_H], body[b, B_W], body[b, B_H]
+    if T.exact:
+        shape, radius, start, verts, normals = T.cores
+        return penetration(
+            qx, qy, shape[a], wa, ha, radius[a], verts[start[a] : start[a + 1]],
+            normals[start[a] : start[a + 1]], shape[b], wb, hb, radius[b],
+            verts[start[b] : start[b + 1]], normals[start[b] : start[b + 1]],
+        )  # fmt: skip
+    depth, code, nx, ny = box_penetration(qx, qy, wa, ha, wb, hb)
+    if not depth > 0.0:
+        return depth, code, nx, ny
+    ux = body[b, B_VX] - body[a, B_VX]
+    uy = body[b, B_VY] - body[a, B_VY]
+    t_enter, _, c, sx, sy = box_sweep(qx - ux * dt, qy - uy * dt, ux, uy, wa, ha, wb, hb)
+    if 0.0 <= t_enter <= dt:  # began this step: the axis it came in by
+        code, nx, ny = c, sx, sy
+        if c == AXIS_X:
+            depth = wa - qx if nx > 0.0 else qx + wb
+        elif c == AXIS_Y:
+            depth = ha - qy if ny > 0.0 else qy + hb
+    if code == AXIS_XY:  # corner to corner: the diagonal, deep enough to part both axes
+        depth = min(wa - qx if nx > 0.0 else qx + wb, ha - qy if ny > 0.0 else qy + hb)
+        depth *= math.sqrt(2.0)
+        nx *= math.sqrt(0.5)
+        ny *= math.sqrt(0.5)
+        code = AXIS_NORMAL
+    return depth, code, nx, ny
+
+
+@njit(cache=True)
+def pair_contacts(F, P, T, keys, pairs, floats, m, at, log):
+    """The listed pairs in contact after the step `at` (a Step), from row m on: wakes a sleeping
+    object that an awake one moving at the rest speed or faster touches (and asks for a new
+    list), and logs a pair event for each approaching at the rest speed or faster (faster than
+    0 without gravity). log = (rows, times, n_ev). Returns (buffers, how many rows, log)."""
+    body, awake, asleep = F.body, F.awake, F.asleep
+    rows, times, n_ev = log
+    rest2 = P.rest * P.rest
+    for c in range(T.counts[N_KEYS]):
+        a = keys[c] >> KEY_SHIFT
+        b = keys[c] & KEY_MASK
+        if not (awake[a] or awake[b]):
+            continue
+        depth, code, nx, ny = _normal(F, T, a, b, at.dt)
+        if not depth > 0.0:
+            continue
+        for s, o in ((a, b), (b, a)):  # a sleeping side woken by a moving one
+            if asleep[s] and awake[o] and _speed2(body, o) >= rest2 and rest2 > 0.0:
+                asleep[s] = False
+                awake[s] = True
+                F.quiet[s] = 0.0
+                T.counts[N_RELIST] = 1
+        wa = F.inv_mass[a] if awake[a] else 0.0
+        wb = F.inv_mass[b] if awake[b] else 0.0
+        if wa + wb == 0.0:
+            continue
+        ux = body[b, B_VX] - body[a, B_VX]
+        uy = body[b, B_VY] - body[a, B_VY]
+        u0 = max(-(ux * nx + uy * ny), 0.0)
+        gap = depth + (body[b, B_X] - body[a, B_X]) * nx + (body[b, B_Y] - body[a, B_Y]) * ny
+        e = min(F.restitution[a], F.restitution[b])
+        mu = max(F.friction[a], F.friction[b])
+        pairs, floats = _room(pairs, floats, m)
+        pairs[m] = keys[c]
+        _put(floats, m, nx, ny, gap, wa, wb, e, mu, u0)
+        m += 1
+        if u0 > 0.0 and u0 >= P.rest:
+            T.counts[N_PAIRS] += 1
+            if at.log:
+                if nx == 0.0:
+                    code = AXIS_Y
+                elif ny == 0.0:
+                    code = AXIS_X
+                rows, times = log_event(rows, times, n_ev, at.tick, at.t, EV_PAIR, a, b, code)
+                n_ev += 1
+    return pairs, floats, m, (rows, times, n_ev)
+
+
+@njit(cache=True)
+def warm(T, pairs, floats, m, last_keys, last):
+    """Each contact that last step had too (same key) starts from the impulses it ended with
+    there (both lists ascend by key: one merge)."""
+    j = 0
+    n_last = T.counts[N_LAST]
+    for c in range(m):
+        while j < n_last and last_keys[j] < pairs[c]:
+            j += 1
+        if j < n_last and last_keys[j] == pairs[c]:
+            floats[c, C_LN] = last[j, 0]
+            floats[c, C_LT] = last[j, 1]
+
+
+@njit(cache=True)
+def keep(T, pairs, floats, m, last_keys, last):
+    """Keep this step's contacts' keys and impulses for the next step's `warm`; returns the
+    buffers (grown when too small)."""
+    if last.shape[0] < m:
+        last_keys = np.empty(2 * m, np.int64)
+        last = np.empty((2 * m, 2))
+    for c in range(m):
+        last_keys[c] = pairs[c]
+        last[c, 0] = floats[c, C_LN]
+        last[c, 1] = floats[c, C_LT]
+    T.counts[N_LAST] = m
+    return last_keys, last
