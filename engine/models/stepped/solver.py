@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import math
 
+from collide2d.engine.broadphase import KEY_MASK, KEY_SHIFT
 from collide2d.engine.jit import njit
 from collide2d.engine.models.stepped.move import B_H, B_VX, B_VY, B_W, B_X, B_Y
 from collide2d.engine.models.stepped.touch import (
@@ -51,7 +52,6 @@ from collide2d.engine.models.stepped.touch import (
     C_WB,
     WALL_KEY_BASE,
 )
-from collide2d.engine.broadphase import KEY_MASK, KEY_SHIFT
 
 
 @njit(cache=True, inline="always")

@@ -8,10 +8,10 @@ each) and `Touch.floats` (columns C_*), in ascending key order: the walls first 
 side), then the pairs (by ids). Their order is a total order of ids, so the solver's passes, and
 with them every result, are the same whatever order the broad phase found the pairs in.
 
-The candidate list (a Verlet list) holds the pairs whose boxes, each grown by half a margin, overlap,
-at least one of them awake; it is made anew once an awake object has drifted half the margin
-from where it was when the list was made (then no two objects can have closed the margin since,
-so every pair that touches now is listed), and whenever an object wakes (its pairs with the
+The candidate list (a Verlet list) holds the pairs whose boxes, each grown by half a margin,
+overlap, at least one of them awake; it is made anew once an awake object has drifted half the
+margin from where it was when the list was made (then no two objects can have closed the margin
+since, so every pair that touches now is listed), and whenever an object wakes (its pairs with the
 sleeping were not listed). A contact of a sleeping object with an awake one that moves at the
 rest speed or faster wakes it; with a slower one, the sleeping object holds like a static one.
 Two sleeping objects are never paired.
