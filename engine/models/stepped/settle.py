@@ -27,7 +27,7 @@ from collide2d.engine.models.stepped.fall import MAX_HITS_PER_STEP, fall
 from collide2d.engine.models.stepped.move import BODY_COLUMNS
 from collide2d.engine.models.stepped.records import Fall, Physics, Step, Touch
 from collide2d.engine.models.stepped.sleep import doze
-from collide2d.engine.models.stepped.solver import correct, kinetic, solve
+from collide2d.engine.models.stepped.solver import correct, energy, kinetic, solve
 from collide2d.engine.models.stepped.touch import (
     C_COLUMNS,
     CONTACTS_PER_OBJECT,
@@ -81,21 +81,25 @@ def step(F, P, T, at, sides, bufs, log):
     counts = T.counts
     if counts[N_AWAKE] == 0:  # everything static or asleep
         return bufs, log
-    # move: exact motion under gravity, bounces off the walls
+    # move: exact motion under gravity, bounces off the walls (what they take noted)
+    before = energy(F, P)
     drift, bounces, log = fall(F, P, at, sides, T.hits, log)
+    taken = max(before - energy(F, P), 0.0)
     counts[N_WALLS] += bounces
     # the candidate list anew once an awake object drifted half the margin, or one woke
     if counts[N_KEYS] < 0 or counts[N_RELIST] != 0 or drift >= P.half - DRIFT_SLACK_PX:
         keys = relist(F, P, T, keys)
     # contacts: walls, then pairs by ids; starting from last step's impulses
-    pairs, floats, m = walls(F, P, sides, pairs, floats)
+    pairs, floats, m = walls(F, P, sides, pairs, floats, at.dt)
     pairs, floats, m, log = pair_contacts(F, P, T, keys, pairs, floats, m, at, log)
     warm(T, pairs, floats, m, last_keys, last)
     counts[N_CONTACTS] = m
-    # velocities: every contact together, then restitution; never more kinetic energy
-    k0 = solve(F, P, pairs, floats, m)
-    # positions: overlap past slop, within the energy the velocities gave up
-    correct(F, P, pairs, floats, m, k0 - kinetic(F), sides)
+    # velocities: every contact together, then restitution; never more energy than the step began
+    # with
+    limit = solve(F, P, pairs, floats, m, taken)
+    # positions: overlap past slop, within the energy given up so far
+    T.bank[0] += limit - kinetic(F)
+    T.bank[0] -= correct(F, P, pairs, floats, m, T.bank[0], sides)
     last_keys, last = keep(T, pairs, floats, m, last_keys, last)
     # sleep: objects slow for sleep_after s
     counts[N_AWAKE] = doze(F, P, at.dt)
@@ -204,6 +208,7 @@ class Settle:
             cores=(cores.shape, cores.radius, cores.start, cores.verts, cores.normals),
             exact=geometry == "exact",
             hits=np.zeros(MAX_HITS_PER_STEP + 1, np.int64),
+            bank=np.zeros(1),
         )
         self.tick = 0
 

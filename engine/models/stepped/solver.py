@@ -8,28 +8,32 @@ changed in place.
 Velocities (`solve`), sequential impulses over `iterations` passes. A contact of normal n (from a
 to b) has the relative normal velocity u = (v_b - v_a)·n (< 0 approaching) and the effective mass
 1 / (w_a + w_b) (w the inverse masses; the same along the tangent t, there being no rotation).
-Each pass gives each contact in turn the impulse that stops its approach, kept as a running total
-clamped at >= 0 (a contact pushes, never pulls), then the friction impulse that stops its sliding,
-its total clamped to mu times the normal total (Coulomb's cone, in 2-D a segment). Each such
-update is the least kinetic energy its one impulse can reach within its bounds, so from the
-velocities the step began with the passes never add energy. A contact that the last step had too
-starts from the impulses it ended with there (warm starting: a stack's weight is carried from step
-to step instead of being found again in a few passes); should that start leave more kinetic energy
-than the step began with, the passes run again from no impulse at all.
+Each pass gives each contact in turn the impulse that brings u up to its goal (touch.C_GO: 0
+between two falling objects; ½·g·dt away from a support that does not fall, so that the next
+step's gravity brings the object back to it exactly: a body at rest neither sinks nor lifts off),
+kept as a running total clamped at >= 0 (a contact pushes, never pulls), then the friction
+impulse that stops its sliding, its total clamped to mu times the normal total (Coulomb's cone,
+in 2-D a segment). The passes run forward and backward in turn. A contact that the last step had
+too starts from the impulses it ended with there (warm starting: a stack's weight is carried from
+step to step instead of being found again in a few passes). Should the passes leave more kinetic
+energy than the step began with (plus what its move took away), their change is scaled back by
+the largest factor in [0, 1] that does not (the energy is a quadratic in the factor).
 
 Then restitution, one pass: a contact that approached at the rest speed or faster (any speed
 without gravity) is given the normal impulse that makes it part at e times that speed (and the
 friction that goes with it); slower contacts get e = 0, so a body at rest stays at rest. Alone a
 contact then parts at exactly -e times its approach. Among many, one pass can overshoot; the pass
-is then scaled by the largest factor in [0, 1] that leaves the kinetic energy at most what it was
-before the step's impulses (the energy is a quadratic in the factor).
+is scaled back the same way.
 
-Positions (`correct`): overlap deeper than `slop` is removed in `iterations` passes, each pair
-pushed apart along its normal by its depth past slop, shared by inverse mass, never out of the
-world (a side that a wall stops hands the rest to the other). Velocities are not touched. A push
-shared by inverse mass along gravity keeps the potential energy; one against a wall or a static or
-sleeping object raises it. The pushes are scaled back, when needed, so that what they raise stays
-within what the velocity passes took away this step: the step's energy never rises.
+Positions (`correct`): overlap deeper than `slop` is removed in `iterations` passes (forward and
+backward in turn), each pair pushed apart along its normal by its depth past slop, shared by
+inverse mass, never out of the world (a side that a wall stops hands the rest to the other).
+Velocities are not touched. A push shared by inverse mass along gravity keeps the potential
+energy; one against a wall or a static or sleeping object raises it (the object had sunk into its
+support, the fall's energy given up by the contact's velocity). The pushes are scaled back, when
+needed, so that what they raise stays within the energy the velocity passes have given up so far
+and pushes have not spent (settle.py keeps that account): the energy never rises above what the
+scene began with, and a push never gives an object speed.
 """
 
 from __future__ import annotations
@@ -42,6 +46,7 @@ from collide2d.engine.models.stepped.move import B_H, B_VX, B_VY, B_W, B_X, B_Y
 from collide2d.engine.models.stepped.touch import (
     C_E,
     C_GAP,
+    C_GO,
     C_LN,
     C_LT,
     C_MU,
@@ -73,6 +78,19 @@ def kinetic(F):
     return 0.5 * k
 
 
+@njit(cache=True)
+def energy(F, P):
+    """Kinetic and potential energy of the awake objects (potential relative to the world's
+    origin, -m·(g·p), p the top-left corner), px^2/s^2 x mass."""
+    body = F.body
+    k = 0.0
+    for i in range(body.shape[0]):
+        if F.awake[i]:
+            vx, vy = body[i, B_VX], body[i, B_VY]
+            k += F.mass[i] * (0.5 * (vx * vx + vy * vy) - P.gx * body[i, B_X] - P.gy * body[i, B_Y])
+    return k
+
+
 @njit(cache=True, inline="always")
 def _impulse(body, a, b, wa, wb, jx, jy):
     """Impulse j (per unit mass x inverse mass) from a to b: a loses wa j, b gains wb j."""
@@ -95,22 +113,23 @@ def _velocity(body, a, b, nx, ny):
 
 
 @njit(cache=True)
-def _pass(body, pairs, floats, m, target, rest):
-    """One pass over the contacts: each one's normal impulse toward the normal velocity
-    `target` (0: stop the approach; 1: part at e x its approach, for those that came at `rest`
-    or faster), then its friction."""
-    for c in range(m):
+def _pass(body, pairs, floats, m, target, rest, back):
+    """One pass over the contacts, in key order (from the last when `back`): each one's normal
+    impulse toward the normal velocity `target` (0: stop the approach; 1: part at e x its
+    approach, for those that came at `rest` or faster), then its friction."""
+    for k in range(m):
+        c = m - 1 - k if back else k
         row = floats[c]
         a, b = sides_of(pairs[c])
         nx, ny, wa, wb = row[C_NX], row[C_NY], row[C_WA], row[C_WB]
         mass = 1.0 / (wa + wb)
         un, ut = _velocity(body, a, b, nx, ny)
-        goal = 0.0
+        goal = row[C_GO]
         if target:
             u0 = row[C_U0]
             if not (u0 > 0.0 and u0 >= rest and row[C_E] > 0.0):
                 continue
-            goal = row[C_E] * u0
+            goal = max(row[C_E] * u0, goal)
         total = max(row[C_LN] + (goal - un) * mass, 0.0)
         dn = total - row[C_LN]
         row[C_LN] = total
@@ -137,18 +156,6 @@ def _save_velocities(F):
     for i in range(body.shape[0]):
         saved[i, 0] = body[i, B_VX]
         saved[i, 1] = body[i, B_VY]
-
-
-@njit(cache=True)
-def _restart(F, floats, m):
-    """Back to the velocities saved and no impulse."""
-    body, saved = F.body, F.saved
-    for i in range(body.shape[0]):
-        body[i, B_VX] = saved[i, 0]
-        body[i, B_VY] = saved[i, 1]
-    for c in range(m):
-        floats[c, C_LN] = 0.0
-        floats[c, C_LT] = 0.0
 
 
 @njit(cache=True)
@@ -182,23 +189,21 @@ def _scale_back(F, k0):
 
 
 @njit(cache=True)
-def solve(F, P, pairs, floats, m):
-    """The velocity passes and the restitution pass (module docstring); returns the kinetic
-    energy the awake objects had before them."""
+def solve(F, P, pairs, floats, m, taken):
+    """The velocity passes and the restitution pass (module docstring), leaving at most the
+    kinetic energy the awake objects had before them plus `taken`, what the step's move took
+    away; returns that bound."""
     body = F.body
-    k0 = kinetic(F)
+    limit = kinetic(F) + taken
     _save_velocities(F)
     _apply_started(body, pairs, floats, m)
-    for _ in range(P.iterations):
-        _pass(body, pairs, floats, m, False, P.rest)
-    if kinetic(F) > k0:  # the warm start added energy: from no impulse
-        _restart(F, floats, m)
-        for _ in range(P.iterations):
-            _pass(body, pairs, floats, m, False, P.rest)
+    for it in range(P.iterations):
+        _pass(body, pairs, floats, m, False, P.rest, it % 2 == 1)
+    _scale_back(F, limit)  # should the warm start have added energy
     _save_velocities(F)
-    _pass(body, pairs, floats, m, True, P.rest)
-    _scale_back(F, k0)
-    return k0
+    _pass(body, pairs, floats, m, True, P.rest, False)
+    _scale_back(F, limit)
+    return limit
 
 
 @njit(cache=True)
@@ -255,8 +260,9 @@ def correct(F, P, pairs, floats, m, budget, sides):
         saved[i, 0] = body[i, B_X]
         saved[i, 1] = body[i, B_Y]
     raised = 0.0
-    for _ in range(P.iterations):
-        for c in range(first, m):
+    for it in range(P.iterations):
+        for k in range(first, m):
+            c = m - 1 - (k - first) if it % 2 else k
             a, b = sides_of(pairs[c])
             raised += _push(F, P, a, b, floats[c], sides)
     if raised > budget:

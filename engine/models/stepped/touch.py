@@ -39,16 +39,22 @@ from collide2d.engine.sort import sort_keys
 
 # The columns of a contact's row of floats: the normal, the depth plus the offset along it (px),
 # the two sides' inverse masses (0 for a static, sleeping or wall side), the contact's e and mu,
-# the speed it approached at when found (px/s, > 0 approaching), and the normal and friction
-# impulses so far (per unit of inverse mass: px/s x mass).
-C_NX, C_NY, C_GAP, C_WA, C_WB, C_E, C_MU, C_U0, C_LN, C_LT = range(10)
-C_COLUMNS = 10
+# the speed it approached at when found (px/s, > 0 approaching), the normal and friction
+# impulses so far (per unit of inverse mass: px/s x mass), and the speed it is to part at (px/s,
+# `_goal`).
+C_NX, C_NY, C_GAP, C_WA, C_WB, C_E, C_MU, C_U0, C_LN, C_LT, C_GO = range(11)
+C_COLUMNS = 11
 # The model's counts: listed keys (-1: no list), contacts, last step's contacts, wall events,
 # pair events, whether the list must be made anew, awake objects.
 N_KEYS, N_CONTACTS, N_LAST, N_WALLS, N_PAIRS, N_RELIST, N_AWAKE = range(7)
 N_SIZE = 7
 # A wall contact's key: below every pair's key (which are >= 0), by object, then side (SIDE_*).
 WALL_KEY_BASE = -(1 << 62)
+# The depth of two boxes that touch along a side without overlapping (px): a contact that holds
+# them apart (a stack built exactly touching) but that no push acts on.
+TOUCHING = 1e-300
+# Boxes this close (px) touch: room for the rounding of two positions that moved alike.
+TOUCH_PX = 1e-9
 # An object this close to a wall (px) touches it.
 WALL_TOUCH_PX = 1e-9
 # Contacts and keys to start with per object (the buffers double when full).
@@ -99,14 +105,27 @@ def _room(pairs, floats, m):
 
 
 @njit(cache=True, inline="always")
-def _put(floats, m, nx, ny, gap, wa, wb, e, mu, u0):
+def _goal(P, wa, wb, nx, ny, dt):
+    """The speed a contact is to part at so that the next step's gravity brings it back to where
+    it is: half what gravity closes it by in a step (0 between two objects that both fall).
+    A body resting on a support so leaves it at ½·g·dt and is back on it at the step's end: it
+    neither sinks into it nor lifts off."""
+    ga = 1.0 if wa > 0.0 else 0.0
+    gb = 1.0 if wb > 0.0 else 0.0
+    closing = (ga - gb) * (P.gx * nx + P.gy * ny)
+    return max(0.5 * closing * dt, 0.0)
+
+
+@njit(cache=True, inline="always")
+def _put(floats, m, nx, ny, gap, wa, wb, e, mu, u0, goal):
     row = floats[m]
     row[C_NX], row[C_NY], row[C_GAP], row[C_WA], row[C_WB] = nx, ny, gap, wa, wb
     row[C_E], row[C_MU], row[C_U0], row[C_LN], row[C_LT] = e, mu, u0, 0.0, 0.0
+    row[C_GO] = goal
 
 
 @njit(cache=True)
-def walls(F, P, sides, pairs, floats):
+def walls(F, P, sides, pairs, floats, dt):
     """The contacts of awake objects with the walls they touch, in id order (x sides first);
     returns (buffers, how many)."""
     body = F.body
@@ -129,7 +148,9 @@ def walls(F, P, sides, pairs, floats):
                 pairs, floats = _room(pairs, floats, m)
                 pairs[m] = WALL_KEY_BASE + 4 * i + 2 * axis + high
                 nx, ny = (sign, 0.0) if axis == 0 else (0.0, sign)
-                _put(floats, m, nx, ny, 0.0, F.inv_mass[i], 0.0, e, mu, max(sign * v, 0.0))
+                w = F.inv_mass[i]
+                goal = _goal(P, w, 0.0, nx, ny, dt)
+                _put(floats, m, nx, ny, 0.0, w, 0.0, e, mu, max(sign * v, 0.0), goal)
                 m += 1
     return pairs, floats, m
 
@@ -149,6 +170,8 @@ def _normal(F, T, a, b, dt):
             verts[start[b] : start[b + 1]], normals[start[b] : start[b + 1]],
         )  # fmt: skip
     depth, code, nx, ny = box_penetration(qx, qy, wa, ha, wb, hb)
+    if -TOUCH_PX <= depth <= 0.0:  # touching (the other axis overlaps, or touches too)
+        return TOUCHING, code, nx, ny
     if not depth > 0.0:
         return depth, code, nx, ny
     ux = body[b, B_VX] - body[a, B_VX]
@@ -204,7 +227,7 @@ def pair_contacts(F, P, T, keys, pairs, floats, m, at, log):
         mu = max(F.friction[a], F.friction[b])
         pairs, floats = _room(pairs, floats, m)
         pairs[m] = keys[c]
-        _put(floats, m, nx, ny, gap, wa, wb, e, mu, u0)
+        _put(floats, m, nx, ny, gap, wa, wb, e, mu, u0, _goal(P, wa, wb, nx, ny, at.dt))
         m += 1
         if u0 > 0.0 and u0 >= P.rest:
             T.counts[N_PAIRS] += 1
