@@ -48,8 +48,8 @@ from collide2d.engine.threads import PARALLEL_MIN_OBJECTS
 # many chunks (threads) the move and narrow stages split into (1: none), how many steps ran the
 # move and the narrow phase together (narrow.move_narrow), and from ST_BANDS on where
 # each bucket of the list begins (`bucket_count` + 1 entries; see the module docstring).
-ST_KEYS, ST_METHOD, ST_POSSIBLE, ST_WALLS, ST_PAIRS, ST_NEAR, ST_CHUNKS, ST_FUSED, ST_BANDS = range(
-    9
+ST_KEYS, ST_METHOD, ST_POSSIBLE, ST_WALLS, ST_PAIRS, ST_NEAR, ST_CHUNKS, ST_FUSED, ST_BANDS = (
+    range(9)
 )
 # The listed pairs come in this many bands by how far apart their boxes were when the list was
 # made, nearest first: a band whose pairs were farther apart than any two objects have drifted
@@ -199,28 +199,12 @@ def _reorder_split(S, order, scratch, keys, n_keys, chunks):
     n = order.shape[0]
     for c in prange(chunks):
         _gather_range(
-            body,
-            inv_mass,
-            static,
-            movable,
-            ext,
-            order,
-            scratch,
-            c * n // chunks,
+            body, inv_mass, static, movable, ext, order, scratch, c * n // chunks,
             (c + 1) * n // chunks,
         )
     for c in prange(chunks):
         _place_range(
-            body,
-            inv_mass,
-            static,
-            movable,
-            ext,
-            rank,
-            anchor,
-            order,
-            scratch,
-            c * n // chunks,
+            body, inv_mass, static, movable, ext, rank, anchor, order, scratch, c * n // chunks,
             (c + 1) * n // chunks,
         )
     inv = scratch[1]
@@ -418,3 +402,5 @@ def relist(S, dt, L, keys, spare):
     params[P_DRIFT] = 0.0
     params[P_REACH] = 0.0
     return spare, keys, k
+
+

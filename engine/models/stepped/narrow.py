@@ -119,18 +119,8 @@ def _blocks_range(body, ext, keys, state, first, last, bands, near, when, base, 
     for block in range(first, last):
         for kind in range(2):
             k += _tested_range(
-                body,
-                ext,
-                keys,
-                state,
-                (2 * block + kind) * BANDS,
-                bands,
-                near,
-                when,
-                base + k,
-                room - k,
-                dt,
-                sides,
+                body, ext, keys, state, (2 * block + kind) * BANDS, bands, near, when, base + k,
+                room - k, dt, sides,
             )
     return k
 
@@ -177,44 +167,15 @@ def _narrow_split(body, ext, keys, state, bands, near, when, dt, sides, chunks):
     found = np.zeros(chunks, np.int64)
     for c in prange(chunks):
         found[c] = _blocks_range(
-            body,
-            ext,
-            keys,
-            state,
-            c * blocks // chunks,
-            (c + 1) * blocks // chunks,
-            bands,
-            near,
-            when,
-            c * share,
-            share,
-            dt,
-            sides,
+            body, ext, keys, state, c * blocks // chunks, (c + 1) * blocks // chunks, bands,
+            near, when, c * share, share, dt, sides,
         )
     return _join_sorted(found, share, room, near, when)
 
 
 @njit(cache=True)
-def _move_blocks(
-    body,
-    static,
-    ext,
-    anchor,
-    dt,
-    sides,
-    folds,
-    n_folds,
-    keys,
-    state,
-    params,
-    start,
-    first,
-    last,
-    near,
-    when,
-    base,
-    room,
-):
+def _move_blocks(body, static, ext, anchor, dt, sides, folds, n_folds, keys, state, params, start,
+                 first, last, near, when, base, room):
     """Move blocks first ... last-1 one by one (fold rows from row n_folds), each block's own
     pairs tested right after its move, while its rows are in the cache: the bands that its own
     drift and `start` (where any object began the step, candidates.start_reach) allow, since
@@ -226,31 +187,13 @@ def _move_blocks(
     k = 0
     for block in range(first, last):
         n_folds, d = move_range(
-            body,
-            static,
-            ext,
-            anchor,
-            min(n, block * rows),
-            min(n, (block + 1) * rows),
-            dt,
-            sides,
-            folds,
-            n_folds,
+            body, static, ext, anchor, min(n, block * rows), min(n, (block + 1) * rows), dt,
+            sides, folds, n_folds,
         )
         drift = max(drift, d)
         k += _tested_range(
-            body,
-            ext,
-            keys,
-            state,
-            2 * block * BANDS,
-            reach_bands(max(d, start), params),
-            near,
-            when,
-            base + k,
-            room - k,
-            dt,
-            sides,
+            body, ext, keys, state, 2 * block * BANDS, reach_bands(max(d, start), params), near,
+            when, base + k, room - k, dt, sides,
         )
     return n_folds, drift, k
 
@@ -278,40 +221,14 @@ def move_narrow(
     k = 0
     for block in range(block_count(state)):
         n_folds, d, found = _move_blocks(
-            body,
-            static,
-            ext,
-            anchor,
-            dt,
-            sides,
-            folds,
-            n_folds,
-            keys,
-            state,
-            params,
-            start,
-            block,
-            block + 1,
-            near,
-            when,
-            k,
-            room - k,
+            body, static, ext, anchor, dt, sides, folds, n_folds, keys, state, params, start,
+            block, block + 1, near, when, k, room - k,
         )
         k += found
         drift = max(drift, d)
         k += _tested_range(
-            body,
-            ext,
-            keys,
-            state,
-            (2 * block + 1) * BANDS,
-            reach_bands(max(drift, start), params),
-            near,
-            when,
-            k,
-            room - k,
-            dt,
-            sides,
+            body, ext, keys, state, (2 * block + 1) * BANDS, reach_bands(max(drift, start), params),
+            near, when, k, room - k, dt, sides,
         )
     if k <= room:
         sort_by_time(when, near, k)
@@ -319,9 +236,8 @@ def move_narrow(
 
 
 @njit(cache=True, parallel=True)
-def _move_narrow_split(
-    body, static, ext, anchor, dt, sides, folds, keys, state, params, near, when, chunks
-):
+def _move_narrow_split(body, static, ext, anchor, dt, sides, folds, keys, state, params, near,
+                       when, chunks):
     """`move_narrow` with the blocks cut into `chunks` contiguous runs, one per thread: each run
     moves its blocks and tests their own pairs; once every block has moved, the pairs that reach
     into earlier blocks (perhaps another run's), with the reach of all. Fold rows and pairs in
@@ -339,24 +255,8 @@ def _move_narrow_split(
     for c in prange(chunks):
         first = min(n, (c * blocks // chunks) * rows)
         n_folds, drifts[c], found[c] = _move_blocks(
-            body,
-            static,
-            ext,
-            anchor,
-            dt,
-            sides,
-            folds,
-            2 * first,
-            keys,
-            state,
-            params,
-            start,
-            c * blocks // chunks,
-            (c + 1) * blocks // chunks,
-            near,
-            when,
-            c * share,
-            share,
+            body, static, ext, anchor, dt, sides, folds, 2 * first, keys, state, params, start,
+            c * blocks // chunks, (c + 1) * blocks // chunks, near, when, c * share, share,
         )
         fold_rows[c] = n_folds - 2 * first
         firsts[c] = first
@@ -365,18 +265,8 @@ def _move_narrow_split(
     for c in prange(chunks):
         for block in range(c * blocks // chunks, (c + 1) * blocks // chunks):
             found[c] += _tested_range(
-                body,
-                ext,
-                keys,
-                state,
-                (2 * block + 1) * BANDS,
-                bands,
-                near,
-                when,
-                c * share + found[c],
-                share - found[c],
-                dt,
-                sides,
+                body, ext, keys, state, (2 * block + 1) * BANDS, bands, near, when,
+                c * share + found[c], share - found[c], dt, sides,
             )
     n_folds = join_folds(folds, fold_rows, firsts)
     return n_folds, drift, _join_sorted(found, share, room, near, when)

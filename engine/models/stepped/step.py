@@ -105,18 +105,7 @@ def _stages(first, last, S, at, cores, rows, times, n_ev, L, lists):
         # from where the candidate list was made, and how far its path reached
         if fused:
             n_folds, drift, state[ST_NEAR] = move_narrow(
-                body,
-                S.static,
-                S.ext,
-                anchor,
-                dt,
-                sides,
-                folds,
-                keys,
-                state,
-                params,
-                near,
-                when,
+                body, S.static, S.ext, anchor, dt, sides, folds, keys, state, params, near, when,
                 chunks,
             )
             state[ST_FUSED] += 1
