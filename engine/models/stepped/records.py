@@ -112,6 +112,8 @@ class Touch(NamedTuple):
     cores: tuple  # the exact shapes (shapes.build_cores) when colliding by them
     exact: bool  # whether objects collide by their real shapes
     hits: np.ndarray  # int64 scratch: one object's bounces in a step (fall.fall_one)
+    capped: np.ndarray  # (n,) bool scratch (touch.cap_goals)
     bank: np.ndarray  # (1,) float64 energy given up so far and not yet spent on pushes (solver)
     hits: np.ndarray  # int64 scratch: one object's bounces in a step (fall.fall_one)
+    capped: np.ndarray  # (n,) bool scratch (touch.cap_goals)
     bank: np.ndarray  # (1,) float64 energy given up so far and not yet spent on pushes (solver)

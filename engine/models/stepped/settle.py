@@ -38,6 +38,7 @@ from collide2d.engine.models.stepped.touch import (
     N_RELIST,
     N_SIZE,
     N_WALLS,
+    cap_goals,
     keep,
     pair_contacts,
     relist,
@@ -92,11 +93,12 @@ def step(F, P, T, at, sides, bufs, log):
     # contacts: walls, then pairs by ids; starting from last step's impulses
     pairs, floats, m = walls(F, P, sides, pairs, floats, at.dt)
     pairs, floats, m, log = pair_contacts(F, P, T, keys, pairs, floats, m, at, log)
+    cap_goals(F, P, pairs, floats, m, T.capped)
     warm(T, pairs, floats, m, last_keys, last)
     counts[N_CONTACTS] = m
     # velocities: every contact together, then restitution; never more energy than the step began
     # with
-    limit = solve(F, P, pairs, floats, m, taken)
+    limit = solve(F, P, pairs, floats, m, taken, at.dt)
     # positions: overlap past slop, within the energy given up so far
     T.bank[0] += limit - kinetic(F)
     T.bank[0] -= correct(F, P, pairs, floats, m, T.bank[0], sides)
@@ -208,6 +210,7 @@ class Settle:
             cores=(cores.shape, cores.radius, cores.start, cores.verts, cores.normals),
             exact=geometry == "exact",
             hits=np.zeros(MAX_HITS_PER_STEP + 1, np.int64),
+            capped=np.zeros(n, bool),
             bank=np.zeros(1),
         )
         self.tick = 0

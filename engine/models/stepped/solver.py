@@ -40,7 +40,6 @@ from __future__ import annotations
 
 import math
 
-from collide2d.engine.broadphase import KEY_MASK, KEY_SHIFT
 from collide2d.engine.jit import njit
 from collide2d.engine.models.stepped.move import B_H, B_VX, B_VY, B_W, B_X, B_Y
 from collide2d.engine.models.stepped.touch import (
@@ -55,16 +54,8 @@ from collide2d.engine.models.stepped.touch import (
     C_U0,
     C_WA,
     C_WB,
-    WALL_KEY_BASE,
+    _sides,
 )
-
-
-@njit(cache=True, inline="always")
-def sides_of(key):
-    """(a, b) of a contact's key; b = -1 for a wall."""
-    if key < 0:
-        return (key - WALL_KEY_BASE) >> 2, -1
-    return key >> KEY_SHIFT, key & KEY_MASK
 
 
 @njit(cache=True)
@@ -113,18 +104,20 @@ def _velocity(body, a, b, nx, ny):
 
 
 @njit(cache=True)
-def _pass(body, pairs, floats, m, target, rest, back):
+def _pass(body, pairs, floats, m, target, rest, back, inv_dt):
     """One pass over the contacts, in key order (from the last when `back`): each one's normal
     impulse toward the normal velocity `target` (0: stop the approach; 1: part at e x its
     approach, for those that came at `rest` or faster), then its friction."""
     for k in range(m):
         c = m - 1 - k if back else k
         row = floats[c]
-        a, b = sides_of(pairs[c])
+        a, b = _sides(pairs[c])
         nx, ny, wa, wb = row[C_NX], row[C_NY], row[C_WA], row[C_WB]
         mass = 1.0 / (wa + wb)
         un, ut = _velocity(body, a, b, nx, ny)
         goal = row[C_GO]
+        if b < 0:  # a wall's gap may close within the step
+            goal -= row[C_GAP] * inv_dt
         if target:
             u0 = row[C_U0]
             if not (u0 > 0.0 and u0 >= rest and row[C_E] > 0.0):
@@ -145,7 +138,7 @@ def _apply_started(body, pairs, floats, m):
     """The impulses the contacts start from (warm starting), applied."""
     for c in range(m):
         row = floats[c]
-        a, b = sides_of(pairs[c])
+        a, b = _sides(pairs[c])
         ln, lt, nx, ny = row[C_LN], row[C_LT], row[C_NX], row[C_NY]
         _impulse(body, a, b, row[C_WA], row[C_WB], ln * nx - lt * ny, ln * ny + lt * nx)
 
@@ -189,19 +182,20 @@ def _scale_back(F, k0):
 
 
 @njit(cache=True)
-def solve(F, P, pairs, floats, m, taken):
+def solve(F, P, pairs, floats, m, taken, dt):
     """The velocity passes and the restitution pass (module docstring), leaving at most the
     kinetic energy the awake objects had before them plus `taken`, what the step's move took
     away; returns that bound."""
     body = F.body
+    inv_dt = 1.0 / dt
     limit = kinetic(F) + taken
     _save_velocities(F)
     _apply_started(body, pairs, floats, m)
     for it in range(P.iterations):
-        _pass(body, pairs, floats, m, False, P.rest, it % 2 == 1)
+        _pass(body, pairs, floats, m, False, P.rest, it % 2 == 1, inv_dt)
     _scale_back(F, limit)  # should the warm start have added energy
     _save_velocities(F)
-    _pass(body, pairs, floats, m, True, P.rest, False)
+    _pass(body, pairs, floats, m, True, P.rest, False, inv_dt)
     _scale_back(F, limit)
     return limit
 
@@ -263,7 +257,7 @@ def correct(F, P, pairs, floats, m, budget, sides):
     for it in range(P.iterations):
         for k in range(first, m):
             c = m - 1 - (k - first) if it % 2 else k
-            a, b = sides_of(pairs[c])
+            a, b = _sides(pairs[c])
             raised += _push(F, P, a, b, floats[c], sides)
     if raised > budget:
         s = max(budget, 0.0) / raised

@@ -126,8 +126,10 @@ def _put(floats, m, nx, ny, gap, wa, wb, e, mu, u0, goal):
 
 @njit(cache=True)
 def walls(F, P, sides, pairs, floats, dt):
-    """The contacts of awake objects with the walls they touch, in id order (x sides first);
-    returns (buffers, how many)."""
+    """The contacts of awake objects with the walls they touch or are within half the margin of,
+    in id order (x sides first); returns (buffers, how many). Such a contact keeps its gap (px)
+    in C_GAP: the solver lets it close by up to the gap in a step (a speculative contact), so
+    that an object a bounce just took off a wall is still held by it."""
     body = F.body
     m = 0
     for i in range(body.shape[0]):
@@ -135,22 +137,24 @@ def walls(F, P, sides, pairs, floats, dt):
             continue
         e = min(F.restitution[i], P.restitution)
         mu = max(F.friction[i], P.friction)
+        w = F.inv_mass[i]
         for axis in range(2):
             span = sides[axis] - body[i, B_W + axis]
+            if not span > 0.0:
+                continue
             p = body[i, B_X + axis]
             v = body[i, B_VX + axis]
             for high in range(2):
-                if high == 0 and not p <= WALL_TOUCH_PX:
+                gap = span - p if high else p
+                if not gap <= P.half:
                     continue
-                if high == 1 and not (span > 0.0 and p >= span - WALL_TOUCH_PX):
-                    continue
+                gap = gap if gap > WALL_TOUCH_PX else 0.0
                 sign = 1.0 if high else -1.0
                 pairs, floats = _room(pairs, floats, m)
                 pairs[m] = WALL_KEY_BASE + 4 * i + 2 * axis + high
                 nx, ny = (sign, 0.0) if axis == 0 else (0.0, sign)
-                w = F.inv_mass[i]
-                goal = _goal(P, w, 0.0, nx, ny, dt)
-                _put(floats, m, nx, ny, 0.0, w, 0.0, e, mu, max(sign * v, 0.0), goal)
+                u0 = max(sign * v, 0.0) if gap == 0.0 else 0.0
+                _put(floats, m, nx, ny, gap, w, 0.0, e, mu, u0, _goal(P, w, 0.0, nx, ny, dt))
                 m += 1
     return pairs, floats, m
 
@@ -239,6 +243,41 @@ def pair_contacts(F, P, T, keys, pairs, floats, m, at, log):
                 rows, times = log_event(rows, times, n_ev, at.tick, at.t, EV_PAIR, a, b, code)
                 n_ev += 1
     return pairs, floats, m, (rows, times, n_ev)
+
+
+@njit(cache=True)
+def cap_goals(F, P, pairs, floats, m, capped):
+    """No goal (touch._goal) for the contacts of an object that something which does not fall (a
+    wall, a static or a sleeping object) holds from above: held between two such, it could not
+    part from both, and the impulses would grow without end. capped (n,) bool is scratch."""
+    for c in range(m):
+        a, b = _sides(pairs[c])
+        row = floats[c]
+        up = -(P.gx * row[C_NX] + P.gy * row[C_NY])  # > 0: b is above a
+        if b < 0 and row[C_GAP] > 0.0:  # a wall not touched yet
+            continue
+        if b < 0 or row[C_WB] == 0.0:
+            if up > 0.0:
+                capped[a] = True
+        elif row[C_WA] == 0.0 and up < 0.0:
+            capped[b] = True
+    for c in range(m):
+        a, b = _sides(pairs[c])
+        if capped[a] or (b >= 0 and capped[b]):
+            floats[c, C_GO] = 0.0
+    for c in range(m):
+        a, b = _sides(pairs[c])
+        capped[a] = False
+        if b >= 0:
+            capped[b] = False
+
+
+@njit(cache=True, inline="always")
+def _sides(key):
+    """(a, b) of a contact's key; b = -1 for a wall."""
+    if key < 0:
+        return (key - WALL_KEY_BASE) >> 2, -1
+    return key >> KEY_SHIFT, key & KEY_MASK
 
 
 @njit(cache=True)
