@@ -172,7 +172,10 @@ def fall(F, P, at, sides, hits, log):
     rows, times, n_ev = log
     drift = 0.0
     events = 0
+    saved = F.saved
     for i in range(body.shape[0]):
+        saved[i, 0] = body[i, B_X]  # where the step began (touch.py sweeps pairs from there)
+        saved[i, 1] = body[i, B_Y]
         if not F.awake[i]:
             continue
         e = min(F.restitution[i], P.restitution)

@@ -101,7 +101,7 @@ class Touch(NamedTuple):
     pairs: np.ndarray  # (m,) int64 this step's contacts as keys (touch.py), sorted
     floats: np.ndarray  # (m, C_COLUMNS) float64 this step's contacts (touch.C_*)
     last_keys: np.ndarray  # (m,) int64 last step's contacts' keys
-    last: np.ndarray  # (m, 2) float64 their normal and friction impulses
+    last: np.ndarray  # (m, 4) float64 their normal and friction impulses and their normals
     counts: np.ndarray  # int64 scalar state, slots touch.N_*
     lo: np.ndarray  # (n, 2) float64 grown boxes, low corners
     hi: np.ndarray  # (n, 2) float64 grown boxes, high corners

@@ -92,7 +92,9 @@ def step(F, P, T, at, sides, bufs, log):
         keys = relist(F, P, T, keys)
     # contacts: walls, then pairs by ids; starting from last step's impulses
     pairs, floats, m = walls(F, P, sides, pairs, floats, at.dt)
-    pairs, floats, m, log = pair_contacts(F, P, T, keys, pairs, floats, m, at, log)
+    pairs, floats, m, log = pair_contacts(
+        F, P, T, keys, pairs, floats, m, at, log, (last_keys, last)
+    )
     cap_goals(F, P, pairs, floats, m, T.capped)
     warm(T, pairs, floats, m, last_keys, last)
     counts[N_CONTACTS] = m
@@ -199,7 +201,7 @@ class Settle:
             pairs=np.empty(room, np.int64),
             floats=np.empty((room, C_COLUMNS)),
             last_keys=np.empty(room, np.int64),
-            last=np.empty((room, 2)),
+            last=np.empty((room, 4)),
             counts=counts,
             lo=np.empty((n, 2)),
             hi=np.empty((n, 2)),

@@ -245,14 +245,14 @@ def correct(F, P, pairs, floats, m, budget, sides):
     """The position passes (module docstring); `budget` the energy the velocity passes took
     away this step. Returns the potential energy the pushes raised."""
     body, saved = F.body, F.saved
+    for i in range(body.shape[0]):  # (sleep.doze reads how far each was pushed)
+        saved[i, 0] = body[i, B_X]
+        saved[i, 1] = body[i, B_Y]
     first = 0
     while first < m and pairs[first] < 0:  # the walls' contacts: the move keeps objects inside
         first += 1
     if first == m:
         return 0.0
-    for i in range(body.shape[0]):
-        saved[i, 0] = body[i, B_X]
-        saved[i, 1] = body[i, B_Y]
     raised = 0.0
     for it in range(P.iterations):
         for k in range(first, m):

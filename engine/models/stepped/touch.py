@@ -19,7 +19,10 @@ Two sleeping objects are never paired.
 A contact's normal runs from its first object to its second (to the wall, for a wall). Boxes: the
 axis along which the pair started overlapping in the step, when it did (contact.box_sweep, swept
 back along the relative velocity), else the axis of the smaller overlap (contact.box_penetration);
-exact shapes (`geometry: exact`): the minimum-penetration normal (contact.penetration). It keeps
+exact shapes (`geometry: exact`): the minimum-penetration normal (contact.penetration). The sweep
+starts where the step began (fall.fall keeps it), so a bounce off a wall within the step does
+not turn it. Boxes that touched in the last step keep the normal they touched by while they
+still overlap across it. It keeps
 `C_GAP`, the depth plus the offset of the two objects along the normal, so that the solver reads
 the depth left after any push as C_GAP - (p_b - p_a)·n.
 """
@@ -178,15 +181,24 @@ def _normal(F, T, a, b, dt):
         return TOUCHING, code, nx, ny
     if not depth > 0.0:
         return depth, code, nx, ny
-    ux = body[b, B_VX] - body[a, B_VX]
-    uy = body[b, B_VY] - body[a, B_VY]
-    t_enter, _, c, sx, sy = box_sweep(qx - ux * dt, qy - uy * dt, ux, uy, wa, ha, wb, hb)
+    # from where the step began (fall.fall saved it), on a straight line
+    q0x = F.saved[b, 0] - F.saved[a, 0]
+    q0y = F.saved[b, 1] - F.saved[a, 1]
+    ux = (qx - q0x) / dt
+    uy = (qy - q0y) / dt
+    t_enter, _, c, sx, sy = box_sweep(q0x, q0y, ux, uy, wa, ha, wb, hb)
     if 0.0 <= t_enter <= dt:  # began this step: the axis it came in by
         code, nx, ny = c, sx, sy
         if c == AXIS_X:
             depth = wa - qx if nx > 0.0 else qx + wb
         elif c == AXIS_Y:
             depth = ha - qy if ny > 0.0 else qy + hb
+    elif t_enter < 0.0:  # overlapping as the step began: the smaller overlap then
+        d0, c0, mx, my = box_penetration(q0x, q0y, wa, ha, wb, hb)
+        if c0 != AXIS_XY:
+            along = _held(body, a, b, mx, my)
+            if along > 0.0:
+                depth, code, nx, ny = along, c0, mx, my
     if code == AXIS_XY:  # corner to corner: the diagonal, deep enough to part both axes
         depth = min(wa - qx if nx > 0.0 else qx + wb, ha - qy if ny > 0.0 else qy + hb)
         depth *= math.sqrt(2.0)
@@ -197,20 +209,54 @@ def _normal(F, T, a, b, dt):
 
 
 @njit(cache=True)
-def pair_contacts(F, P, T, keys, pairs, floats, m, at, log):
+def _held(body, a, b, nx, ny):
+    """The depth of boxes a and b along the axis-aligned normal they touched by in the last step
+    (they still overlap, or touch, across it); -1 when they no longer do, or it was no axis."""
+    if nx != 0.0 and ny != 0.0:
+        return -1.0
+    qx = body[b, B_X] - body[a, B_X]
+    qy = body[b, B_Y] - body[a, B_Y]
+    wa, ha, wb, hb = body[a, B_W], body[a, B_H], body[b, B_W], body[b, B_H]
+    xdiff = min(wa, qx + wb) - max(0.0, qx)
+    ydiff = min(ha, qy + hb) - max(0.0, qy)
+    if ny != 0.0:
+        across, depth = xdiff, (ha - qy if ny > 0.0 else qy + hb)
+    else:
+        across, depth = ydiff, (wa - qx if nx > 0.0 else qx + wb)
+    if not (across > 0.0 and depth >= -TOUCH_PX):
+        return -1.0
+    return max(depth, TOUCHING)
+
+
+@njit(cache=True)
+def pair_contacts(F, P, T, keys, pairs, floats, m, at, log, held):
     """The listed pairs in contact after the step `at` (a Step), from row m on: wakes a sleeping
     object that an awake one moving at the rest speed or faster touches (and asks for a new
     list), and logs a pair event for each approaching at the rest speed or faster (faster than
-    0 without gravity). log = (rows, times, n_ev). Returns (buffers, how many rows, log)."""
+    0 without gravity). log = (rows, times, n_ev); held = (keys, rows) of last step's contacts
+    (`keep`): boxes that touched then keep the normal they touched by while they still overlap
+    across it (a box wedged into a gap narrower than itself stays on top, where the smaller
+    overlap would turn it sideways). Returns (buffers, how many rows, log)."""
     body, awake, asleep = F.body, F.awake, F.asleep
     rows, times, n_ev = log
+    last_keys, last = held
+    n_last = T.counts[N_LAST]
+    j = 0
     rest2 = P.rest * P.rest
     for c in range(T.counts[N_KEYS]):
         a = keys[c] >> KEY_SHIFT
         b = keys[c] & KEY_MASK
         if not (awake[a] or awake[b]):
             continue
-        depth, code, nx, ny = _normal(F, T, a, b, at.dt)
+        while j < n_last and last_keys[j] < keys[c]:
+            j += 1
+        depth = -1.0
+        if j < n_last and last_keys[j] == keys[c] and not T.exact:
+            nx, ny = last[j, 2], last[j, 3]
+            depth = _held(body, a, b, nx, ny)
+            code = AXIS_NORMAL
+        if depth < 0.0:
+            depth, code, nx, ny = _normal(F, T, a, b, at.dt)
         if not depth > 0.0:
             continue
         for s, o in ((a, b), (b, a)):  # a sleeping side woken by a moving one
@@ -296,14 +342,17 @@ def warm(T, pairs, floats, m, last_keys, last):
 
 @njit(cache=True)
 def keep(T, pairs, floats, m, last_keys, last):
-    """Keep this step's contacts' keys and impulses for the next step's `warm`; returns the
+    """Keep this step's contacts' keys, impulses and normals for the next step's `warm` and
+    `pair_contacts`; returns the
     buffers (grown when too small)."""
     if last.shape[0] < m:
         last_keys = np.empty(2 * m, np.int64)
-        last = np.empty((2 * m, 2))
+        last = np.empty((2 * m, 4))
     for c in range(m):
         last_keys[c] = pairs[c]
         last[c, 0] = floats[c, C_LN]
         last[c, 1] = floats[c, C_LT]
+        last[c, 2] = floats[c, C_NX]
+        last[c, 3] = floats[c, C_NY]
     T.counts[N_LAST] = m
     return last_keys, last
