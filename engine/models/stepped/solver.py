@@ -110,26 +110,28 @@ def _pass(body, pairs, floats, m, target, rest, back, inv_dt):
     approach, for those that came at `rest` or faster), then its friction."""
     for k in range(m):
         c = m - 1 - k if back else k
-        row = floats[c]
         a, b = _sides(pairs[c])
-        nx, ny, wa, wb = row[C_NX], row[C_NY], row[C_WA], row[C_WB]
+        nx, ny = floats[c, C_NX], floats[c, C_NY]
+        wa, wb = floats[c, C_WA], floats[c, C_WB]
         mass = 1.0 / (wa + wb)
         un, ut = _velocity(body, a, b, nx, ny)
-        goal = row[C_GO]
+        goal = floats[c, C_GO]
         if b < 0:  # a wall's gap may close within the step
-            goal -= row[C_GAP] * inv_dt
+            goal -= floats[c, C_GAP] * inv_dt
         if target:
-            u0 = row[C_U0]
-            if not (u0 > 0.0 and u0 >= rest and row[C_E] > 0.0):
+            u0 = floats[c, C_U0]
+            if not (u0 > 0.0 and u0 >= rest and floats[c, C_E] > 0.0):
                 continue
-            goal = max(row[C_E] * u0, goal)
-        total = max(row[C_LN] + (goal - un) * mass, 0.0)
-        dn = total - row[C_LN]
-        row[C_LN] = total
-        bound = row[C_MU] * total
-        kept = min(max(row[C_LT] - ut * mass, -bound), bound)  # (the normal impulse leaves ut)
-        dl = kept - row[C_LT]
-        row[C_LT] = kept
+            goal = max(floats[c, C_E] * u0, goal)
+        ln = floats[c, C_LN]
+        total = max(ln + (goal - un) * mass, 0.0)
+        dn = total - ln
+        floats[c, C_LN] = total
+        bound = floats[c, C_MU] * total
+        lt = floats[c, C_LT]
+        kept = min(max(lt - ut * mass, -bound), bound)  # (the normal impulse leaves ut)
+        dl = kept - lt
+        floats[c, C_LT] = kept
         _impulse(body, a, b, wa, wb, dn * nx - dl * ny, dn * ny + dl * nx)
 
 
@@ -137,10 +139,10 @@ def _pass(body, pairs, floats, m, target, rest, back, inv_dt):
 def _apply_started(body, pairs, floats, m):
     """The impulses the contacts start from (warm starting), applied."""
     for c in range(m):
-        row = floats[c]
         a, b = _sides(pairs[c])
-        ln, lt, nx, ny = row[C_LN], row[C_LT], row[C_NX], row[C_NY]
-        _impulse(body, a, b, row[C_WA], row[C_WB], ln * nx - lt * ny, ln * ny + lt * nx)
+        ln, lt, nx, ny = floats[c, C_LN], floats[c, C_LT], floats[c, C_NX], floats[c, C_NY]
+        jx, jy = ln * nx - lt * ny, ln * ny + lt * nx
+        _impulse(body, a, b, floats[c, C_WA], floats[c, C_WB], jx, jy)
 
 
 @njit(cache=True)
@@ -200,7 +202,7 @@ def solve(F, P, pairs, floats, m, taken, dt):
     return limit
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _shift(body, i, dx, dy, sides):
     """Move object i by (dx, dy) px, kept in the world; returns the move made."""
     x = min(max(body[i, B_X] + dx, 0.0), max(sides[0] - body[i, B_W], 0.0))
@@ -212,14 +214,13 @@ def _shift(body, i, dx, dy, sides):
     return mx, my
 
 
-@njit(cache=True)
-def _push(F, P, a, b, row, sides):
-    """Push the pair apart along its normal by its depth past slop (module docstring); returns
-    the potential energy that raised."""
-    body, mass = F.body, F.mass
-    nx, ny, wa, wb = row[C_NX], row[C_NY], row[C_WA], row[C_WB]
-    depth = row[C_GAP] - ((body[b, B_X] - body[a, B_X]) * nx + (body[b, B_Y] - body[a, B_Y]) * ny)
-    push = depth - P.slop
+@njit(cache=True, inline="always")
+def _push(body, mass, gx, gy, slop, a, b, floats, c, sides):
+    """Push contact c's pair apart along its normal by its depth past slop (module docstring);
+    returns the potential energy that raised."""
+    nx, ny, wa, wb = floats[c, C_NX], floats[c, C_NY], floats[c, C_WA], floats[c, C_WB]
+    apart = (body[b, B_X] - body[a, B_X]) * nx + (body[b, B_Y] - body[a, B_Y]) * ny
+    push = floats[c, C_GAP] - apart - slop
     if not push > 0.0:
         return 0.0
     raised = 0.0
@@ -228,15 +229,15 @@ def _push(F, P, a, b, row, sides):
         share = push * (wa / (wa + wb))
         mx, my = _shift(body, a, -share * nx, -share * ny, sides)
         made = -(mx * nx + my * ny)
-        raised -= mass[a] * (P.gx * mx + P.gy * my)
+        raised -= mass[a] * (gx * mx + gy * my)
     if wb > 0.0:
         mx, my = _shift(body, b, (push - made) * nx, (push - made) * ny, sides)
         made += mx * nx + my * ny
-        raised -= mass[b] * (P.gx * mx + P.gy * my)
+        raised -= mass[b] * (gx * mx + gy * my)
     left = push - made
     if wa > 0.0 and left > 0.0:
         mx, my = _shift(body, a, -left * nx, -left * ny, sides)
-        raised -= mass[a] * (P.gx * mx + P.gy * my)
+        raised -= mass[a] * (gx * mx + gy * my)
     return raised
 
 
@@ -254,11 +255,12 @@ def correct(F, P, pairs, floats, m, budget, sides):
     if first == m:
         return 0.0
     raised = 0.0
+    mass, gx, gy, slop = F.mass, P.gx, P.gy, P.slop
     for it in range(P.iterations):
         for k in range(first, m):
             c = m - 1 - (k - first) if it % 2 else k
             a, b = _sides(pairs[c])
-            raised += _push(F, P, a, b, floats[c], sides)
+            raised += _push(body, mass, gx, gy, slop, a, b, floats, c, sides)
     if raised > budget:
         s = max(budget, 0.0) / raised
         for i in range(body.shape[0]):

@@ -121,10 +121,9 @@ def _goal(P, wa, wb, nx, ny, dt):
 
 @njit(cache=True, inline="always")
 def _put(floats, m, nx, ny, gap, wa, wb, e, mu, u0, goal):
-    row = floats[m]
-    row[C_NX], row[C_NY], row[C_GAP], row[C_WA], row[C_WB] = nx, ny, gap, wa, wb
-    row[C_E], row[C_MU], row[C_U0], row[C_LN], row[C_LT] = e, mu, u0, 0.0, 0.0
-    row[C_GO] = goal
+    floats[m, C_NX], floats[m, C_NY], floats[m, C_GAP] = nx, ny, gap
+    floats[m, C_WA], floats[m, C_WB], floats[m, C_E], floats[m, C_MU] = wa, wb, e, mu
+    floats[m, C_U0], floats[m, C_LN], floats[m, C_LT], floats[m, C_GO] = u0, 0.0, 0.0, goal
 
 
 @njit(cache=True)
@@ -163,27 +162,33 @@ def walls(F, P, sides, pairs, floats, dt):
 
 
 @njit(cache=True)
-def _normal(F, T, a, b, dt):
-    """(depth, code, nx, ny) of objects a and b (ids) after the step: module docstring."""
-    body = F.body
+def _exact_normal(body, cores, a, b):
+    """(depth, code, nx, ny) of objects a and b (ids) by their exact shapes."""
+    shape, radius, start, verts, normals = cores
     qx = body[b, B_X] - body[a, B_X]
     qy = body[b, B_Y] - body[a, B_Y]
     wa, ha, wb, hb = body[a, B_W], body[a, B_H], body[b, B_W], body[b, B_H]
-    if T.exact:
-        shape, radius, start, verts, normals = T.cores
-        return penetration(
-            qx, qy, shape[a], wa, ha, radius[a], verts[start[a] : start[a + 1]],
-            normals[start[a] : start[a + 1]], shape[b], wb, hb, radius[b],
-            verts[start[b] : start[b + 1]], normals[start[b] : start[b + 1]],
-        )  # fmt: skip
+    return penetration(
+        qx, qy, shape[a], wa, ha, radius[a], verts[start[a] : start[a + 1]],
+        normals[start[a] : start[a + 1]], shape[b], wb, hb, radius[b],
+        verts[start[b] : start[b + 1]], normals[start[b] : start[b + 1]],
+    )  # fmt: skip
+
+
+@njit(cache=True, inline="always")
+def _normal(body, saved, a, b, dt):
+    """(depth, code, nx, ny) of boxes a and b (ids) after the step: module docstring."""
+    qx = body[b, B_X] - body[a, B_X]
+    qy = body[b, B_Y] - body[a, B_Y]
+    wa, ha, wb, hb = body[a, B_W], body[a, B_H], body[b, B_W], body[b, B_H]
     depth, code, nx, ny = box_penetration(qx, qy, wa, ha, wb, hb)
     if -TOUCH_PX <= depth <= 0.0:  # touching (the other axis overlaps, or touches too)
         return TOUCHING, code, nx, ny
     if not depth > 0.0:
         return depth, code, nx, ny
     # from where the step began (fall.fall saved it), on a straight line
-    q0x = F.saved[b, 0] - F.saved[a, 0]
-    q0y = F.saved[b, 1] - F.saved[a, 1]
+    q0x = saved[b, 0] - saved[a, 0]
+    q0y = saved[b, 1] - saved[a, 1]
     ux = (qx - q0x) / dt
     uy = (qy - q0y) / dt
     t_enter, _, c, sx, sy = box_sweep(q0x, q0y, ux, uy, wa, ha, wb, hb)
@@ -208,7 +213,7 @@ def _normal(F, T, a, b, dt):
     return depth, code, nx, ny
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _held(body, a, b, nx, ny):
     """The depth of boxes a and b along the axis-aligned normal they touched by in the last step
     (they still overlap, or touch, across it); -1 when they no longer do, or it was no axis."""
@@ -256,7 +261,10 @@ def pair_contacts(F, P, T, keys, pairs, floats, m, at, log, held):
             depth = _held(body, a, b, nx, ny)
             code = AXIS_NORMAL
         if depth < 0.0:
-            depth, code, nx, ny = _normal(F, T, a, b, at.dt)
+            if T.exact:
+                depth, code, nx, ny = _exact_normal(body, T.cores, a, b)
+            else:
+                depth, code, nx, ny = _normal(body, F.saved, a, b, at.dt)
         if not depth > 0.0:
             continue
         for s, o in ((a, b), (b, a)):  # a sleeping side woken by a moving one
@@ -298,14 +306,13 @@ def cap_goals(F, P, pairs, floats, m, capped):
     part from both, and the impulses would grow without end. capped (n,) bool is scratch."""
     for c in range(m):
         a, b = _sides(pairs[c])
-        row = floats[c]
-        up = -(P.gx * row[C_NX] + P.gy * row[C_NY])  # > 0: b is above a
-        if b < 0 and row[C_GAP] > 0.0:  # a wall not touched yet
+        up = -(P.gx * floats[c, C_NX] + P.gy * floats[c, C_NY])  # > 0: b is above a
+        if b < 0 and floats[c, C_GAP] > 0.0:  # a wall not touched yet
             continue
-        if b < 0 or row[C_WB] == 0.0:
+        if b < 0 or floats[c, C_WB] == 0.0:
             if up > 0.0:
                 capped[a] = True
-        elif row[C_WA] == 0.0 and up < 0.0:
+        elif floats[c, C_WA] == 0.0 and up < 0.0:
             capped[b] = True
     for c in range(m):
         a, b = _sides(pairs[c])
