@@ -11,11 +11,13 @@ nothing sleeps; `sleep: false` makes `sleep_after` infinite.
 
 from __future__ import annotations
 
+import math
+
 from collide2d.engine.jit import njit
 from collide2d.engine.models.stepped.move import B_VX, B_VY, B_X, B_Y
 
-# An object the step's pushes (solver.correct) moved farther than this (px) is still settling,
-# however slow: it does not count toward sleep.
+# An object the step's pushes (solver.correct) moved farther than this (px), beyond what a step
+# of gravity sinks it (|g|·dt²), is still settling, however slow: it does not count toward sleep.
 SETTLED_PUSH_PX = 1e-3
 
 
@@ -25,13 +27,15 @@ def doze(F, P, dt):
     below it for sleep_after s; returns how many objects are awake."""
     body = F.body
     rest2 = P.rest * P.rest
+    # what a step of gravity sinks an object into a support and its push takes back
+    settled = SETTLED_PUSH_PX + math.hypot(P.gx, P.gy) * dt * dt
     awake = 0
     for i in range(body.shape[0]):
         if not F.awake[i]:
             continue
         pushed = max(abs(body[i, B_X] - F.saved[i, 0]), abs(body[i, B_Y] - F.saved[i, 1]))
         slow = body[i, B_VX] * body[i, B_VX] + body[i, B_VY] * body[i, B_VY] < rest2
-        if slow and pushed <= SETTLED_PUSH_PX:
+        if slow and pushed <= settled:
             F.quiet[i] += dt
         else:
             F.quiet[i] = 0.0
