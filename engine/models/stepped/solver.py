@@ -116,8 +116,6 @@ def _pass(body, pairs, floats, m, target, rest, back, inv_dt):
         mass = 1.0 / (wa + wb)
         un, ut = _velocity(body, a, b, nx, ny)
         goal = floats[c, C_GO]
-        if b < 0:  # a wall's gap may close within the step
-            goal -= floats[c, C_GAP] * inv_dt
         if target:
             u0 = floats[c, C_U0]
             if not (u0 > 0.0 and u0 >= rest and floats[c, C_E] > 0.0):

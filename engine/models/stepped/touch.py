@@ -133,8 +133,10 @@ def _put(floats, m, nx, ny, gap, wa, wb, e, mu, u0, goal):
 def walls(F, P, sides, pairs, floats, dt):
     """The contacts of awake objects with the walls they touch or are within half the margin of,
     in id order (x sides first); returns (buffers, how many). Such a contact keeps its gap (px)
-    in C_GAP: the solver lets it close by up to the gap in a step (a speculative contact), so
-    that an object a bounce just took off a wall is still held by it."""
+    in C_GAP, and may close by up to the gap in the step, or at the speed the object already
+    has toward it, whichever is more (a speculative contact: the wall's own bounce is the
+    move's, fall.py), so that an object a bounce just took off a wall is still held by it when
+    others push it back."""
     body = F.body
     m = 0
     for i in range(body.shape[0]):
@@ -158,8 +160,13 @@ def walls(F, P, sides, pairs, floats, dt):
                 pairs, floats = _room(pairs, floats, m)
                 pairs[m] = WALL_KEY_BASE + 4 * i + 2 * axis + high
                 nx, ny = (sign, 0.0) if axis == 0 else (0.0, sign)
-                u0 = max(sign * v, 0.0) if gap == 0.0 else 0.0
-                _put(floats, m, nx, ny, gap, w, 0.0, e, mu, u0, _goal(P, w, 0.0, nx, ny, dt))
+                toward = max(sign * v, 0.0)
+                goal = _goal(P, w, 0.0, nx, ny, dt)
+                u0 = toward
+                if gap > 0.0:  # may close by the gap, and never slows what moves it there
+                    goal = -max(gap / dt, toward)
+                    u0 = 0.0
+                _put(floats, m, nx, ny, gap, w, 0.0, e, mu, u0, goal)
                 m += 1
     return pairs, floats, m
 
@@ -345,7 +352,7 @@ def cap_goals(F, P, pairs, floats, m, capped):
     for c in range(m):
         a, b = _sides(pairs[c])
         if capped[a] or (b >= 0 and capped[b]):
-            floats[c, C_GO] = 0.0
+            floats[c, C_GO] = min(floats[c, C_GO], 0.0)
     for c in range(m):
         a, b = _sides(pairs[c])
         capped[a] = False
