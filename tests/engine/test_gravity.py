@@ -206,3 +206,20 @@ def test_options_out_of_range_are_refused(options):
     world = WorldSpec(100, 100, 60, gravity=(0.0, G))
     with pytest.raises(ValueError):
         make("stepped", world, Bodies.boxes([[10, 10]], 5, [[0, 0]]), **options)
+
+
+def test_the_settling_path_gives_the_same_bytes_on_one_thread_or_two():
+    from collide2d.engine import threads
+
+    world = WorldSpec(120, 90, 60, gravity=(0.0, G))
+    bodies = pile_bodies(60, 5, 120)
+    before = threads.threads()
+    runs = []
+    try:
+        for t in (1, 2):
+            threads.set_threads(t)
+            m = make("stepped", world, bodies)
+            runs.append((m.advance(120).tobytes(), m.positions().tobytes(), m.event_counts()))
+    finally:
+        threads.set_threads(before)
+    assert runs[0] == runs[1] and runs[0][2][1] > 0
