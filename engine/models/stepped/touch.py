@@ -123,8 +123,8 @@ def _goal(P, wa, wb, nx, ny, dt):
 
 
 @njit(cache=True, inline="always")
-def _put(floats, m, nx, ny, gap, wa, wb, e, mu, u0, goal):
-    floats[m, C_NX], floats[m, C_NY], floats[m, C_GAP] = nx, ny, gap
+def _put(floats, m, normal, gap, wa, wb, e, mu, u0, goal):
+    floats[m, C_NX], floats[m, C_NY], floats[m, C_GAP] = normal[0], normal[1], gap
     floats[m, C_WA], floats[m, C_WB], floats[m, C_E], floats[m, C_MU] = wa, wb, e, mu
     floats[m, C_U0], floats[m, C_LN], floats[m, C_LT], floats[m, C_GO] = u0, 0.0, 0.0, goal
 
@@ -166,7 +166,7 @@ def walls(F, P, sides, pairs, floats, dt):
                 if gap > 0.0:  # may close by the gap, and never slows what moves it there
                     goal = -max(gap / dt, toward)
                     u0 = 0.0
-                _put(floats, m, nx, ny, gap, w, 0.0, e, mu, u0, goal)
+                _put(floats, m, (nx, ny), gap, w, 0.0, e, mu, u0, goal)
                 m += 1
     return pairs, floats, m
 
@@ -320,7 +320,7 @@ def pair_contacts(F, P, T, keys, pairs, floats, m, at, log, held):
         mu = max(F.friction[a], F.friction[b])
         pairs, floats = _room(pairs, floats, m)
         pairs[m] = keys[c]
-        _put(floats, m, nx, ny, gap, wa, wb, e, mu, u0, _goal(P, wa, wb, nx, ny, at.dt))
+        _put(floats, m, (nx, ny), gap, wa, wb, e, mu, u0, _goal(P, wa, wb, nx, ny, at.dt))
         m += 1
         if u0 > 0.0 and u0 >= P.rest:
             T.counts[N_PAIRS] += 1
