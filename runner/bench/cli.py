@@ -22,7 +22,7 @@ from collide2d.engine import models
 from collide2d.runner.command.exitcodes import EXIT_BAD_INPUT, EXIT_DIFFERENCE, EXIT_OK
 
 PARTS = ("scaling", "error", "peers", "skips", "targets", "paper", "exact", "raster")
-PARTS += ("stages", "load", "gravity")  # runner/bench/stages.py, load.py, gravity.py
+PARTS += ("stages", "load", "gravity")  # runner/bench/stages.py, load.py, peers.py
 DEFAULT_PARTS = ("scaling", "error", "skips", "targets")
 FILE_PARTS = ("error", "skips", "targets", "paper", "raster")  # read scenarios/*.yaml
 REPORT_DIR = "bench"
@@ -153,9 +153,7 @@ def _run_parts(args, parts, ns, models_, quick, in_process, folder, echo) -> tup
         rows += load.load(quick, echo)
     if "gravity" in parts:
         echo.part("gravity")
-        from collide2d.runner.bench import gravity
-
-        rows += gravity.gravity(quick, echo)
+        rows += peers.gravity(quick, echo)
     return rows, time.perf_counter() - began
 
 
