@@ -229,7 +229,15 @@ def _ms_per_step(run, steps: int) -> float:
 
 
 def _row(scene, model, n, value, note) -> dict:
-    return {"part": "gravity", "scene": scene, "model": model, "n": n, "value": value, "note": note}
+    """One figure of the gravity part, its note led by the model's name."""
+    return {
+        "part": "gravity",
+        "scene": scene,
+        "model": model,
+        "n": n,
+        "value": value,
+        "note": f"{model}: {note}",
+    }
 
 
 def timings(n: int, echo) -> list[dict]:
