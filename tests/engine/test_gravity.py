@@ -223,3 +223,17 @@ def test_the_settling_path_gives_the_same_bytes_on_one_thread_or_two():
     finally:
         threads.set_threads(before)
     assert runs[0] == runs[1] and runs[0][2][1] > 0
+
+
+def test_circles_by_their_exact_shapes_settle_inside_without_gaining_energy():
+    world = WorldSpec(120, 90, 60, gravity=(0.0, G))
+    bodies = pile_bodies(30, 11, 120, e=0.5, mu=0.3)
+    m = make("stepped", world, bodies, geometry="exact")
+    e0 = energy(m, bodies, world)
+    scale = abs(e0) + float(bodies.mass.sum()) * G * 90
+    for _ in range(240):
+        m.advance(1)
+        assert energy(m, bodies, world) <= e0 + 1e-9 * scale
+    p = m.positions()
+    assert np.isfinite(p).all() and (p >= 0).all() and (p <= [112, 82]).all()
+    assert m._settle.asleep().sum() >= 25  # nearly all at rest after 4 s
