@@ -22,7 +22,7 @@ from collide2d.engine import models
 from collide2d.runner.command.exitcodes import EXIT_BAD_INPUT, EXIT_DIFFERENCE, EXIT_OK
 
 PARTS = ("scaling", "error", "peers", "skips", "targets", "paper", "exact", "raster")
-PARTS += ("stages", "load", "jit")  # runner/bench/stages.py, load.py, targets.py
+PARTS += ("stages", "load", "jit", "gravity")  # bench/stages.py, load.py, targets.py, peers.py
 DEFAULT_PARTS = ("scaling", "error", "skips", "targets")
 FILE_PARTS = ("error", "skips", "targets", "paper", "raster", "jit")  # read scenarios/*.yaml
 REPORT_DIR = "bench"
@@ -154,6 +154,9 @@ def _run_parts(args, parts, ns, models_, quick, in_process, folder, echo) -> tup
     if "jit" in parts:
         echo.part("jit")
         rows += targets.cold_start(quick, echo, folder)
+    if "gravity" in parts:
+        echo.part("gravity")
+        rows += peers.gravity(quick, echo)
     return rows, time.perf_counter() - began
 
 

@@ -1,4 +1,5 @@
-"""The peers part of `collide2d bench`: pymunk steps the same standard scene (the `bench` extra).
+"""The peers parts of `collide2d bench`: pymunk steps the same scenes (the `bench` extra): the
+standard scene (`peers`), and a settling pile under gravity (`gravity`).
 
 pymunk steps at 1/STANDARD_FPS s with boxes of mass 1 and infinite moment, elasticity 1, friction 0
 and four static walls: the standard scene run by the pymunk model (`engine.models.pymunk`, the
@@ -9,12 +10,35 @@ kept (`PymunkTimer`). The scaling part times pymunk in turn with the stepped mod
 machine whose speed drifts over minutes (a shared virtual machine's does, by a quarter) slows
 both sides of the ratio alike (timed apart, minutes after the stepped model, the ratio took that
 drift in); `peers` then divides the stepped model's steps/s by pymunk's.
+
+The gravity part (`--part gravity`, `gravity`): the stepped model's settling path against pymunk
+under gravity, and both against the closed forms (PHYSICS.md).
+
+A settling pile (`pile`): n boxes of 8 px, e 0.3 and mu 0.3, on a grid ASPECT times as wide as it
+is tall (8 rows at 1,000, 25 at 10,000), dropped into a box just wider, at 60 fps with 2
+substeps (so that nothing falls a box's height in a step). pymunk steps the same scene at the
+same 1/120 s: rotation off (infinite moment), its default 10 iterations and 0.1 px slop,
+elasticity and friction √0.3 on every shape (pymunk multiplies the two sides': 0.3 on every
+contact). Each times its first simulated second (the pile falling and landing: `moving`), one
+after the other in this run; then the stepped model runs on until its pile sleeps and times one
+more second (`settled`).
+
+Closed forms: a box dropped 100 px with e 0.5, its first three bounce instants
+against `t_n = t1·(1 + 2e(1 - e^(n-1)) / (1 - e))` (each found from the state after the step that
+held it: exact between contacts, the bounce lies `τ = 2h / (v + √(v² + 2g·h))` before it, h the
+height above the floor and v the speed up); a box sliding at 200 px/s with mu 0.5 against
+`v0² / (2·mu·g)`. Rows are one figure each (`value`, described by `note`).
 """
 
 from __future__ import annotations
 
+import math
 import time
 
+import numpy as np
+
+from collide2d.engine.models import make
+from collide2d.engine.world import Bodies, WorldSpec
 from collide2d.runner.bench.scenes import STANDARD_FPS, STANDARD_SIZE_PX, standard_scene
 from collide2d.runner.bench.timing import PROBE_S, QUICK_TARGET_S, TARGET_S, median
 
@@ -125,3 +149,200 @@ def peers(ns: list[int], ours: dict[int, float], timed: dict, echo) -> list[dict
             f"stepped/pymunk = {row['ratio']:.2f}"
         )
     return rows
+
+
+# --- the gravity part ---------------------------------------------------------------------------
+
+G = 980.0
+FPS = 60
+SUBSTEPS = 2
+SIZE = 8.0
+PITCH = 10.0
+E = 0.3
+MU = 0.3
+SETTLE_LIMIT_S = 12  # the stepped pile must sleep within this
+ASPECT = 16  # the pile's grid is this many times as wide as it is tall
+
+
+def pile(n: int) -> tuple[WorldSpec, Bodies]:
+    """The settling pile of n boxes (module docstring)."""
+    rows = max(1, int(round(math.sqrt(n / ASPECT))))
+    cols = -(-n // rows)
+    width = int(cols * PITCH) + 4
+    height = int(rows * PITCH * 1.6) + 20
+    k = np.arange(n)
+    rng = np.random.default_rng(1)
+    pos = np.stack([k % cols, k // cols], axis=1) * PITCH + rng.uniform(0, PITCH - SIZE, (n, 2))
+    bodies = Bodies.boxes(pos + 2.0, SIZE, rng.uniform(-20, 20, (n, 2)))
+    bodies = Bodies(**{**bodies.__dict__, "restitution": np.full(n, E), "friction": np.full(n, MU)})
+    return WorldSpec(width, height, FPS, gravity=(0.0, G)), bodies
+
+
+def _space(world: WorldSpec, bodies: Bodies, e: float, mu: float):
+    """The scene as a pymunk space (module docstring)."""
+    import pymunk
+
+    space = pymunk.Space()
+    space.gravity = (0.0, G)
+    space.iterations = 10
+    w, h = world.width, world.height
+    corners = ((0, 0), (w, 0), (w, h), (0, h))
+    for k in range(4):
+        wall = pymunk.Segment(space.static_body, corners[k], corners[(k + 1) % 4], 0.0)
+        wall.elasticity = math.sqrt(e)
+        wall.friction = math.sqrt(mu)
+        space.add(wall)
+    for (x, y), (bw, bh), (vx, vy) in zip(
+        bodies.pos.tolist(), bodies.size.tolist(), bodies.vel.tolist(), strict=True
+    ):
+        body = pymunk.Body(1.0, math.inf)
+        body.position = (x + bw / 2, y + bh / 2)
+        body.velocity = (vx, vy)
+        shape = pymunk.Poly.create_box(body, (bw, bh))
+        shape.elasticity = math.sqrt(e)
+        shape.friction = math.sqrt(mu)
+        space.add(body, shape)
+    return space
+
+
+def _ms_per_step(run, steps: int) -> float:
+    began = time.perf_counter()
+    run(steps)
+    return (time.perf_counter() - began) / steps * 1e3
+
+
+def _row(scene, model, n, value, note) -> dict:
+    """One figure of the gravity part, its note led by the model's name."""
+    return {
+        "part": "gravity",
+        "scene": scene,
+        "model": model,
+        "n": n,
+        "value": value,
+        "note": f"{model}: {note}",
+    }
+
+
+def timings(n: int, echo) -> list[dict]:
+    """Per-step times of the settling pile of n boxes: stepped and pymunk moving, stepped
+    settled."""
+    world, bodies = pile(n)
+    steps = FPS * SUBSTEPS
+    model = make("stepped", world, bodies, substeps=SUBSTEPS)
+    model.advance(1)  # compiled (or loaded) before the clock starts
+    ours = _ms_per_step(lambda k: model.advance(k // SUBSTEPS, log=False), steps)
+    rows = [_row(f"pile-{n}", "stepped", n, ours, "ms per step (1/120 s), the first second")]
+    slept = 1.0 + 1.0 / FPS
+    while not model._settle.asleep().all() and slept < SETTLE_LIMIT_S:
+        model.advance(FPS // 2, log=False)
+        slept += 0.5
+    settled = _ms_per_step(lambda k: model.advance(k // SUBSTEPS, log=False), steps)
+    asleep = int(model._settle.asleep().sum())
+    rows.append(
+        _row(
+            f"pile-{n}",
+            "stepped",
+            n,
+            settled,
+            f"ms per step settled ({asleep}/{n} asleep after {slept:.1f} s)",
+        )  # fmt: skip
+    )
+    rows.append(
+        _row(f"pile-{n}", "stepped", n, settled / ours, "settled / moving per step (target <= 0.1)")
+    )
+    echo(f"gravity  stepped  n={n:<6d} moving {ours:8.3f} ms/step, settled {settled:8.4f} ms/step")
+    try:
+        space = _space(world, bodies, E, MU)
+    except ImportError:
+        return rows
+    dt = 1.0 / (FPS * SUBSTEPS)
+    space.step(dt)
+
+    def stepping(k):
+        for _ in range(k):
+            space.step(dt)
+
+    peer = _ms_per_step(stepping, steps)
+    rows.append(_row(f"pile-{n}", "pymunk", n, peer, "ms per step (1/120 s), the first second"))
+    target = 5 if n < 5000 else 10
+    rows.append(
+        _row(
+            f"pile-{n}",
+            "stepped",
+            n,
+            peer / ours,
+            f"pymunk / stepped per step (target >= {target})",
+        )
+    )
+    echo(f"gravity  pymunk   n={n:<6d} moving {peer:8.3f} ms/step; stepped {peer / ours:.2f}x")
+    return rows
+
+
+def _bounce_times(states, floor, dt) -> list[float]:
+    """The bounce instants from states (t, y, vy) sampled after each step (module docstring)."""
+    out = []
+    for (_, _, v0), (t, y, v) in zip(states, states[1:], strict=False):
+        if v0 > 0.0 and v < 0.0:
+            h = floor - y
+            up = -v
+            out.append(t - 2.0 * max(h, 0.0) / (up + math.sqrt(up * up + 2.0 * G * max(h, 0.0))))
+    return out
+
+
+def closed_forms(echo) -> list[dict]:
+    """Errors against the closed forms: bounce instants and a slide (module docstring)."""
+    e, drop, box = 0.5, 100.0, 10.0
+    world = WorldSpec(100, 200, FPS, gravity=(0.0, G))
+    dt = 1.0 / FPS
+    floor = 200.0 - box
+    t1 = math.sqrt(2 * drop / G)
+    expected = [t1 * (1 + 2 * e * (1 - e ** (k - 1)) / (1 - e)) for k in (1, 2, 3)]
+    bodies = Bodies.boxes([[45, floor - drop]], box, [[0, 0]])
+    bodies = Bodies(**{**bodies.__dict__, "restitution": np.array([e])})
+    model = make("stepped", world, bodies, sleep=False)
+    states = [(0.0, floor - drop, 0.0)]
+    for k in range(1, 2 * FPS):
+        model.advance(1, log=False)
+        states.append((k * dt, model.positions()[0, 1], model.velocities()[0, 1]))
+    ours = _bounce_times(states, floor, dt)[:3]
+    worst = max(abs(a - b) for a, b in zip(ours, expected, strict=False))
+    rows = [_row("bounce", "stepped", 1, worst, "largest error of the first 3 bounce instants, s")]
+    v0, mu = 200.0, 0.5
+    slide = v0 * v0 / (2 * mu * G)
+    block = Bodies.boxes([[10, floor]], box, [[v0, 0]])
+    block = Bodies(**{**block.__dict__, "friction": np.array([mu])})
+    model = make("stepped", WorldSpec(400, 200, FPS, gravity=(0.0, G)), block)
+    model.advance(2 * FPS, log=False)
+    err = abs(model.positions()[0, 0] - 10 - slide) / slide
+    rows.append(_row("slide", "stepped", 1, err, "relative error of the slide distance"))
+    echo(f"gravity  stepped  bounce {rows[0]['value']:.2e} s, slide {err:.2e}")
+    try:
+        import pymunk  # noqa: F401
+    except ImportError:
+        return rows
+    space = _space(world, bodies, e, 0.0)
+    ball = [b for b in space.bodies][0]
+    states = [(0.0, floor - drop, 0.0)]
+    for k in range(1, 2 * FPS):
+        space.step(dt)
+        states.append((k * dt, ball.position.y - box / 2, ball.velocity.y))
+    theirs = _bounce_times(states, floor, dt)[:3]
+    err = max(abs(a - b) for a, b in zip(theirs, expected, strict=False)) if theirs else math.inf
+    rows.append(_row("bounce", "pymunk", 1, err, "largest error of the first 3 bounce instants, s"))
+    space = _space(WorldSpec(400, 200, FPS, gravity=(0.0, G)), block, 1.0, mu)
+    sled = [b for b in space.bodies][0]
+    x0 = sled.position.x
+    for _ in range(2 * FPS):
+        space.step(dt)
+    err = abs(sled.position.x - x0 - slide) / slide
+    rows.append(_row("slide", "pymunk", 1, err, "relative error of the slide distance"))
+    echo(f"gravity  pymunk   bounce {rows[2]['value']:.2e} s, slide {err:.2e}")
+    return rows
+
+
+def gravity(quick: bool, echo) -> list[dict]:
+    """The part's rows: the piles (1,000; and 10,000 unless quick), then the closed forms."""
+    rows: list[dict] = []
+    for n in (1000,) if quick else (1000, 10_000):
+        rows += timings(n, echo)
+    return rows + closed_forms(echo)

@@ -17,7 +17,8 @@ from dataclasses import dataclass, field
 from collide2d.engine.models import make as make_model
 from collide2d.engine.models import scenario_options
 from collide2d.runner.stress.checks import Checker
-from collide2d.runner.stress.scenes import Scene, scenes
+from collide2d.runner.stress.falling import every_scene
+from collide2d.runner.stress.scenes import Scene
 
 # Ticks per model call in the second, unchecked run (which must give the same bytes).
 CHUNK_TICKS = 65_536
@@ -130,7 +131,7 @@ def run_suite(quick: bool, only_scenes=(), only_models=(), on_case=None) -> list
     """Every scene under every model it applies to (filtered by name when asked); `on_case` is
     called with each result as it comes."""
     results = []
-    for scene in scenes(quick):
+    for scene in every_scene(quick):
         if only_scenes and scene.name not in only_scenes:
             continue
         for model in scene.models:

@@ -113,13 +113,34 @@ class Checker:
         self.momentum_scale = math.sqrt(2.0 * self.energy0 * float(np.sum(self.mass[movers])))
         self.momentum = self.out[[_PX, _PY]].copy()
         self.unexplained = np.zeros(2)  # momentum change summed over wall-free ticks
-        self.check_momentum = model != "paper" and not self.static.any()
+        world = scene.world
+        # gravity, restitution or friction: the total energy must never rise above where it
+        # began (kinetic plus potential, relative to the origin); momentum is not kept
+        self.settling = bool(
+            world.has_gravity
+            or world.restitution < 1.0
+            or world.friction > 0.0
+            or np.any(b.restitution < 1.0)
+            or np.any(b.friction > 0.0)
+        )
+        self.gravity = np.array(world.gravity, np.float64)
+        self.total0 = self._total(pos0)
+        self.total_scale = abs(self.total0) + float(np.sum(self.mass[~self.static])) * (
+            float(np.hypot(*self.gravity)) * max(self.width, self.height)
+        )
+        self.check_momentum = model != "paper" and not self.static.any() and not self.settling
         self.energy_drift = 0.0
         self.momentum_drift = 0.0 if self.check_momentum else None
         self.penetration = 0.0
         self.energy_tol = EXACT_ENERGY_TOL if model == "exact" else STEPPED_ENERGY_TOL
         self.momentum_tol = EXACT_MOMENTUM_TOL if model == "exact" else STEPPED_MOMENTUM_TOL
         self.tick(0, pos0, vel0, None)
+
+    def _total(self, pos) -> float:
+        """Kinetic energy (the last figures) plus potential, -m·(g·p), of the movers."""
+        movers = ~self.static
+        potential = -float(np.sum(self.mass[movers] * (np.asarray(pos)[movers] @ self.gravity)))
+        return float(self.out[_ENERGY]) + potential
 
     def _figures(self, pos, vel) -> None:
         tick_figures(
@@ -141,6 +162,7 @@ class Checker:
 
     def tick(self, k: int, pos: np.ndarray, vel: np.ndarray, events) -> bool:
         """Check the state after tick k (0: the start); False once an invariant broke."""
+        self._pos = pos
         self._figures(pos, vel)
         out = self.out
         if out[_FINITE] != 1.0:
@@ -175,6 +197,12 @@ class Checker:
                 self.energy_drift = max(
                     self.energy_drift, abs(out[_ENERGY] - self.energy0) / self.energy0
                 )
+            return
+        if self.settling:
+            rise = (self._total(self._pos) - self.total0) / max(self.total_scale, 1e-300)
+            self.energy_drift = max(self.energy_drift, rise)
+            if rise > self.energy_tol:
+                self.fail(k, f"total energy rose by {rise:.3g} (bound {self.energy_tol:g})")
             return
         if self.energy0 > 0:
             drift = abs(out[_ENERGY] - self.energy0) / self.energy0

@@ -18,6 +18,7 @@ from collide2d.runner.command.exitcodes import EXIT_BAD_INPUT, EXIT_DIFFERENCE, 
 def cmd_stress(args: argparse.Namespace) -> int:
     from collide2d.runner.output import files as outputs
     from collide2d.runner.stress.cases import VERDICT_FAIL, run_suite
+    from collide2d.runner.stress.falling import every_scene
     from collide2d.runner.stress.report import (
         HEADER,
         line,
@@ -25,14 +26,13 @@ def cmd_stress(args: argparse.Namespace) -> int:
         report_json,
         report_markdown,
     )
-    from collide2d.runner.stress.scenes import scenes
 
     try:
         target = report_dir(args.out)
     except ValueError as exc:
         print(f"collide2d stress: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
-    known = [s.name for s in scenes(True)]
+    known = [s.name for s in every_scene(True)]
     unknown = [s for s in args.scene or () if s not in known]
     if unknown:
         print(

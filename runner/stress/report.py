@@ -19,7 +19,7 @@ from collide2d.runner.stress.checks import (
     STEPPED_ENERGY_TOL,
     STEPPED_MOMENTUM_TOL,
 )
-from collide2d.runner.stress.scenes import scenes
+from collide2d.runner.stress.falling import every_scene
 
 REPORT_DIR = "stress"
 
@@ -78,7 +78,7 @@ def report_markdown(results: list[CaseResult], quick: bool, total_s: float) -> s
                 lines.append(f"- {r.scene} / {r.model}: {r.note}")
     run = {r.scene for r in results}
     lines += ["", "## Scenes", ""]
-    lines += [f"- `{s.name}`: {s.about}." for s in scenes(quick) if s.name in run]
+    lines += [f"- `{s.name}`: {s.about}." for s in every_scene(quick) if s.name in run]
     return "\n".join(lines) + "\n"
 
 
@@ -95,7 +95,7 @@ def report_json(results: list[CaseResult], quick: bool, total_s: float) -> dict:
             "stepped_momentum": STEPPED_MOMENTUM_TOL,
             "penetration_px": PENETRATION_TOL_PX,
         },
-        "scenes": {s.name: s.about for s in scenes(quick)},
+        "scenes": {s.name: s.about for s in every_scene(quick)},
         "cases": [{k: _json_number(v) for k, v in asdict(r).items()} for r in results],
     }
 

@@ -42,3 +42,30 @@ def ref_hull(points):
 def pixel_corners(verts):
     v = np.asarray(verts, float)
     return (v[:, None, :] + np.array([[0, 0], [1, 0], [0, 1], [1, 1]])[None]).reshape(-1, 2)
+
+
+def pile_bodies(n, seed, width, size=8.0, pitch=10.0, e=0.3, mu=0.3, speed=20.0):
+    """n objects, boxes and circles in turn (sides size, px), on a jittered grid of `pitch` px
+    from the top of a world `width` px wide, at small random speeds: a pile about to be dropped.
+    Every object has restitution e and friction mu."""
+    from collide2d.engine.world import KIND_CIRCLE, Looks
+
+    rng = np.random.default_rng(seed)
+    cols = int(width // pitch)
+    idx = np.arange(n)
+    pos = np.stack([idx % cols, idx // cols], axis=1) * pitch
+    pos = pos + rng.uniform(0, pitch - size, (n, 2))
+    kind = np.where(idx % 2 == 1, KIND_CIRCLE, 0).astype(np.int8)
+    return Bodies(
+        kind=kind,
+        pos=pos,
+        size=np.full((n, 2), size),
+        vel=rng.uniform(-speed, speed, (n, 2)),
+        mass=rng.uniform(0.5, 2.0, n),
+        static=np.zeros(n, bool),
+        vert_start=np.zeros(n + 1, np.int64),
+        verts=np.zeros((0, 2), np.int64),
+        looks=Looks(color=np.ones(n, np.uint8), fill=np.zeros(n, bool)),
+        restitution=np.full(n, float(e)),
+        friction=np.full(n, float(mu)),
+    )

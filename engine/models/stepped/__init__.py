@@ -5,8 +5,11 @@ This package holds what only the stepped model uses: `model` (the `Model` class 
 per stage: `move` (move and walls), `candidates` (the candidate list and the order the objects
 are kept in), `narrow` (the listed pairs in contact, in order) and `pairs` (the exchange and the
 push), with `approach` (a pair's contact after a step: its normal from the direction of
-approach). `collide2d.engine.models.make("stepped", ...)` builds it from `Model`, which this
-package re-exports.
+approach). A world with gravity, restitution or friction takes the settling path instead:
+`settle` (its step and run loop), `fall` (exact motion under gravity, wall bounces), `touch`
+(contacts, wake), `solver` (velocities and overlap, never adding energy) and `sleep`.
+`collide2d.engine.models.make("stepped", ...)` builds it from `Model`, which this package
+re-exports.
 
 Its modules may import numpy, each other and the shared stages of `collide2d.engine` (jit,
 contact, response, shapes, broadphase, sort, threads, splitchoice, events, errors, world);

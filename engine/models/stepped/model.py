@@ -66,6 +66,14 @@ from collide2d.engine.models.stepped.candidates import (
 )
 from collide2d.engine.models.stepped.move import BODY_COLUMNS
 from collide2d.engine.models.stepped.records import Lists, State, Step
+from collide2d.engine.models.stepped.settle import (
+    ITERATIONS,
+    SLEEP_AFTER_S,
+    SLOP_PX,
+    Settle,
+    check_options,
+    settles,
+)
 from collide2d.engine.models.stepped.step import STAGES, run, step
 from collide2d.engine.shapes import GEOMETRIES, build_cores
 from collide2d.engine.sort import median
@@ -101,6 +109,11 @@ class Model:
         geometry: str | None = None,
         skip: bool = True,
         broadphase: str | None = None,
+        iterations: int = ITERATIONS,
+        slop: float = SLOP_PX,
+        rest_speed: float | None = None,
+        sleep: bool = True,
+        sleep_after: float = SLEEP_AFTER_S,
     ):
         if bodies.n >= 1 << (BAND_SHIFT - KEY_SHIFT):
             raise ValueError(f"at most {(1 << (BAND_SHIFT - KEY_SHIFT)) - 1} objects")
@@ -113,6 +126,14 @@ class Model:
         self.substeps = int(substeps)
         self.geometry = geometry
         self.tick = 0
+        # gravity, restitution or friction: the settling path (settle.py); else the elastic one
+        self._settle = None
+        if settles(world, bodies):
+            self._settle = Settle(
+                world, bodies, substeps, geometry, iterations, slop, rest_speed, sleep, sleep_after
+            )
+            return
+        check_options(iterations, slop, rest_speed, sleep, sleep_after)
         n = bodies.n
         static = np.ascontiguousarray(bodies.static, bool).copy()
         pos = np.ascontiguousarray(bodies.pos, np.float64).copy()
@@ -143,6 +164,10 @@ class Model:
         """Run `ticks` ticks; the events in the order they happened (empty when log is False).
         A scene that splits runs them split among threads or not, as the clock says
         (splitchoice): the same bytes either way."""
+        if self._settle is not None:
+            events = self._settle.advance(int(ticks), log)
+            self.tick = self._settle.tick
+            return events
         parts = self._split.run(int(ticks), lambda k, chunks: self._advance(k, log, chunks))
         return parts[0] if len(parts) == 1 else np.concatenate(parts)
 
@@ -170,6 +195,8 @@ class Model:
 
     def event_counts(self) -> tuple[int, int]:
         """(wall events, pair events) so far, logged or not."""
+        if self._settle is not None:
+            return self._settle.event_counts()
         state = self._bp.state
         return int(state[ST_WALLS]), int(state[ST_PAIRS])
 
@@ -182,7 +209,12 @@ class Model:
         which dominates in small scenes. A scene that splits runs split (the clock does not
         choose here). The move and the narrow phase, which `advance` runs together block by block
         while the list holds (narrow.move_narrow), run here one after the other, so that
-        each has a time of its own."""
+        each has a time of its own. On the settling path (settle.py) the whole step is timed as
+        "move"."""
+        if self._settle is not None:
+            began = time.perf_counter()
+            self.advance(ticks, log=False)
+            return dict.fromkeys(STAGES, 0.0) | {"move": time.perf_counter() - began}
         self._bp.state[ST_CHUNKS] = self._split.chunks
         fps = float(self.world.fps)
         width, height = float(self.world.width), float(self.world.height)
@@ -213,10 +245,14 @@ class Model:
 
     def positions(self) -> np.ndarray:
         """(n, 2) float64 top-left corners, px."""
+        if self._settle is not None:
+            return self._settle.positions()
         return self._by_id(self._S.body[:, 0:2])
 
     def velocities(self) -> np.ndarray:
         """(n, 2) float64 velocities, px/s."""
+        if self._settle is not None:
+            return self._settle.velocities()
         return self._by_id(self._S.body[:, 2:4])
 
     def _by_id(self, a: np.ndarray) -> np.ndarray:

@@ -58,3 +58,62 @@ class Step(NamedTuple):
     tick: int  # the tick it belongs to
     t: float  # the time of that tick's end, s (the events' time)
     log: bool  # whether events are logged
+
+
+# --- the settling path: gravity, restitution, friction and sleep (settle.py) -------------------
+
+
+class Fall(NamedTuple):
+    """The state of the settling path (settle.py), every row in id order."""
+
+    body: np.ndarray  # (n, 6) float64 x, y, vx, vy, w, h: move.B_*
+    inv_mass: np.ndarray  # (n,) float64, 0 for static objects
+    mass: np.ndarray  # (n,) float64, 0 for static objects (their energy is not counted)
+    static: np.ndarray  # (n,) bool
+    restitution: np.ndarray  # (n,) float64 e in [0, 1]
+    friction: np.ndarray  # (n,) float64 mu >= 0
+    awake: np.ndarray  # (n,) bool: moved and paired (not static, not asleep)
+    asleep: np.ndarray  # (n,) bool
+    quiet: np.ndarray  # (n,) float64 seconds it has been slower than the rest speed
+    anchor: np.ndarray  # (n, 2) float64 where each was when the candidate list was made, px
+    saved: np.ndarray  # (n, 2) float64 scratch: velocities or positions before a pass
+
+
+class Physics(NamedTuple):
+    """The settling path's constants (docs/models.md#stepped-gravity-restitution-and-friction)."""
+
+    gx: float  # gravity, px/s^2 (y down)
+    gy: float
+    restitution: float  # the walls' e
+    friction: float  # the walls' mu
+    rest: float  # the rest speed, px/s (0 without gravity: no rest rule)
+    slop: float  # the overlap left in place, px
+    iterations: int  # velocity passes (and position passes) per step
+    sleep_after: float  # seconds below the rest speed before sleeping (inf: never)
+    half: float  # half the candidate list's margin, px
+
+
+class Touch(NamedTuple):
+    """The settling path's candidate list, its contacts and their scratch. `keys`, `pairs`,
+    `floats`, `last_keys` and `last` can grow: `settle.run` hands them back."""
+
+    keys: np.ndarray  # int64 the candidate list (sorted keys of ids, broadphase.KEY_SHIFT)
+    pairs: np.ndarray  # (m,) int64 this step's contacts as keys (touch.py), sorted
+    floats: np.ndarray  # (m, C_COLUMNS) float64 this step's contacts (touch.C_*)
+    last_keys: np.ndarray  # (m,) int64 last step's contacts' keys
+    last: np.ndarray  # (m, 4) float64 their normal and friction impulses and their normals
+    counts: np.ndarray  # int64 scalar state, slots touch.N_*
+    lo: np.ndarray  # (n, 2) float64 grown boxes, low corners
+    hi: np.ndarray  # (n, 2) float64 grown boxes, high corners
+    order: np.ndarray  # (n,) int64 the broad phase's order
+    ws: tuple  # the pair finder's scratch (broadphase.workspace)
+    finder: np.ndarray  # the method's marker (broadphase.marker)
+    cell: float  # the grid's cell, px
+    cores: tuple  # the exact shapes (shapes.build_cores) when colliding by them
+    exact: bool  # whether objects collide by their real shapes
+    hits: np.ndarray  # int64 scratch: one object's bounces in a step (fall.fall_one)
+    capped: np.ndarray  # (n,) bool scratch (touch.cap_goals)
+    bank: np.ndarray  # (1,) float64 energy given up so far and not yet spent on pushes (solver)
+    hits: np.ndarray  # int64 scratch: one object's bounces in a step (fall.fall_one)
+    capped: np.ndarray  # (n,) bool scratch (touch.cap_goals)
+    bank: np.ndarray  # (1,) float64 energy given up so far and not yet spent on pushes (solver)

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from collide2d.runner.command.main import main
 from collide2d.runner.stress import cases
-from collide2d.runner.stress.scenes import scenes
+from collide2d.runner.stress.falling import every_scene
 
 from .test_cases import FakeModel, set_nan
 
@@ -59,7 +59,7 @@ def test_collide2d_stress_quick_passes_and_reports_every_case(tmp_path):
     data = json.loads((tmp_path / "stress" / "report.json").read_text())
     assert data["mode"] == "quick" and data["ok"] is True
     cases = {(c["scene"], c["model"]): c for c in data["cases"]}
-    expected = {(s.name, m) for s in scenes(True) for m in s.models}
+    expected = {(s.name, m) for s in every_scene(True) for m in s.models}
     assert set(cases) == expected
     for (scene, model), c in cases.items():
         assert c["verdict"] in ("pass", "stopped"), (scene, model, c["problems"])
@@ -74,5 +74,5 @@ def test_collide2d_stress_quick_passes_and_reports_every_case(tmp_path):
     assert "| scene | model | verdict | ticks run | events | energy drift |" in text
     assert f"Cases: {len(expected)}, failed: 0" in text
     assert "## Scenes" in text and "- `mass_ratios`: masses 1e-12 ... 1e12" in text
-    assert data["scenes"].keys() == {s.name for s in scenes(True)}
+    assert data["scenes"].keys() == {s.name for s in every_scene(True)}
     assert "stress: " in proc.stdout and " 0 failed" in proc.stdout
