@@ -464,6 +464,7 @@ class Model:
         self._G = build_grid(self._F, self._N, self.cell_size, gnx, gny)
         cap = max(64, HEAP_PER_OBJECT * n)
         self._heap = [np.empty(cap), np.empty((cap, 3), np.int64), np.empty((cap, 2))]
+        self._plain = None  # the state as the kernel takes it, made again when the heap grows
         self._horizons = new_horizons(
             static, bucket_width(self._F, static, self.cell_size, world.width, world.height)
         )
@@ -502,7 +503,7 @@ class Model:
         while True:
             status = self._call(target, bool(log), self.max_events_per_tick, rows, times)
             if status == STATUS_HEAP_FULL:
-                self._heap = [events.grown(a) for a in self._heap]
+                self._grow_heap()
             elif status == STATUS_LOG_FULL:
                 rows, times = events.grown(rows), events.grown(times)
             elif status == STATUS_CAP:
@@ -519,8 +520,15 @@ class Model:
         as compiled: no numpy warning.)"""
         everyone = self.repredict == "all"
         with np.errstate(over="ignore", invalid="ignore"):
-            state = plain(self._state())
+            if self._plain is None:
+                self._plain = plain(self._state())
+            state = self._plain
             return _run(state, self._jobs, self._stack, target, log, cap, everyone, rows, times)
+
+    def _grow_heap(self) -> None:
+        """Twice the heap's room, its entries kept."""
+        self._heap = [events.grown(a) for a in self._heap]
+        self._plain = None
 
     def event_counts(self) -> tuple[int, int]:
         """(wall events, pair events) so far, logged or not."""
@@ -542,7 +550,7 @@ class Model:
         rows, times = events.new_log(True, RECENT)
         cap = int(st[S_TICK_EVENTS]) + RECENT
         while self._call(int(st[S_TICK]) + 1, True, cap, rows, times) == STATUS_HEAP_FULL:
-            self._heap = [events.grown(a) for a in self._heap]
+            self._grow_heap()
         st[S_WALLS : S_PAIRS + 1] = counts  # the counts stay those of the events before the stop
         t = float(self._stf[SF_T_NOW])
         n = int(st[S_LOGGED])
