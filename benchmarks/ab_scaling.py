@@ -31,7 +31,9 @@ def bench(checkout: Path, models: list[str], ns: list[int], quick: bool) -> dict
         cmd += [x for m in models for x in ("--model", m)]
         cmd += [x for n in ns for x in ("--n", str(n))]
         cmd += ["--quick"] if quick else []
-        subprocess.run(cmd, check=True, cwd=checkout)
+        # (exit 1 says a section IV target was missed: the figures are written all the same)
+        if subprocess.run(cmd, cwd=checkout).returncode not in (0, 1):
+            raise SystemExit(f"the bench of {checkout} failed")
         with open(Path(out) / "bench" / "bench.csv", newline="") as f:
             return {
                 (row["model"], int(row["n"])): float(row["steps_per_s"])
