@@ -16,6 +16,7 @@ from collide2d.engine.models.exact.heap import RANK_CROSS, RANK_WALL, make_key, 
 from collide2d.engine.models.exact.horizonqueue import (
     FAR,
     Q_NEXT,
+    QS_AT,
     QS_TOP,
     bucket_width,
     first_horizon,
@@ -39,22 +40,22 @@ updates = st.lists(
 )
 
 
-def _bucket(t, QW):
-    a = t * QW[0]
+def _bucket(t, rate):
+    a = t * rate
     return int(a) if a < FAR else FAR
 
 
 def _check(Q, static, expected):
     """The queue holds exactly `expected` ({object: (t, key)}), each finite one filed once in the
     list of its bucket's slot."""
-    QT, QC, QL, QH, QS, QW = Q
+    QT, QL, QH, QS = Q.time, Q.links, Q.heads, Q.state
     mask = QH.size - 1
     seen = []
     for s in range(QH.size):
         j = QH[s]
         while j >= 0:
-            assert _bucket(QT[j], QW) & mask == s
-            assert _bucket(QT[j], QW) >= QS[0]  # never behind the walk
+            assert _bucket(QT[j], Q.rate) & mask == s
+            assert _bucket(QT[j], Q.rate) >= QS[QS_AT]  # never behind the walk
             seen.append(int(j))
             j = QL[j, Q_NEXT]
     filed = sorted(i for i, (t, _) in expected.items() if t < np.inf)
@@ -76,7 +77,7 @@ def _check(Q, static, expected):
 def test_updates_keep_the_first_horizon_known(compiled, moves, seed, width, n):
     static = np.random.default_rng(seed).random(n) < 0.25
     Q = new_horizons(static, width)
-    QT = Q[0]
+    QT = Q.time
     expected = {int(i): (np.inf, horizon_key(Q, i)) for i in np.flatnonzero(~static)}
     with jit.lane(compiled):
         for i, t, cross, side, look in moves:
@@ -96,7 +97,7 @@ def test_updates_keep_the_first_horizon_known(compiled, moves, seed, width, n):
                 assert top == -1
                 continue
             assert (QT[top], horizon_key(Q, top), top) == min(finite)
-            assert Q[4][QS_TOP] == top
+            assert Q.state[QS_TOP] == top
             bound = QT[top] + 2.0**-40  # the instant of the top: its two nearest times at 1.0
             k = first_horizon(Q, bound)
             assert horizon_key(Q, k) == min(key for t, key, _ in finite if t <= bound)

@@ -152,7 +152,7 @@ def build_grid(F, N, cell, gnx, gny):
 def room_around(gx, gy, N, cells, s_start, world):
     """Heap entries a prediction in cell (gx, gy) may push: a horizon, and one contact per object
     filed in the 3×3 cells around it (moving and static)."""
-    gnx, gny = world[4], world[5]
+    gnx, gny = world.gnx, world.gny
     room = 1
     for cy in range(max(gy - 1, 0), min(gy + 1, gny - 1) + 1):
         for cx in range(max(gx - 1, 0), min(gx + 1, gnx - 1) + 1):
@@ -162,12 +162,13 @@ def room_around(gx, gy, N, cells, s_start, world):
 
 
 @hot
-def room_needed(rank, a, b, HT, st, N, cells, s_start, world):
+def room_needed(rank, a, b, S):
     """Heap entries the event (rank, a, b) may push at most; when the heap has room for the worst
     case of any event (two predictions against everything), it is not counted."""
-    if HT.shape[0] - st[S_HEAP_N] >= 2 * (N.shape[0] + 1):
+    N, cells, s_start, world = S.N, S.cells, S.s_start, S.world
+    if S.HT.shape[0] - S.st[S_HEAP_N] >= 2 * (N.shape[0] + 1):
         return 0
-    gnx = world[4]
+    gnx = world.gnx
     gx = N[a, CELL] % gnx
     gy = N[a, CELL] // gnx
     if rank == RANK_CROSS:

@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from collide2d.engine.jit import njit
-from collide2d.engine.models.exact.state import CNT, S_HEAP_N, hot
+from collide2d.engine.models.exact.state import CNT, S_HEAP_N, Entry, hot
 
 # Children per heap node: a 4-ary heap is half as deep as a binary one, and its four children
 # share a cache line.
@@ -85,28 +85,34 @@ def _earlier(HT, HI, i, t, key):
 
 
 @hot
-def _put(HT, HI, HN, i, t, key, ca, cb, nx, ny):
-    HT[i] = t
-    HI[i, HKEY], HI[i, HCA], HI[i, HCB] = key, ca, cb
-    HN[i, 0], HN[i, 1] = nx, ny
+def entry(HT, HI, HN, i):
+    """The entry in slot i."""
+    return Entry(HT[i], HI[i, HKEY], HI[i, HCA], HI[i, HCB], HN[i, 0], HN[i, 1])
+
+
+@hot
+def _put(HT, HI, HN, i, e):
+    HT[i] = e.t
+    HI[i, HKEY], HI[i, HCA], HI[i, HCB] = e.key, e.ca, e.cb
+    HN[i, 0], HN[i, 1] = e.nx, e.ny
 
 
 @hot
 def _move(HT, HI, HN, i, j):
     """Entry j moves to slot i."""
-    _put(HT, HI, HN, i, HT[j], HI[j, HKEY], HI[j, HCA], HI[j, HCB], HN[j, 0], HN[j, 1])
+    _put(HT, HI, HN, i, entry(HT, HI, HN, j))
 
 
 @hot
-def _sift_up(HT, HI, HN, i, t, key, ca, cb, nx, ny):
-    """Place an entry at hole i, moving it up past later parents."""
+def _sift_up(HT, HI, HN, i, e):
+    """Place entry e at hole i, moving it up past later parents."""
     while i > 0:
         p = (i - 1) // ARITY
-        if _earlier(HT, HI, p, t, key) or (HT[p] == t and HI[p, HKEY] == key):
+        if _earlier(HT, HI, p, e.t, e.key) or (HT[p] == e.t and HI[p, HKEY] == e.key):
             break
         _move(HT, HI, HN, i, p)
         i = p
-    _put(HT, HI, HN, i, t, key, ca, cb, nx, ny)
+    _put(HT, HI, HN, i, e)
 
 
 @hot
@@ -123,8 +129,9 @@ def _first_child(HT, HI, first, last):
 
 
 @hot
-def _sift_down(HT, HI, HN, n, i, t, key, ca, cb, nx, ny):
-    """Place an entry at hole i of a heap of n, moving it down past earlier children."""
+def _sift_down(HT, HI, HN, n, i, e):
+    """Place entry e at hole i of a heap of n, moving it down past earlier children."""
+    t, key = e.t, e.key
     while True:
         first = ARITY * i + 1
         if first + ARITY <= n:  # a full family: a loop of constant length, unrolled
@@ -137,41 +144,41 @@ def _sift_down(HT, HI, HN, n, i, t, key, ca, cb, nx, ny):
             break
         _move(HT, HI, HN, i, c)
         i = c
-    _put(HT, HI, HN, i, t, key, ca, cb, nx, ny)
+    _put(HT, HI, HN, i, e)
 
 
 @hot
-def push(HT, HI, HN, st, t, key, ca, cb, nx, ny):
-    """Add an entry (there is room)."""
+def push(HT, HI, HN, st, e):
+    """Add entry e (there is room)."""
     n = st[S_HEAP_N]
     st[S_HEAP_N] = n + 1
-    _sift_up(HT, HI, HN, n, t, key, ca, cb, nx, ny)
+    _sift_up(HT, HI, HN, n, e)
 
 
 @hot
 def pop(HT, HI, HN, st):
-    """Remove and return the earliest entry (t, key, ca, cb, nx, ny)."""
-    top = (HT[0], HI[0, HKEY], HI[0, HCA], HI[0, HCB], HN[0, 0], HN[0, 1])
+    """Remove and return the earliest entry."""
+    top = entry(HT, HI, HN, 0)
     n = st[S_HEAP_N] - 1
     st[S_HEAP_N] = n
     if n > 0:
-        _sift_down(HT, HI, HN, n, 0, HT[n], HI[n, HKEY], HI[n, HCA], HI[n, HCB], HN[n, 0], HN[n, 1])
+        _sift_down(HT, HI, HN, n, 0, entry(HT, HI, HN, n))
     return top
 
 
 @hot
 def remove(HT, HI, HN, st, k):
-    """Remove and return entry k (t, key, ca, cb, nx, ny); the last entry takes its place."""
-    entry = (HT[k], HI[k, HKEY], HI[k, HCA], HI[k, HCB], HN[k, 0], HN[k, 1])
+    """Remove and return entry k; the last entry takes its place."""
+    taken = entry(HT, HI, HN, k)
     n = st[S_HEAP_N] - 1
     st[S_HEAP_N] = n
     if k < n:
-        t, key, ca, cb, nx, ny = HT[n], HI[n, HKEY], HI[n, HCA], HI[n, HCB], HN[n, 0], HN[n, 1]
-        if k > 0 and not _earlier(HT, HI, (k - 1) // ARITY, t, key):
-            _sift_up(HT, HI, HN, k, t, key, ca, cb, nx, ny)
+        last = entry(HT, HI, HN, n)
+        if k > 0 and not _earlier(HT, HI, (k - 1) // ARITY, last.t, last.key):
+            _sift_up(HT, HI, HN, k, last)
         else:
-            _sift_down(HT, HI, HN, n, k, t, key, ca, cb, nx, ny)
-    return entry
+            _sift_down(HT, HI, HN, n, k, last)
+    return taken
 
 
 @hot
@@ -215,9 +222,7 @@ def compact(HT, HI, HN, st, N):
             _move(HT, HI, HN, keep, i)
             keep += 1
     for i in range((keep - 2) // ARITY, -1, -1):
-        _sift_down(
-            HT, HI, HN, keep, i, HT[i], HI[i, HKEY], HI[i, HCA], HI[i, HCB], HN[i, 0], HN[i, 1]
-        )
+        _sift_down(HT, HI, HN, keep, i, entry(HT, HI, HN, i))
     st[S_HEAP_N] = keep
     return HT.shape[0] - keep
 

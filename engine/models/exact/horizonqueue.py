@@ -15,15 +15,16 @@ the horizons within an instant of the first, the one with the smallest key, as t
 does for its contacts. The order is that of (time, key) exactly, whatever w is: w only sets how
 much walking finding the next takes.
 
-The queue is one tuple Q = (QT, QC, QL, QH, QS, QW), small, as the event loop's memory
-traffic is most of its time: each object's horizon time QT (n,) float64 (inf: none, or a static
-object; the bucket of a finite one is QT·QW[0], rounded down) and what it is, QC (n,) int8 (rank
-× 4 + side or direction: its event queue key, heap.py, is `horizon_key`, so ties go
-crossings first, then walls, by id); its links QL (n, 2) int32 (next and previous object in its
-bucket's list, -1 for none); the first object of each ring slot QH (slots,) int32 (-1: empty;
-slots a power of two); the scalar state QS (the bucket the walk is at, every filed horizon's
-bucket being at least it; the object of the first horizon, -1 when not known; how many horizons
-are filed) and QW (1,) float64, one over the bucket width (1/s).
+The queue is one record Q (state.Horizons), small, as the event loop's memory traffic is most
+of its time, read by field (the kernels name the fields QT, QC, QL, QH, QS): each object's horizon
+time QT = Q.time (n,) float64 (inf: none, or a static object; the bucket of a finite one is
+QT·Q.rate, rounded down) and what it is, QC = Q.code (n,) int8 (rank × 4 + side or direction: its
+event queue key, heap.py, is `horizon_key`, so ties go crossings first, then walls, by id); its
+links QL = Q.links (n, 2) int32 (next and previous object in its bucket's list, -1 for none); the
+first object of each ring slot QH = Q.heads (slots,) int32 (-1: empty; slots a power of two); the
+scalar state QS = Q.state (the bucket the walk is at, every filed horizon's bucket being at least
+it; the object of the first horizon, -1 when not known; how many horizons are filed) and Q.rate,
+one over the bucket width (1/s).
 """
 
 from __future__ import annotations
@@ -32,7 +33,7 @@ import numpy as np
 
 from collide2d.engine.jit import njit
 from collide2d.engine.models.exact.heap import ID_BITS, RANK_WALL, make_key
-from collide2d.engine.models.exact.state import INF, hot
+from collide2d.engine.models.exact.state import INF, Horizons, hot
 from collide2d.engine.sort import median
 
 # Columns of QL: the next and previous object in the same bucket's list.
@@ -64,7 +65,7 @@ def bucket_width(F: np.ndarray, static: np.ndarray, cell: float, width: float, h
     return w if np.isfinite(w) and w > 0.0 else 1.0
 
 
-def new_horizons(static: np.ndarray, width: float) -> tuple:
+def new_horizons(static: np.ndarray, width: float) -> Horizons:
     """The queue Q of `static`'s objects: none has a horizon yet; buckets `width` s wide."""
     static = np.asarray(static, bool)
     n = static.size
@@ -77,20 +78,20 @@ def new_horizons(static: np.ndarray, width: float) -> tuple:
     QH = np.full(slots, -1, np.int32)
     QS = np.zeros(3, np.int64)
     QS[QS_TOP] = -1
-    QW = np.array([1.0 / float(width)])
-    return QT, QC, QL, QH, QS, QW
+    return Horizons(QT, QC, QL, QH, QS, 1.0 / float(width))
 
 
 @hot
 def horizon_key(Q, i):
     """Object i's horizon as an event queue key (rank, i, side or direction)."""
-    c = int(Q[1][i])
+    c = int(Q.code[i])
     return make_key(c >> 2, int(i), c & 3, c & 3)
 
 
 @hot
-def _bucket(t, QW):
-    a = t * QW[0]
+def _bucket(t, rate):
+    """The bucket of time t, at `rate` buckets per second."""
+    a = t * rate
     return int(a) if a < FAR else FAR
 
 
@@ -113,14 +114,14 @@ def set_horizon(Q, i, t, rank, d):
     """Object i's horizon becomes (t, rank, side or direction d) (t >= the present; inf: none):
     it leaves its bucket for that of t, and the first horizon stays known unless it was i's and
     i's is now later."""
-    QT, QC, QL, QH, QS, QW = Q
+    QT, QC, QL, QH, QS = Q.time, Q.code, Q.links, Q.heads, Q.state
     mask = QH.shape[0] - 1
     if QT[i] < INF:  # unlink
         nxt, prv = int(QL[i, Q_NEXT]), int(QL[i, Q_PREV])
         if prv >= 0:
             QL[prv, Q_NEXT] = nxt
         else:
-            QH[_bucket(QT[i], QW) & mask] = nxt
+            QH[_bucket(QT[i], Q.rate) & mask] = nxt
         if nxt >= 0:
             QL[nxt, Q_PREV] = prv
         QS[QS_FILED] -= 1
@@ -130,7 +131,7 @@ def set_horizon(Q, i, t, rank, d):
     QT[i] = t
     QC[i] = code
     if t < INF:
-        b = _bucket(t, QW)
+        b = _bucket(t, Q.rate)
         s = b & mask
         QL[i, Q_PREV] = -1
         head = int(QH[s])
@@ -152,7 +153,7 @@ def set_horizon(Q, i, t, rank, d):
 def next_top(Q):
     """find_top, with a scene of FEW objects looked at in place (no call: the two-body chain
     finds its first horizon again after nearly every event)."""
-    QT, QC, _, _, QS, QW = Q
+    QT, QC, QS = Q.time, Q.code, Q.state
     if QT.shape[0] > FEW:
         return find_top(Q)
     best = -1
@@ -160,7 +161,7 @@ def next_top(Q):
         if QT[j] < INF and (best < 0 or _before(QT, QC, j, best)):
             best = j
     if best >= 0:
-        QS[QS_AT] = _bucket(QT[best], QW)
+        QS[QS_AT] = _bucket(QT[best], Q.rate)
     QS[QS_TOP] = best
     return best
 
@@ -170,7 +171,7 @@ def find_top(Q):
     """The object of the first horizon (by time, then key), -1 if none has one; kept known in
     QS. Walks the buckets from the current one to the first holding a horizon of its own (not
     one of a later pass of the ring); after a whole ring without, looks at every object."""
-    QT, QC, QL, QH, QS, QW = Q
+    QT, QC, QL, QH, QS = Q.time, Q.code, Q.links, Q.heads, Q.state
     if QS[QS_FILED] == 0:
         QS[QS_TOP] = -1
         return -1
@@ -180,7 +181,7 @@ def find_top(Q):
     for _ in range(QH.shape[0] if QT.shape[0] > FEW else 0):
         j = int(QH[at & mask])
         while j >= 0:
-            if _bucket(QT[j], QW) == at and (best < 0 or _before(QT, QC, j, best)):
+            if _bucket(QT[j], Q.rate) == at and (best < 0 or _before(QT, QC, j, best)):
                 best = j
             j = int(QL[j, Q_NEXT])
         if best >= 0:
@@ -190,7 +191,7 @@ def find_top(Q):
         for j in range(QT.shape[0]):
             if QT[j] < INF and (best < 0 or _before(QT, QC, j, best)):
                 best = j
-        at = _bucket(QT[best], QW)
+        at = _bucket(QT[best], Q.rate)
     QS[QS_AT] = at
     QS[QS_TOP] = best
     return best
@@ -200,10 +201,10 @@ def find_top(Q):
 def first_horizon(Q, bound):
     """The object of the horizon to take next: of those no later than `bound` (the first
     horizon's, at least; it is known), the one with the smallest key."""
-    QT, QC, QL, QH, QS, QW = Q
+    QT, QC, QL, QH, QS = Q.time, Q.code, Q.links, Q.heads, Q.state
     mask = QH.shape[0] - 1
     best = int(QS[QS_TOP])
-    last = min(_bucket(bound, QW), QS[QS_AT] + mask)  # a whole ring sees every slot
+    last = min(_bucket(bound, Q.rate), QS[QS_AT] + mask)  # a whole ring sees every slot
     for b in range(QS[QS_AT], last + 1):
         j = int(QH[b & mask])
         while j >= 0:

@@ -26,16 +26,16 @@ def listing(word: str, ids: list[int], most: int = 8) -> str:
 
 
 def jammed(F, N, world, ids: list[int], axis: int, t: float) -> list[int]:
-    """The moving objects of `ids` (in the exact model's state F, N, world) held on `axis` at
-    time t from both sides by a chain of boxes of `ids` that touch (or overlap) along the axis
-    and overlap on the other, from a wall or a static object to a wall or a static object: they
-    cannot move on that axis."""
+    """The moving objects of `ids` (in the exact model's state F, N and its World record) held
+    on `axis` at time t from both sides by a chain of boxes of `ids` that touch (or overlap) along
+    the axis and overlap on the other, from a wall or a static object to a wall or a static
+    object: they cannot move on that axis."""
     k = 0 if axis == AXIS_X else 1
     ids = np.array(ids, np.int64)
     lo = F[ids, X : Y + 1] + F[ids, VX : VY + 1] * (t - F[ids, TLOC : TLOC + 1])
     hi = lo + F[ids, SW : SH + 1]
-    side = world[k]
-    tol = 1e-9 * max(world[0], world[1])
+    side = (world.width, world.height)[k]
+    tol = 1e-9 * max(world.width, world.height)
     fixed = N[ids, STATIC] != 0
     o = 1 - k
     beside = (lo[:, None, o] < hi[None, :, o]) & (lo[None, :, o] < hi[:, None, o])

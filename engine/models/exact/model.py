@@ -156,11 +156,15 @@ from collide2d.engine.models.exact.state import (
     TLOC,
     VX,
     VY,
+    Cores,
     State,
+    World,
     X,
     Y,
     hot,
     kernel,
+    named,
+    plain,
 )
 from collide2d.engine.noroom import no_room, no_room_message
 from collide2d.engine.response import exchange
@@ -200,7 +204,7 @@ def _move_to(i, t, F):
 @hot
 def _on_cross(i, d, N, cells, world, jobs):
     """i's centre enters the next cell: refile it. Returns the number of jobs (1)."""
-    gnx = world[4]
+    gnx = world.gnx
     gx = N[i, CELL] % gnx + (1 if d == DIR_RIGHT else -1 if d == DIR_LEFT else 0)
     gy = N[i, CELL] // gnx + (1 if d == DIR_DOWN else -1 if d == DIR_UP else 0)
     cell_remove(N, cells, i)
@@ -217,10 +221,10 @@ def _on_wall(i, side, t, F, N, world, jobs):
     _move_to(i, t, F)
     if side == SIDE_LEFT or side == SIDE_RIGHT:
         F[i, VX] = -F[i, VX]
-        F[i, X] = 0.0 if side == SIDE_LEFT else world[0] - F[i, SW]
+        F[i, X] = 0.0 if side == SIDE_LEFT else world.width - F[i, SW]
     else:
         F[i, VY] = -F[i, VY]
-        F[i, Y] = 0.0 if side == SIDE_TOP else world[1] - F[i, SH]
+        F[i, Y] = 0.0 if side == SIDE_TOP else world.height - F[i, SH]
     N[i, CNT] += 1
     N[i, PARTNER] = -1
     set_job(jobs, 0, i, -1, JOB_EVENT)
@@ -261,7 +265,7 @@ def _on_pair(a, b, code, nx, ny, t, F, N, jobs):
 
 
 @kernel
-def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
+def _run(state, jobs, stack, tick_to, log, cap, everyone, rows, times):
     """Run ticks until tick_to: first (once) predict every object's first events; then take due
     events in order, apply each, predict again for the objects it touched. (Objects not touched
     keep their clocks; positions() moves them to the tick's end.)
@@ -274,10 +278,13 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
     Returns a status: STATUS_DONE; STATUS_HEAP_FULL / STATUS_LOG_FULL (grow, call again: nothing
     was lost); STATUS_CAP (a runaway; stops mid-tick, before the event past the cap, so that a call
     with a higher cap would resume). st[S_LOGGED] counts the rows written, st[S_WALLS] and
-    st[S_PAIRS] every event, logged or not.
+    st[S_PAIRS] every event, logged or not. `state` is the State record as plain tuples
+    (state.plain).
     """
-    F, N, C, cells, s_start, s_items, HT, HI, HN, Q, st, stf, world = S
-    QT, _, _, _, QS, _ = Q
+    S = named(state)
+    F, N, cells, HT, HI, HN = S.F, S.N, S.cells, S.HT, S.HI, S.HN
+    st, stf, world, Q = S.st, S.stf, S.world, S.Q
+    QT, QS = Q.time, Q.state
     n = F.shape[0]
     extra_room = n * n if everyone else 0
     # (The loop's steps are written out here, not as inlined helpers: helpers cost ~15 % of the
@@ -291,7 +298,7 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
             i = st[S_FIRST]
             if N[i, STATIC] == 0:
                 room = room_around(
-                    N[i, CELL] % world[4], N[i, CELL] // world[4], N, cells, s_start, world
+                    N[i, CELL] % world.gnx, N[i, CELL] // world.gnx, N, cells, S.s_start, world
                 )
                 if not has_room(room, HT, HI, HN, st, N):
                     return STATUS_HEAP_FULL
@@ -302,7 +309,7 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
             if st[S_TICK] >= tick_to:
                 return STATUS_DONE
             tick = st[S_TICK] + 1
-            t_end = tick / world[2]
+            t_end = tick / world.fps
             top = QS[QS_TOP]
             if top < 0:
                 top = next_top(Q)
@@ -334,7 +341,7 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
                 k = first_of_instant(HT, HI, st, N, stack)
                 key = HI[k, HKEY]
             rank, a, b, code = split_key(key)
-            room = room_needed(rank, a, b, HT, st, N, cells, s_start, world) + extra_room
+            room = room_needed(rank, a, b, S) + extra_room
             if HT.shape[0] - st[S_HEAP_N] < room:
                 if compact(HT, HI, HN, st, N) < room:
                     return STATUS_HEAP_FULL
@@ -346,7 +353,8 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
             if horizon:
                 t = QT[k]
             else:
-                t, key, ca, cb, nx, ny = remove(HT, HI, HN, st, k)
+                e = remove(HT, HI, HN, st, k)
+                t = e.t
             stf[SF_T_NOW] = t
             if rank == RANK_CROSS:
                 n_jobs = _on_cross(a, b, N, cells, world, jobs)
@@ -355,13 +363,13 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
                 if st[S_TICK_EVENTS] > cap:  # put it back: a call with a higher cap resumes
                     st[S_TICK_EVENTS] -= 1
                     if not horizon:
-                        push(HT, HI, HN, st, t, key, ca, cb, nx, ny)
+                        push(HT, HI, HN, st, e)
                     return STATUS_CAP
                 if rank == RANK_WALL:
                     n_jobs = _on_wall(a, b, t, F, N, world, jobs)
                     kind, b = EV_WALL, -1
                 else:
-                    n_jobs = _on_pair(a, b, code, nx, ny, t, F, N, jobs)
+                    n_jobs = _on_pair(a, b, code, e.nx, e.ny, t, F, N, jobs)
                     kind = EV_PAIR
                 if n_jobs > 0:  # a pair that was not approaching is no event
                     st[S_WALLS if kind == EV_WALL else S_PAIRS] += 1
@@ -388,9 +396,7 @@ def _run(S, jobs, stack, tick_to, log, cap, everyone, rows, times):
                 set_job(jobs, J_EXTRA, extra, N[extra, PARTNER], JOB_CONTACTS)
                 job = J_EXTRA
                 extra += 1
-            predict(
-                jobs, job, t, F, N, C, cells, s_start, s_items, HT, HI, HN, Q, st, world
-            )
+            predict(jobs, job, t, S)
 
 
 class Model:
@@ -441,7 +447,7 @@ class Model:
         self._N[:, PARTNER] = -1
         self._N[:, STATIC] = static
         self._N[:, SHAPE] = cores.shape
-        self._C = (cores.radius, cores.start, cores.verts, cores.normals)
+        self._C = Cores(cores.radius, cores.start, cores.verts, cores.normals)
         if cell_size is None:
             cell_size = grid_cell(world.width, world.height, bodies.size, static)
             few = int((~static).sum()) <= ONE_CELL_MOVERS
@@ -452,17 +458,13 @@ class Model:
                 cell_size = float(max(world.width, world.height))
         self.cell_size = float(cell_size)
         gnx, gny = grid_dims(world.width, world.height, self.cell_size)
-        self._world = (
-            float(world.width),
-            float(world.height),
-            float(world.fps),
-            self.cell_size,
-            gnx,
-            gny,
+        self._world = World(
+            float(world.width), float(world.height), float(world.fps), self.cell_size, gnx, gny
         )
         self._G = build_grid(self._F, self._N, self.cell_size, gnx, gny)
         cap = max(64, HEAP_PER_OBJECT * n)
         self._heap = [np.empty(cap), np.empty((cap, 3), np.int64), np.empty((cap, 2))]
+        self._plain = None  # the state as the kernel takes it, made again when the heap grows
         self._horizons = new_horizons(
             static, bucket_width(self._F, static, self.cell_size, world.width, world.height)
         )
@@ -473,12 +475,18 @@ class Model:
 
     def _state(self) -> State:
         """The arrays the kernels share."""
+        cells, s_start, s_items = self._G
+        HT, HI, HN = self._heap
         return State(
             self._F,
             self._N,
             self._C,
-            *self._G,
-            *self._heap,
+            cells,
+            s_start,
+            s_items,
+            HT,
+            HI,
+            HN,
             self._horizons,
             self._st,
             self._stf,
@@ -495,7 +503,7 @@ class Model:
         while True:
             status = self._call(target, bool(log), self.max_events_per_tick, rows, times)
             if status == STATUS_HEAP_FULL:
-                self._heap = [events.grown(a) for a in self._heap]
+                self._grow_heap()
             elif status == STATUS_LOG_FULL:
                 rows, times = events.grown(rows), events.grown(times)
             elif status == STATUS_CAP:
@@ -512,9 +520,15 @@ class Model:
         as compiled: no numpy warning.)"""
         everyone = self.repredict == "all"
         with np.errstate(over="ignore", invalid="ignore"):
-            return _run(
-                self._state(), self._jobs, self._stack, target, log, cap, everyone, rows, times
-            )
+            if self._plain is None:
+                self._plain = plain(self._state())
+            state = self._plain
+            return _run(state, self._jobs, self._stack, target, log, cap, everyone, rows, times)
+
+    def _grow_heap(self) -> None:
+        """Twice the heap's room, its entries kept."""
+        self._heap = [events.grown(a) for a in self._heap]
+        self._plain = None
 
     def event_counts(self) -> tuple[int, int]:
         """(wall events, pair events) so far, logged or not."""
@@ -536,7 +550,7 @@ class Model:
         rows, times = events.new_log(True, RECENT)
         cap = int(st[S_TICK_EVENTS]) + RECENT
         while self._call(int(st[S_TICK]) + 1, True, cap, rows, times) == STATUS_HEAP_FULL:
-            self._heap = [events.grown(a) for a in self._heap]
+            self._grow_heap()
         st[S_WALLS : S_PAIRS + 1] = counts  # the counts stay those of the events before the stop
         t = float(self._stf[SF_T_NOW])
         n = int(st[S_LOGGED])
@@ -570,9 +584,9 @@ class Model:
         """(n, 2) float64 top-left corners at the last tick's end, px (each object carried from
         its own clock; kept inside the world against the last rounding)."""
         F = self._F
-        t = self.tick / self._world[2]
+        t = self.tick / self._world.fps
         pos = F[:, X : Y + 1] + F[:, VX : VY + 1] * (t - F[:, TLOC : TLOC + 1])
-        limit = np.array(self._world[:2]) - F[:, SW : SH + 1]
+        limit = np.array([self._world.width, self._world.height]) - F[:, SW : SH + 1]
         return np.minimum(np.maximum(pos, 0.0), limit)
 
     def velocities(self) -> np.ndarray:

@@ -39,6 +39,7 @@ from collide2d.engine.models.exact.state import (
     TLOC,
     VX,
     VY,
+    Entry,
     X,
     Y,
     hot,
@@ -52,11 +53,11 @@ def _wall_time(i, F, world):
     t_best = INF
     side = -1
     if F[i, VX] > 0.0:
-        t_best, side = F[i, TLOC] + (world[0] - F[i, SW] - F[i, X]) / F[i, VX], SIDE_RIGHT
+        t_best, side = F[i, TLOC] + (world.width - F[i, SW] - F[i, X]) / F[i, VX], SIDE_RIGHT
     elif F[i, VX] < 0.0:
         t_best, side = F[i, TLOC] + F[i, X] / -F[i, VX], SIDE_LEFT
     if F[i, VY] > 0.0:
-        t = F[i, TLOC] + (world[1] - F[i, SH] - F[i, Y]) / F[i, VY]
+        t = F[i, TLOC] + (world.height - F[i, SH] - F[i, Y]) / F[i, VY]
         if t < t_best:
             t_best, side = t, SIDE_BOTTOM
     elif F[i, VY] < 0.0:
@@ -69,7 +70,7 @@ def _wall_time(i, F, world):
 @hot
 def _cross_time(i, F, N, world):
     """(t, direction) when i's box centre next leaves its grid cell, (inf, -1) if never."""
-    cell, gnx, gny = world[3], world[4], world[5]
+    cell, gnx, gny = world.cell, world.gnx, world.gny
     gx = N[i, CELL] % gnx
     gy = N[i, CELL] // gnx
     cx = F[i, X] + 0.5 * F[i, SW]
@@ -93,9 +94,8 @@ def _cross_time(i, F, N, world):
 
 @njit(cache=True)
 def _shape_contact(a, b, qx, qy, ux, uy, now, F, N, C):
-    """next_contact for a pair with a circle or polygon; cores C = (radius, start, verts,
-    normals)."""
-    radius, start, verts, normals = C
+    """next_contact for a pair with a circle or polygon, of cores C (state.Cores)."""
+    radius, start, verts, normals = C.radius, C.start, C.verts, C.normals
     return next_contact(
         qx,
         qy,
@@ -118,12 +118,13 @@ def _shape_contact(a, b, qx, qy, ux, uy, now, F, N, C):
 
 
 @hot
-def _predict_pair(i, j, t_now, limit, F, N, C, HT, HI, HN, st):
+def _predict_pair(i, j, t_now, limit, S):
     """Push the next contact of i and j if it comes no later than `limit` (s).
 
     The pair is swept from the later of the two objects' clocks, so that only one position is
     carried forward and the predicted time does not depend on when the question is asked.
     """
+    F, N = S.F, S.N
     a = min(i, j)
     b = max(i, j)
     t0 = max(F[a, TLOC], F[b, TLOC])
@@ -139,18 +140,21 @@ def _predict_pair(i, j, t_now, limit, F, N, C, HT, HI, HN, st):
             qx, qy, ux, uy, F[a, SW], F[a, SH], F[b, SW], F[b, SH], now
         )
     else:
-        t, code, nx, ny = _shape_contact(a, b, qx, qy, ux, uy, now, F, N, C)
+        t, code, nx, ny = _shape_contact(a, b, qx, qy, ux, uy, now, F, N, S.C)
     t = max(t0 + t, t_now)
     if t <= limit:
-        push(HT, HI, HN, st, t, make_key(RANK_PAIR, a, b, code), N[a, CNT], N[b, CNT], nx, ny)
+        e = Entry(t, make_key(RANK_PAIR, a, b, code), N[a, CNT], N[b, CNT], nx, ny)
+        push(S.HT, S.HI, S.HN, S.st, e)
 
 
 @hot
-def predict(jobs, k, t_now, F, N, C, cells, s_start, s_items, HT, HI, HN, Q, st, world):
+def predict(jobs, k, t_now, S):
     """Run prediction job k for object i: set its horizon (the first of its next wall contact
     and its next cell crossing; horizonqueue.py) and push its contacts with the objects in the
     3×3 cells around it that come no later than that. Inlined into the event loop's one call
     site: a call would cost more than the prediction of a small scene."""
+    F, N, cells, st, world = S.F, S.N, S.cells, S.st, S.world
+    s_start, s_items = S.s_start, S.s_items
     i, skip, mode = jobs[k, J_OBJ], jobs[k, J_SKIP], jobs[k, J_HIGHER]
     higher = mode == JOB_FIRST
     t_wall, side = _wall_time(i, F, world)
@@ -162,9 +166,9 @@ def predict(jobs, k, t_now, F, N, C, cells, s_start, s_items, HT, HI, HN, Q, st,
             t_h, rank, what = max(t_wall, t_now), RANK_WALL, side
         else:
             t_h, rank, what = INF, RANK_WALL, 0
-        set_horizon(Q, i, t_h, rank, what)  # (one call site: one compiled specialisation)
+        set_horizon(S.Q, i, t_h, rank, what)  # (one call site: one compiled specialisation)
     limit = max(t_wall, t_now)
-    gnx, gny = world[4], world[5]
+    gnx, gny = world.gnx, world.gny
     gx = N[i, CELL] % gnx
     gy = N[i, CELL] // gnx
     x0, x1 = max(gx - 1, 0), min(gx + 1, gnx - 1)
@@ -187,7 +191,7 @@ def predict(jobs, k, t_now, F, N, C, cells, s_start, s_items, HT, HI, HN, Q, st,
             j = cells[c, C_HEAD]
             while j >= 0:
                 if j != i and j != skip and not (higher and j < i):
-                    _predict_pair(i, j, t_now, limit, F, N, C, HT, HI, HN, st)
+                    _predict_pair(i, j, t_now, limit, S)
                 j = N[j, NEXT]
             if not statics:  # (spares reading the static objects' lists of a scene without any)
                 continue
@@ -195,7 +199,7 @@ def predict(jobs, k, t_now, F, N, C, cells, s_start, s_items, HT, HI, HN, Q, st,
                 j = s_items[m]
                 if N[j, STAMP] != st[S_STAMP] and j != skip:
                     N[j, STAMP] = st[S_STAMP]
-                    _predict_pair(i, j, t_now, limit, F, N, C, HT, HI, HN, st)
+                    _predict_pair(i, j, t_now, limit, S)
 
 
 @hot

@@ -1,9 +1,18 @@
-"""The exact model's state layout: the columns of its arrays, its scalar state, its statuses.
+"""The exact model's state layout: its records, the columns of its arrays, its scalar state, its
+statuses.
 
 The exact model (model.py) keeps its objects in two arrays, floats F (n, 8) and ints
 N (n, 8), and its counters in `st` (int64) and `stf` (float64); the event queue (heap.py),
 the grid lists (cells.py) and the predictions (prediction.py) all read them by the names below.
-The `hot` and `kernel` decorators the exact model's kernels are compiled with live here too.
+Its kernels share one record, `State`, read by field, which holds the others: `World` (the
+world's sides, fps and grid), `Cores` (the exact shapes) and `Horizons` (the horizon queue,
+horizonqueue.py); a heap entry travels as an `Entry`.
+
+numba takes a named tuple as it takes a tuple, but reads the type of one handed to it from Python
+field by field (microseconds a call, against a fraction of one for a plain tuple): Python hands
+the kernel `model._run` the state as plain tuples (`plain`), and the kernel names them again
+(`named`). The `hot` and `kernel` decorators the exact model's kernels are compiled with live
+here too.
 """
 
 from __future__ import annotations
@@ -15,23 +24,71 @@ import numpy as np
 from collide2d.engine.jit import njit
 
 
+class World(NamedTuple):
+    """The world the kernels see: its sides, its frame rate and its grid (cells.py)."""
+
+    width: float  # px
+    height: float  # px
+    fps: float  # ticks per second
+    cell: float  # the grid's cell side, px
+    gnx: int  # the grid's columns
+    gny: int  # the grid's rows
+
+
+class Cores(NamedTuple):
+    """The objects' exact shapes (shapes.build_cores): the circles' radii, and each polygon's
+    vertices and edge normals, object i's rows start[i]:start[i + 1]."""
+
+    radius: np.ndarray  # (n,) float64, px
+    start: np.ndarray  # (n + 1,) int64
+    verts: np.ndarray  # (m, 2) float64, px
+    normals: np.ndarray  # (m, 2) float64
+
+
+class Horizons(NamedTuple):
+    """The horizon queue (horizonqueue.py): each moving object's horizon, filed by its time in the
+    buckets of a calendar queue."""
+
+    time: np.ndarray  # (n,) float64 each object's horizon time, s (inf: none)
+    code: np.ndarray  # (n,) int8 what it is: rank × 4 + side or direction
+    links: np.ndarray  # (n, 2) int32 next and previous object in its bucket's list, Q_NEXT/Q_PREV
+    heads: np.ndarray  # (slots,) int32 the first object of each ring slot (-1: empty)
+    state: np.ndarray  # (3,) int64 scalar state, slots QS_* (horizonqueue.py)
+    rate: float  # one over the bucket width, 1/s
+
+
+class Entry(NamedTuple):
+    """A heap entry (heap.py): a predicted event."""
+
+    t: float  # its time, s
+    key: int  # rank, a, b, code (heap.make_key)
+    ca: int  # a's invalidation counter when it was predicted
+    cb: int  # b's
+    nx: float  # the contact normal (contact.py)
+    ny: float
+
+
 class State(NamedTuple):
-    """The arrays the exact model's kernels share, handed to them as one argument (numba takes a
-    named tuple as it takes a tuple; the kernels unpack it by position)."""
+    """The arrays the exact model's kernels share, handed to them as one argument."""
 
     F: np.ndarray  # (n, 8) float64, columns below
     N: np.ndarray  # (n, 8) int64, columns below
-    C: tuple  # exact shapes: radius, vertex start, vertices, edge normals
+    C: Cores  # exact shapes
     cells: np.ndarray  # the grid's per-cell lists of movers (cells.py)
     s_start: np.ndarray  # each cell's first entry in s_items (static objects)
     s_items: np.ndarray  # the static objects filed in each cell
     HT: np.ndarray  # heap: event times
     HI: np.ndarray  # heap: event ids and counters
     HN: np.ndarray  # heap: contact normals
-    Q: tuple  # horizon queue: each object's horizon, filed in buckets (horizonqueue.py)
+    Q: Horizons  # horizon queue: each object's horizon, filed in buckets (horizonqueue.py)
     st: np.ndarray  # int64 scalar state, indices S_* below
     stf: np.ndarray  # float64 scalar state, indices SF_* below
-    world: tuple  # the world's sides and grid, floats
+    world: World
+
+
+def plain(S: State) -> tuple:
+    """S as plain tuples, as the kernel `model._run` takes it (see the module docstring)."""
+    return tuple(S._replace(C=tuple(S.C), Q=tuple(S.Q), world=tuple(S.world)))
 
 
 # Columns of F (n, 8) float64: position (top-left, px) valid at the object's own clock TLOC (s),
@@ -77,3 +134,24 @@ INF = np.inf
 # inlined helper took ~85 % of the run time on event-heavy scenes.
 hot = njit(cache=True, inline="always")
 kernel = njit(cache=True, _nrt=False)
+
+
+@hot
+def named(state):
+    """The State record of `state`, the plain tuples `plain` makes."""
+    S = State(*state)
+    return State(
+        S.F,
+        S.N,
+        Cores(*S.C),
+        S.cells,
+        S.s_start,
+        S.s_items,
+        S.HT,
+        S.HI,
+        S.HN,
+        Horizons(*S.Q),
+        S.st,
+        S.stf,
+        World(*S.world),
+    )

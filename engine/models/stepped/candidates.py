@@ -41,6 +41,7 @@ from collide2d.engine.broadphase import (
 )
 from collide2d.engine.jit import njit, prange
 from collide2d.engine.models.stepped.move import B_H, B_VX, B_VY, B_W, B_X, B_Y
+from collide2d.engine.models.stepped.records import Scratch
 from collide2d.engine.threads import PARALLEL_MIN_OBJECTS
 
 # Where the model's `state` array keeps the keys listed (-1: no list yet), the method, whether
@@ -132,30 +133,36 @@ def _grow_range(body, lo, hi, margin, dt, first, last):
 
 @njit(cache=True)
 def _gather_range(body, inv_mass, static, movable, ext, order, scratch, first, last):
-    """Slots first ... last-1 of the state put in `order`, into the scratch (rows, ids, flags,
-    masses: the body rows, the ids, static | movable << 1, the inverse masses)."""
-    rows, inv, flags, masses = scratch
+    """Slots first ... last-1 of the state put in `order`, into the scratch (a Scratch as a plain
+    tuple: the body rows, the ids, static | movable << 1, the inverse masses)."""
+    R = Scratch(*scratch)
+    rows, flags = R.rows, R.flags
     for s in range(first, last):
         o = order[s]
         for c in range(body.shape[1]):
             rows[s, c] = body[o, c]
-        masses[s] = inv_mass[o]
-        inv[s] = ext[o]
+        R.masses[s] = inv_mass[o]
+        R.ids[s] = ext[o]
         flags[s] = static[o] | (movable[o] << 1)
 
 
 @njit(cache=True)
-def _place_range(body, inv_mass, static, movable, ext, rank, anchor, order, scratch, first, last):
-    """Slots first ... last-1 copied back from the scratch; each anchored where it is."""
-    rows, inv, flags, masses = scratch
+def _place_range(body, inv_mass, static, movable, ext, rank, anchor, scratch, first, last):
+    """Slots first ... last-1 copied back from the scratch; each anchored where it is.
+
+    (The reorder's threads call the range kernels with the state's arrays themselves, not a
+    State: numba fuses two parallel loops whose calls take no array argument, not seeing those
+    a record holds, and the loops of `_reorder_split` must each end before the next begins.)"""
+    R = Scratch(*scratch)
+    rows, ids, flags = R.rows, R.ids, R.flags
     for s in range(first, last):
         for c in range(body.shape[1]):
             body[s, c] = rows[s, c]
-        inv_mass[s] = masses[s]
-        ext[s] = inv[s]
+        inv_mass[s] = R.masses[s]
+        ext[s] = ids[s]
         static[s] = flags[s] & 1
         movable[s] = flags[s] >> 1
-        rank[inv[s]] = s
+        rank[ids[s]] = s
         anchor[s, 0] = rows[s, B_X]
         anchor[s, 1] = rows[s, B_Y]
 
@@ -183,8 +190,8 @@ def _reorder(S, order, scratch, keys, n_keys, chunks):
     ext, rank, anchor = S.ext, S.rank, S.anchor
     n = order.shape[0]
     _gather_range(body, inv_mass, static, movable, ext, order, scratch, 0, n)
-    _place_range(body, inv_mass, static, movable, ext, rank, anchor, order, scratch, 0, n)
-    inv = scratch[1]
+    _place_range(body, inv_mass, static, movable, ext, rank, anchor, scratch, 0, n)
+    inv = Scratch(*scratch).ids
     for s in range(n):
         inv[order[s]] = s
         order[s] = s
@@ -204,10 +211,10 @@ def _reorder_split(S, order, scratch, keys, n_keys, chunks):
         )
     for c in prange(chunks):
         _place_range(
-            body, inv_mass, static, movable, ext, rank, anchor, order, scratch, c * n // chunks,
+            body, inv_mass, static, movable, ext, rank, anchor, scratch, c * n // chunks,
             (c + 1) * n // chunks,
         )
-    inv = scratch[1]
+    inv = Scratch(*scratch).ids
     for c in prange(chunks):
         for s in range(c * n // chunks, (c + 1) * n // chunks):
             inv[order[s]] = s

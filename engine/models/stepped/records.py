@@ -1,6 +1,8 @@
 """The stepped model's state records, read by field in every kernel: `State` (the objects),
 `Lists` (the candidate list kept between steps, the broad phase's state and the stages'
-scratch) and `Step` (what one step is run with).
+scratch), `Step` (what one step is run with), and the groups the candidate list and the narrow
+phase hand their kernels: `Sweep` (what the narrow phase tests and writes), `Move` (what the move
+run with it needs besides) and `Scratch` (the reorder's scratch).
 
 numba takes a named tuple as it takes a tuple, but reads the type of one handed to it from Python
 field by field (microseconds a call, against a fraction of one for a plain tuple): the kernels
@@ -60,6 +62,42 @@ class Step(NamedTuple):
     log: bool  # whether events are logged
 
 
+class Sweep(NamedTuple):
+    """What the narrow phase (narrow.py) tests the candidate list with, and writes its pairs in
+    contact to. (No tuple among its fields: numba hands a record to the threads of a parallel
+    loop only when it holds none.)"""
+
+    body: np.ndarray  # State.body
+    ext: np.ndarray  # State.ext
+    keys: np.ndarray  # the candidate list (Lists.keys)
+    state: np.ndarray  # Lists.state: where each bucket of the list begins (candidates.ST_BANDS)
+    near: np.ndarray  # out: the pairs in contact (Lists.near)
+    when: np.ndarray  # out: the times their contacts began (Lists.when)
+    dt: float  # the step, s
+    width: float  # the world's sides, px
+    height: float
+
+
+class Move(NamedTuple):
+    """What the move run together with the narrow phase (narrow.move_narrow) needs besides a
+    `Sweep`."""
+
+    static: np.ndarray  # State.static
+    anchor: np.ndarray  # State.anchor
+    folds: np.ndarray  # Lists.folds
+    params: np.ndarray  # Lists.params (candidates.P_*), as the last step left them
+
+
+class Scratch(NamedTuple):
+    """The reorder's scratch (candidates._reorder), one row per slot: the state's rows gathered
+    in the new order."""
+
+    rows: np.ndarray  # (n, 6) float64 the body rows
+    ids: np.ndarray  # (n,) int64 the ids (then, old index to new)
+    flags: np.ndarray  # (n,) uint8 static | movable << 1
+    masses: np.ndarray  # (n,) float64 the inverse masses
+
+
 # --- the settling path: gravity, restitution, friction and sleep (settle.py) -------------------
 
 
@@ -111,9 +149,6 @@ class Touch(NamedTuple):
     cell: float  # the grid's cell, px
     cores: tuple  # the exact shapes (shapes.build_cores) when colliding by them
     exact: bool  # whether objects collide by their real shapes
-    hits: np.ndarray  # int64 scratch: one object's bounces in a step (fall.fall_one)
-    capped: np.ndarray  # (n,) bool scratch (touch.cap_goals)
-    bank: np.ndarray  # (1,) float64 energy given up so far and not yet spent on pushes (solver)
     hits: np.ndarray  # int64 scratch: one object's bounces in a step (fall.fall_one)
     capped: np.ndarray  # (n,) bool scratch (touch.cap_goals)
     bank: np.ndarray  # (1,) float64 energy given up so far and not yet spent on pushes (solver)

@@ -40,7 +40,7 @@ from collide2d.engine.models.stepped.candidates import (
 from collide2d.engine.models.stepped.move import log_walls, move_walls
 from collide2d.engine.models.stepped.narrow import move_narrow, narrow
 from collide2d.engine.models.stepped.pairs import respond
-from collide2d.engine.models.stepped.records import Lists, State, Step
+from collide2d.engine.models.stepped.records import Lists, Move, State, Step, Sweep
 
 # The stages of one step, in the order `step` runs them; `Model.profile` times each by name
 # through the same kernel.
@@ -104,10 +104,9 @@ def _stages(first, last, S, at, cores, rows, times, n_ev, L, lists):
         # move, walls: every object; the walls' events in id order; how far anything drifted
         # from where the candidate list was made, and how far its path reached
         if fused:
-            n_folds, drift, state[ST_NEAR] = move_narrow(
-                body, S.static, S.ext, anchor, dt, sides, folds, keys, state, params, near, when,
-                chunks,
-            )
+            swept = Sweep(body, S.ext, keys, state, near, when, dt, at.width, at.height)
+            moved = Move(S.static, anchor, folds, params)
+            n_folds, drift, state[ST_NEAR] = move_narrow(swept, moved, chunks)
             state[ST_FUSED] += 1
         else:
             n_folds, drift = move_walls(body, S.static, S.ext, anchor, dt, sides, folds, chunks)
