@@ -163,8 +163,11 @@ def run(
             `OUT/NAME/` as `collide2d run --out OUT` does, replacing a previous run whole; the
             result then holds the final state and the summary, and its events and frames are
             in the folder.
-        png, gif, viewer, overlay, scale: with `out`, what is written (default: as the
-            scenario's `output` says; `scale` enlarges PNG and GIF frames).
+        png: with `out`, write PNG frames (default: as the scenario's `output` says).
+        gif: with `out`, write `animation.gif` (default: as the scenario's `output` says).
+        viewer: with `out`, write `viewer.html` (default: as the scenario's `output` says).
+        overlay: with `out`, the debug overlays drawn into the frames (default: the scenario's).
+        scale: with `out`, enlarge PNG and GIF frames this many times.
         quiet: with `out`, no progress bar or notes on the terminal.
         limits: with `out`, the guards on what may be written (`--max-output-bytes` ...).
 
