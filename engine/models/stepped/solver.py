@@ -259,7 +259,7 @@ def correct(F, P, pairs, floats, m, budget, sides):
             c = m - 1 - (k - first) if it % 2 else k
             a, b = _sides(pairs[c])
             raised += _push(body, mass, gx, gy, slop, a, b, floats, c, sides)
-    if raised > budget:
+    if raised > max(budget, 0.0):  # (so raised > 0: a budget below 0 with nothing raised is no 0/0)
         s = max(budget, 0.0) / raised
         for i in range(body.shape[0]):
             if F.awake[i]:
