@@ -113,13 +113,26 @@ def compiled_for_run(scenario, frames: int) -> bool:
 
 
 def bursts_past_compiling(scenario) -> bool:
-    """Whether the bounces of the exact model's largest mass ratio (a light object between a wall
-    and a heavy one bounces about pi * sqrt(ratio) times, most of them within one tick) would take
-    longer interpreted than compiling the exact model's kernels from an empty cache."""
+    """Whether the bounces the exact model makes within its first tick would take longer
+    interpreted than compiling the exact model's kernels from an empty cache: those of the
+    largest mass ratio (a light object between a wall and a heavy one bounces about
+    pi * sqrt(ratio) times, most of them within one tick), or the wall bounces of objects so fast
+    that they cross their room many times a tick (`_wall_bounces`)."""
     if scenario.model != "exact" or not scenario.bodies.n:
         return False
     bounces = math.pi * math.sqrt(_mass_ratio(scenario.bodies))
+    bounces = max(bounces, _wall_bounces(scenario))
     return bounces * EVENT_INTERPRETED_S > compilecost.model_seconds("exact")
+
+
+def _wall_bounces(scenario) -> float:
+    """About how many wall bounces the objects make in one tick: each axis's distance travelled
+    over the room the object has on it (at least a pixel), summed over the moving objects."""
+    bodies, world = scenario.bodies, scenario.world
+    moving = ~bodies.static
+    room = np.array([world.width, world.height], dtype=np.float64) - bodies.size[moving]
+    travel = np.abs(bodies.vel[moving]) / world.fps
+    return float(np.sum(travel / np.maximum(room, 1.0)))
 
 
 def _mass_ratio(bodies) -> float:
