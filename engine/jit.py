@@ -68,8 +68,22 @@ def _default_compiled() -> bool:
 
 _DEFAULT = _default_compiled()
 _compiled: ContextVar[bool] = ContextVar("collide2d_compiled", default=_DEFAULT)
+
+
+class Called(set):
+    """The kernels called interpreted in a `recording()` block; `entries` maps each of them
+    called from Python, rather than from another kernel, to the kernels called under it (itself
+    included): run compiled, an entry has those compiled into its own code."""
+
+    def __init__(self):
+        super().__init__()
+        self.entries: dict = {}
+
+
 # While a `recording()` block is open in this thread: the kernels called interpreted in it.
-_called: ContextVar[set | None] = ContextVar("collide2d_called", default=None)
+_called: ContextVar[Called | None] = ContextVar("collide2d_called", default=None)
+# While recording: the kernels called under the entry this thread runs in (None: in none).
+_under: ContextVar[set | None] = ContextVar("collide2d_under", default=None)
 
 
 def compiled() -> bool:
@@ -79,9 +93,9 @@ def compiled() -> bool:
 
 @contextlib.contextmanager
 def recording():
-    """A `with` block that yields the set of kernels called interpreted inside it (the set grows
-    as they are called; a kernel called only from compiled code is not seen)."""
-    called: set = set()
+    """A `with` block that yields the set of kernels called interpreted inside it, a `Called`
+    (it grows as they are called; a kernel called only from compiled code is not seen)."""
+    called = Called()
     token = _called.set(called)
     try:
         yield called
@@ -210,9 +224,19 @@ class Kernel:
         if _compiled.get():
             return (self._dispatcher or self.dispatcher)(*args, **kwargs)
         called = _called.get()
-        if called is not None:
-            called.add(self)
-        return self.py_func(*args, **kwargs)
+        if called is None:
+            return self.py_func(*args, **kwargs)
+        called.add(self)
+        under = _under.get()
+        if under is not None:
+            under.add(self)
+            return self.py_func(*args, **kwargs)
+        under = called.entries.setdefault(self, {self})
+        token = _under.set(under)
+        try:
+            return self.py_func(*args, **kwargs)
+        finally:
+            _under.reset(token)
 
     def __getattr__(self, name: str):
         # numba's dispatcher answers the rest (signatures, overloads, inspect_types, ...)

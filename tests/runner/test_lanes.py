@@ -19,7 +19,7 @@ from collide2d.engine.models.exact import model as exact_model
 from collide2d.engine.models.paper import model as paper_model
 from collide2d.runner import compilecost, lanes
 from collide2d.runner.command.main import main
-from collide2d.runner.run import simulate
+from collide2d.runner.run import make_model, simulate
 from collide2d.runner.scenario.load import loads
 
 SMALL = """version: 1
@@ -75,6 +75,26 @@ def test_a_run_goes_on_compiled_once_the_ticks_left_would_take_longer_than_compi
     assert simulate(gas).summary["kernels"] == "interpreted"
     lanes.set_mode("on")
     assert simulate(gas).summary["kernels"] == "compiled"
+
+
+def test_a_run_whose_entry_kernels_this_process_has_needs_nothing_compiled(monkeypatch):
+    # the kernels a run calls from Python have the ones they call compiled into them: once this
+    # process has them (a sweep's worker after its first run), another run of the scene costs
+    # nothing to go on compiled, though the kernels called under them never compiled on their own
+    gas = loads(GAS)
+    lanes.set_mode("on")
+    simulate(gas)  # compiles (or loads) the paper model's kernels and the energy's
+    lanes.set_mode(None)
+    lane = lanes.RunLane(gas, 0)
+    with lane.opened():
+        make_model(gas).advance(1, False)
+    entries = lane.called.entries
+    assert paper_model._run in entries and paper_model._move in entries[paper_model._run]
+    assert paper_model._move not in entries  # called by _run only
+    assert jit.readiness(paper_model._run) == "compiled"
+    assert lane.ready_seconds() == 0.0
+    monkeypatch.setattr(lanes, "PROBE_S", 1e9)  # only a switch that costs nothing is taken early
+    assert simulate(gas).summary["kernels"] == "interpreted, then compiled"
 
 
 def _looked_at(monkeypatch, spent: float, cost: float, loaded: bool = True) -> bool:
