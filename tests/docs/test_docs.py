@@ -72,6 +72,32 @@ def test_the_readmes_demo_gif_is_what_the_demo_draws(tmp_path):
     assert len(a) == len(b) > 1 and a == b, "remake docs/demo.gif: collide2d run, then copy it"
 
 
+def gif_frames(path):
+    """Each frame of a GIF as (RGB bytes, duration)."""
+    with Image.open(path) as image:
+        return [
+            (f.convert("RGB").tobytes(), f.info.get("duration"))
+            for f in ImageSequence.Iterator(image)
+        ]
+
+
+@pytest.mark.parametrize(
+    "name", ["bouncing_ball", "stack", "sliding_block", "projectile", "pile", "cradle"]
+)
+def test_the_readmes_gravity_gifs_are_what_their_scenarios_draw(tmp_path, name):
+    from collide2d.runner.command.main import main
+
+    scenario = ROOT / "scenarios" / f"gravity_{name}.yaml"
+    assert main(["run", str(scenario), "--out", str(tmp_path), "--quiet"]) == 0
+    shown = gif_frames(ROOT / "docs" / "gravity" / f"{name}.gif")
+    drawn = gif_frames(tmp_path / f"gravity_{name}" / "animation.gif")
+    assert len(shown) == len(drawn) > 1 and shown == drawn, (
+        f"remake docs/gravity/{name}.gif: collide2d run {scenario.relative_to(ROOT)}, then copy "
+        "its animation.gif"
+    )
+    assert f"](docs/gravity/{name}.gif)" in (ROOT / "README.md").read_text()
+
+
 def _parse(line: str) -> str | None:
     """None when the parser takes the command line, else its complaint."""
     from collide2d.runner.command.main import build_parser
