@@ -178,9 +178,10 @@ def register(subparsers) -> None:
         "and substeps against the exact model (run time against error, Pareto plot), what each "
         "skip saves, and the section IV targets; with --peers, pymunk on the same scene; with "
         "--part, also the paper model three ways, the exact model's events/s, the drawing and "
-        "writing of frames, and (jit) each --jit mode's wall time from an empty kernel cache. "
+        "writing of frames, (jit) each --jit mode's wall time from an empty kernel cache, and "
+        "(gravity) a settling pile against pymunk and both against the closed forms. "
         "Writes OUT/bench/bench.csv, bench.md and, with matplotlib, "
-        "scaling.png and runtime_vs_error.png.",
+        "scaling.png, runtime_vs_error.png and gravity_runtime_vs_error.png.",
     )
     p.add_argument("--out", default="out", metavar="DIR", help="output folder (default: out)")
     p.add_argument("--quick", action="store_true", help="small and short everything (seconds)")

@@ -27,7 +27,9 @@ Closed forms: a box dropped 100 px with e 0.5, its first three bounce instants
 against `t_n = t1·(1 + 2e(1 - e^(n-1)) / (1 - e))` (each found from the state after the step that
 held it: exact between contacts, the bounce lies `τ = 2h / (v + √(v² + 2g·h))` before it, h the
 height above the floor and v the speed up); a box sliding at 200 px/s with mu 0.5 against
-`v0² / (2·mu·g)`. Rows are one figure each (`value`, described by `note`).
+`v0² / (2·mu·g)`; each at CHART_FPS steps a second (one step a frame) by both, with the run time
+of its CLOSED_S simulated seconds, for gravity_runtime_vs_error.png (runner/bench/plots.py). Rows
+are one figure each (`value`, described by `note`).
 """
 
 from __future__ import annotations
@@ -289,54 +291,114 @@ def _bounce_times(states, floor, dt) -> list[float]:
     return out
 
 
-def closed_forms(echo) -> list[dict]:
-    """Errors against the closed forms: bounce instants and a slide (module docstring)."""
-    e, drop, box = 0.5, 100.0, 10.0
-    world = WorldSpec(100, 200, FPS, gravity=(0.0, G))
-    dt = 1.0 / FPS
-    floor = 200.0 - box
-    t1 = math.sqrt(2 * drop / G)
-    expected = [t1 * (1 + 2 * e * (1 - e ** (k - 1)) / (1 - e)) for k in (1, 2, 3)]
-    bodies = Bodies.boxes([[45, floor - drop]], box, [[0, 0]])
-    bodies = Bodies(**{**bodies.__dict__, "restitution": np.array([e])})
+# The closed forms' scenes (module docstring), and the rates (fps, one step a frame) each model
+# runs them at for the run-time-against-error chart (gravity_runtime_vs_error.png).
+DROP_E, DROP_PX, BOX_PX, FLOOR_PX = 0.5, 100.0, 10.0, 190.0
+SLIDE_V0, SLIDE_MU = 200.0, 0.5
+CHART_FPS = (30, 60, 120, 240)
+CLOSED_S = 2.0  # simulated seconds of each closed-form run
+
+
+def _bounce_expected() -> list[float]:
+    """The first three bounce instants of the drop (module docstring), s."""
+    e, t1 = DROP_E, math.sqrt(2 * DROP_PX / G)
+    return [t1 * (1 + 2 * e * (1 - e ** (k - 1)) / (1 - e)) for k in (1, 2, 3)]
+
+
+def _drop():
+    world = WorldSpec(100, int(FLOOR_PX + BOX_PX), FPS, gravity=(0.0, G))
+    bodies = Bodies.boxes([[45, FLOOR_PX - DROP_PX]], BOX_PX, [[0, 0]])
+    return world, Bodies(**{**bodies.__dict__, "restitution": np.array([DROP_E])})
+
+
+def _block():
+    world = WorldSpec(400, int(FLOOR_PX + BOX_PX), FPS, gravity=(0.0, G))
+    bodies = Bodies.boxes([[10, FLOOR_PX]], BOX_PX, [[SLIDE_V0, 0]])
+    return world, Bodies(**{**bodies.__dict__, "friction": np.array([SLIDE_MU])})
+
+
+def _bounce_error(states, dt) -> float:
+    """The largest error of the first three bounce instants found in states (t, y, vy), s; inf
+    when fewer than three are found (a bounce lost in a coarse step)."""
+    found = _bounce_times(states, FLOOR_PX, dt)[:3]
+    if len(found) < 3:
+        return math.inf
+    return max(abs(a - b) for a, b in zip(found, _bounce_expected(), strict=True))
+
+
+def _stepped_closed(fps: int) -> tuple[float, float, float, float]:
+    """(bounce error s, its run time s, slide relative error, its run time s) of the stepped
+    model stepping at `fps`."""
+    world, bodies = _drop()
+    world = WorldSpec(world.width, world.height, fps, gravity=world.gravity)
     model = make("stepped", world, bodies, sleep=False)
-    states = [(0.0, floor - drop, 0.0)]
-    for k in range(1, 2 * FPS):
+    states = [(0.0, FLOOR_PX - DROP_PX, 0.0)]
+    began = time.perf_counter()
+    for k in range(1, int(CLOSED_S * fps)):
         model.advance(1, log=False)
-        states.append((k * dt, model.positions()[0, 1], model.velocities()[0, 1]))
-    ours = _bounce_times(states, floor, dt)[:3]
-    worst = max(abs(a - b) for a, b in zip(ours, expected, strict=False))
-    rows = [_row("bounce", "stepped", 1, worst, "largest error of the first 3 bounce instants, s")]
-    v0, mu = 200.0, 0.5
-    slide = v0 * v0 / (2 * mu * G)
-    block = Bodies.boxes([[10, floor]], box, [[v0, 0]])
-    block = Bodies(**{**block.__dict__, "friction": np.array([mu])})
-    model = make("stepped", WorldSpec(400, 200, FPS, gravity=(0.0, G)), block)
-    model.advance(2 * FPS, log=False)
+        states.append((k / fps, model.positions()[0, 1], model.velocities()[0, 1]))
+    bounce_s = time.perf_counter() - began
+    world, block = _block()
+    model = make("stepped", WorldSpec(world.width, world.height, fps, gravity=world.gravity), block)
+    began = time.perf_counter()
+    model.advance(int(CLOSED_S * fps), log=False)
+    slide_s = time.perf_counter() - began
+    slide = SLIDE_V0 * SLIDE_V0 / (2 * SLIDE_MU * G)
     err = abs(model.positions()[0, 0] - 10 - slide) / slide
-    rows.append(_row("slide", "stepped", 1, err, "relative error of the slide distance"))
-    echo(f"gravity  stepped  bounce {rows[0]['value']:.2e} s, slide {err:.2e}")
+    return _bounce_error(states, 1.0 / fps), bounce_s, err, slide_s
+
+
+def _pymunk_closed(fps: int) -> tuple[float, float, float, float]:
+    """As `_stepped_closed`, pymunk stepping at 1/fps s."""
+    dt = 1.0 / fps
+    world, bodies = _drop()
+    space = _space(world, bodies, DROP_E, 0.0)
+    (ball,) = space.bodies
+    states = [(0.0, FLOOR_PX - DROP_PX, 0.0)]
+    began = time.perf_counter()
+    for k in range(1, int(CLOSED_S * fps)):
+        space.step(dt)
+        states.append((k * dt, ball.position.y - BOX_PX / 2, ball.velocity.y))
+    bounce_s = time.perf_counter() - began
+    world, block = _block()
+    space = _space(world, block, 1.0, SLIDE_MU)
+    (sled,) = space.bodies
+    x0 = sled.position.x
+    began = time.perf_counter()
+    for _ in range(int(CLOSED_S * fps)):
+        space.step(dt)
+    slide_s = time.perf_counter() - began
+    slide = SLIDE_V0 * SLIDE_V0 / (2 * SLIDE_MU * G)
+    return _bounce_error(states, dt), bounce_s, abs(sled.position.x - x0 - slide) / slide, slide_s
+
+
+def closed_forms(echo, rates=CHART_FPS) -> list[dict]:
+    """Errors against the closed forms (module docstring), and the run time of each, for the
+    stepped model and pymunk (when installed) stepping at each of `rates` fps."""
+    runs = {"stepped": _stepped_closed}
     try:
         import pymunk  # noqa: F401
+
+        runs["pymunk"] = _pymunk_closed
     except ImportError:
-        return rows
-    space = _space(world, bodies, e, 0.0)
-    ball = [b for b in space.bodies][0]
-    states = [(0.0, floor - drop, 0.0)]
-    for k in range(1, 2 * FPS):
-        space.step(dt)
-        states.append((k * dt, ball.position.y - box / 2, ball.velocity.y))
-    theirs = _bounce_times(states, floor, dt)[:3]
-    err = max(abs(a - b) for a, b in zip(theirs, expected, strict=False)) if theirs else math.inf
-    rows.append(_row("bounce", "pymunk", 1, err, "largest error of the first 3 bounce instants, s"))
-    space = _space(WorldSpec(400, 200, FPS, gravity=(0.0, G)), block, 1.0, mu)
-    sled = [b for b in space.bodies][0]
-    x0 = sled.position.x
-    for _ in range(2 * FPS):
-        space.step(dt)
-    err = abs(sled.position.x - x0 - slide) / slide
-    rows.append(_row("slide", "pymunk", 1, err, "relative error of the slide distance"))
-    echo(f"gravity  pymunk   bounce {rows[2]['value']:.2e} s, slide {err:.2e}")
+        pass
+    _stepped_closed(rates[0])  # compiled (or loaded) before any clock starts
+    rows = []
+    for name, run in runs.items():
+        for fps in rates:
+            bounce, bounce_s, slide, slide_s = run(fps)
+            notes = (
+                ("bounce", bounce, bounce_s, "largest error of the first 3 bounce instants, s"),
+                ("slide", slide, slide_s, "relative error of the slide distance"),
+            )
+            for scene, value, seconds, note in notes:
+                row = _row(scene, name, 1, value, f"{note}, at {fps} fps")
+                row.update(fps=fps, run_time_s=seconds)
+                rows.append(row)
+            echo(
+                f"gravity  {name:<8s} fps={fps:<4d} bounce {bounce:.2e} s "
+                f"({bounce_s * 1e3:.1f} ms), slide {slide:.2e} ({slide_s * 1e3:.1f} ms)"
+            )
     return rows
 
 

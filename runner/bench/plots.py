@@ -1,5 +1,7 @@
 """The plots of `collide2d bench`, when matplotlib is installed (the `plot` extra): scaling.png
-(steps/s against N, per model and peer) and runtime_vs_error.png, the Pareto chart: one panel per
+(steps/s against N, per model and peer), gravity_runtime_vs_error.png (the gravity part's
+closed forms: run time against error of the stepped model and pymunk at each rate) and
+runtime_vs_error.png, the Pareto chart: one panel per
 benchmark scenario, run time against the error at the long horizon, every point labelled with its
 settings ("60" fps, "60x16" fps x substeps), min-max bars on the run time, the Pareto front drawn
 as a step line through its points, and the scene's own floor (the sensitivity row) as a dotted
@@ -13,7 +15,8 @@ from pathlib import Path
 
 
 def plots(rows: list[dict], folder: Path) -> list[str]:
-    """scaling.png and runtime_vs_error.png when matplotlib is installed; the names written."""
+    """scaling.png, runtime_vs_error.png and gravity_runtime_vs_error.png (of the rows there
+    are) when matplotlib is installed; the names written."""
     try:
         import matplotlib
 
@@ -44,7 +47,45 @@ def plots(rows: list[dict], folder: Path) -> list[str]:
         sens = [r for r in rows if r["part"] == "sensitivity"]
         _pareto_figure(plt, ticker, err, sens, folder, atomic_path)
         written.append("runtime_vs_error.png")
+    closed = [r for r in rows if r["part"] == "gravity" and r.get("fps")]
+    if closed:
+        _gravity_figure(plt, closed, folder, atomic_path)
+        written.append("gravity_runtime_vs_error.png")
     return written
+
+
+# Errors below this are drawn at it (a bounce instant exact to round-off has an error of 0).
+GRAVITY_ERROR_FLOOR = 1e-16
+GRAVITY_PANELS = {"bounce": "error of the first 3 bounce instants (s)",
+                  "slide": "relative error of the slide distance"}  # fmt: skip
+
+
+def _gravity_figure(plt, closed, folder, atomic_path) -> None:
+    """gravity_runtime_vs_error.png: the gravity part's closed-form scenes, one panel each, run
+    time against error of each model at each rate (labelled with its fps)."""
+    fig, axes = plt.subplots(1, len(GRAVITY_PANELS), figsize=(6 * len(GRAVITY_PANELS), 4.5))
+    for ax, (scene, ylabel) in zip(axes, GRAVITY_PANELS.items(), strict=True):
+        mine = [r for r in closed if r["scene"] == scene]
+        for name in dict.fromkeys(r["model"] for r in mine):
+            pts = sorted(
+                (r["run_time_s"], max(r["value"], GRAVITY_ERROR_FLOOR), r["fps"])
+                for r in mine
+                if r["model"] == name and math.isfinite(r["value"])  # inf: bounces not found
+            )
+            colour = MODEL_COLOURS.get(name, "tab:purple")
+            ax.plot([p[0] for p in pts], [p[1] for p in pts], marker="o", ms=4, label=name,
+                    color=colour)  # fmt: skip
+            for x, y, fps in pts:
+                ax.annotate(str(fps), (x, y), textcoords="offset points", xytext=(3, 3),
+                            fontsize=6, color=colour)  # fmt: skip
+        ax.set(xscale="log", yscale="log", title=scene, ylabel=ylabel)
+        ax.set_xlabel("run time of 2 simulated seconds (s)")
+        ax.legend(fontsize="x-small", loc="best")
+    fig.suptitle("Under gravity: run time against error of the closed forms (labels: fps)")
+    fig.tight_layout()
+    with atomic_path(folder / "gravity_runtime_vs_error.png") as tmp:
+        fig.savefig(tmp, format="png", dpi=110)
+    plt.close(fig)
 
 
 MODEL_COLOURS = {"paper": "tab:orange", "stepped": "tab:blue", "exact": "tab:green"}
