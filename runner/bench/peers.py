@@ -305,14 +305,16 @@ def _bounce_expected() -> list[float]:
     return [t1 * (1 + 2 * e * (1 - e ** (k - 1)) / (1 - e)) for k in (1, 2, 3)]
 
 
-def _drop():
-    world = WorldSpec(100, int(FLOOR_PX + BOX_PX), FPS, gravity=(0.0, G))
+def _drop(fps: int):
+    """The drop's world at `fps` and its box."""
+    world = WorldSpec(100, int(FLOOR_PX + BOX_PX), fps, gravity=(0.0, G))
     bodies = Bodies.boxes([[45, FLOOR_PX - DROP_PX]], BOX_PX, [[0, 0]])
     return world, Bodies(**{**bodies.__dict__, "restitution": np.array([DROP_E])})
 
 
-def _block():
-    world = WorldSpec(400, int(FLOOR_PX + BOX_PX), FPS, gravity=(0.0, G))
+def _block(fps: int):
+    """The slide's world at `fps` and its block."""
+    world = WorldSpec(400, int(FLOOR_PX + BOX_PX), fps, gravity=(0.0, G))
     bodies = Bodies.boxes([[10, FLOOR_PX]], BOX_PX, [[SLIDE_V0, 0]])
     return world, Bodies(**{**bodies.__dict__, "friction": np.array([SLIDE_MU])})
 
@@ -329,8 +331,7 @@ def _bounce_error(states, dt) -> float:
 def _stepped_closed(fps: int) -> tuple[float, float, float, float]:
     """(bounce error s, its run time s, slide relative error, its run time s) of the stepped
     model stepping at `fps`."""
-    world, bodies = _drop()
-    world = WorldSpec(world.width, world.height, fps, gravity=world.gravity)
+    world, bodies = _drop(fps)
     model = make("stepped", world, bodies, sleep=False)
     states = [(0.0, FLOOR_PX - DROP_PX, 0.0)]
     began = time.perf_counter()
@@ -338,8 +339,8 @@ def _stepped_closed(fps: int) -> tuple[float, float, float, float]:
         model.advance(1, log=False)
         states.append((k / fps, model.positions()[0, 1], model.velocities()[0, 1]))
     bounce_s = time.perf_counter() - began
-    world, block = _block()
-    model = make("stepped", WorldSpec(world.width, world.height, fps, gravity=world.gravity), block)
+    world, block = _block(fps)
+    model = make("stepped", world, block)
     began = time.perf_counter()
     model.advance(int(CLOSED_S * fps), log=False)
     slide_s = time.perf_counter() - began
@@ -351,7 +352,7 @@ def _stepped_closed(fps: int) -> tuple[float, float, float, float]:
 def _pymunk_closed(fps: int) -> tuple[float, float, float, float]:
     """As `_stepped_closed`, pymunk stepping at 1/fps s."""
     dt = 1.0 / fps
-    world, bodies = _drop()
+    world, bodies = _drop(fps)
     space = _space(world, bodies, DROP_E, 0.0)
     (ball,) = space.bodies
     states = [(0.0, FLOOR_PX - DROP_PX, 0.0)]
@@ -360,7 +361,7 @@ def _pymunk_closed(fps: int) -> tuple[float, float, float, float]:
         space.step(dt)
         states.append((k * dt, ball.position.y - BOX_PX / 2, ball.velocity.y))
     bounce_s = time.perf_counter() - began
-    world, block = _block()
+    world, block = _block(fps)
     space = _space(world, block, 1.0, SLIDE_MU)
     (sled,) = space.bodies
     x0 = sled.position.x

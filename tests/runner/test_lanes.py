@@ -170,7 +170,7 @@ def test_a_huge_mass_ratio_starts_compiled_a_small_one_interpreted():
         assert not lanes.bursts_past_compiling(loads(CHAIN.replace("mass: 1e10", f"mass: {ratio}")))
 
 
-def test_an_object_crossing_its_room_a_million_times_a_tick_starts_compiled(tmp_path):
+def test_an_object_crossing_its_room_a_million_times_a_tick_starts_compiled():
     fast = (
         "version: 1\nworld: {width: 40, height: 40, fps: 1}\nmodel: exact\nticks: 3\n"
         "objects:\n  - {shape: box, size: 10, position: [15, 15], velocity: [%s, 0]}\n"
