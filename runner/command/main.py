@@ -309,6 +309,9 @@ def _answered(args: argparse.Namespace) -> int:
         print(str(err), file=sys.stderr)
         return EXIT_BAD_INPUT
     except Exception as err:
+        if _from_ctrl_c(err):
+            print("collide2d: interrupted; outputs already written are whole", file=sys.stderr)
+            return EXIT_INTERRUPTED
         if type(err).__name__ == "RunStopped":  # runner.run's, not imported unless a run ran
             print(str(err), file=sys.stderr)
             return EXIT_BAD_INPUT
@@ -320,6 +323,19 @@ def _answered(args: argparse.Namespace) -> int:
     except KeyboardInterrupt:
         print("collide2d: interrupted; outputs already written are whole", file=sys.stderr)
         return EXIT_INTERRUPTED
+
+
+def _from_ctrl_c(err: BaseException) -> bool:
+    """Whether `err` comes of a Ctrl-C: a compiled kernel that Ctrl-C stopped is reported by
+    numba as a SystemError ("returned a result with an exception set") whose cause, at the end of
+    the chain, is the KeyboardInterrupt."""
+    seen = set()
+    while err is not None and id(err) not in seen:
+        if isinstance(err, KeyboardInterrupt):
+            return True
+        seen.add(id(err))
+        err = err.__cause__ or err.__context__
+    return False
 
 
 # A Ctrl-C that arrives while Python runs a finalizer (`__del__`: numba's compiler frees LLVM

@@ -365,6 +365,31 @@ def test_ctrl_c_stops_any_command_even_started_with_sigint_ignored(tmp_path, sta
     assert not (tmp_path / "bench").exists()
 
 
+def test_a_ctrl_c_that_stops_a_compiled_kernel_is_an_interrupt_not_a_crash(capsys):
+    """numba reports a kernel that Ctrl-C stopped as a chain of SystemErrors caused by the
+    KeyboardInterrupt (`bench --part gravity` runs its kernels in this process): exit 130."""
+    import argparse
+
+    from collide2d.runner.command import main as cli
+
+    def stopped(args):
+        try:
+            try:
+                raise KeyboardInterrupt
+            except KeyboardInterrupt as inner:
+                raise SystemError("returned a result with an exception set") from inner
+        except SystemError as middle:
+            raise SystemError("returned a result with an exception set") from middle
+
+    def broken(args):
+        raise SystemError("returned a result with an exception set")
+
+    assert cli._answered(argparse.Namespace(func=stopped)) == 130
+    assert "interrupted; outputs already written are whole" in capsys.readouterr().err
+    assert cli._answered(argparse.Namespace(func=broken, command="bench")) == 3  # a bug stays one
+    assert "unexpected error" in capsys.readouterr().err
+
+
 def test_a_ctrl_c_that_lands_in_a_finalizer_is_raised_just_after_it():
     """Python swallows an exception raised in `__del__` (numba's compiler frees LLVM objects so,
     while it compiles): a Ctrl-C that lands there still stops the command, a moment later."""
