@@ -310,8 +310,7 @@ def _answered(args: argparse.Namespace) -> int:
         return EXIT_BAD_INPUT
     except Exception as err:
         if _from_ctrl_c(err):
-            print("collide2d: interrupted; outputs already written are whole", file=sys.stderr)
-            return EXIT_INTERRUPTED
+            return _interrupted()
         if type(err).__name__ == "RunStopped":  # runner.run's, not imported unless a run ran
             print(str(err), file=sys.stderr)
             return EXIT_BAD_INPUT
@@ -321,8 +320,12 @@ def _answered(args: argparse.Namespace) -> int:
             return EXIT_BAD_INPUT
         return unexpected(err, args)
     except KeyboardInterrupt:
-        print("collide2d: interrupted; outputs already written are whole", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        return _interrupted()
+
+
+def _interrupted() -> int:
+    print("collide2d: interrupted; outputs already written are whole", file=sys.stderr)
+    return EXIT_INTERRUPTED
 
 
 def _from_ctrl_c(err: BaseException) -> bool:
