@@ -6,7 +6,9 @@ runs them on the cluster (`--scheduler`, else an embedded LocalCluster of `--wor
 and writes OUT/sweep/ whole (`folder`; OUT is `--out`, else the project's `out` setting, else
 `out`). Exit status: 0 done, 2 bad input (nothing written), Dask not installed, a scheduler that
 does not answer or OUT/sweep taken by another sweep, 3 when a run failed unexpectedly (its row says
-so), 130 when cancelled by Ctrl-C (the rows done are written, marked incomplete).
+so), 130 when cancelled by Ctrl-C (the rows done are written, marked incomplete). The line
+`sweep: N runs on ...` comes once the cluster is up; a Ctrl-C while it starts goes unseen
+(runner.sweep.cluster).
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ import sys
 from pathlib import Path
 
 from collide2d.runner.command.exitcodes import EXIT_BAD_INPUT, EXIT_OK, EXIT_UNEXPECTED
+from collide2d.runner.output.progress import say
 
 EXIT_CANCELLED = 130
 REPORT_DIR = "sweep"
@@ -136,9 +139,6 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         paths, axes, seeds, limits = matrix_from_args(args)
         folder.check_replaceable(out_root)
         runs = plan.check(paths, axes, seeds, limits, progress=checking)
-        if not args.quiet:
-            where = args.scheduler or f"{args.workers or os.cpu_count()} local workers"
-            print(f"sweep: {len(runs)} runs on {where}", file=sys.stderr, flush=True)
         # the bar from the start: starting the cluster and compiling the kernels take a while
         progress = cluster.progress_for(len(runs), "sweep", args.quiet)
         try:
@@ -146,6 +146,9 @@ def cmd_sweep(args: argparse.Namespace) -> int:
                 cluster.connect(args.workers, args.scheduler) as client,
                 folder.staged(out_root) as stage,
             ):
+                if not args.quiet:  # the cluster is up: from here a Ctrl-C writes the rows done
+                    where = args.scheduler or f"{args.workers or os.cpu_count()} local workers"
+                    say(f"sweep: {len(runs)} runs on {where}")
                 table, complete = driver.run_sweep(client, runs, progress=progress)
                 written = results.write(stage, table, complete)
         finally:

@@ -118,7 +118,11 @@ def _connected(Client, LocalCluster, workers, scheduler):
             return
         # worker processes start with SIGINT ignored (they inherit it): Ctrl-C on a terminal
         # reaches every process of the group, and only this one should act on it (cancel,
-        # write, close the cluster) instead of each worker printing a traceback as it dies
+        # write, close the cluster) instead of each worker printing a traceback as it dies.
+        # The disposition is the whole process's, so a Ctrl-C while they start (a second or
+        # two) goes unseen here too; `sweep` says when the cluster is up. (Holding it back
+        # with a signal mask instead does not work: processes spawned do not inherit a mask,
+        # and native threads, OpenBLAS's, would take the signal and drop it.)
         with _sigint(signal.SIG_IGN):
             cluster = LocalCluster(
                 n_workers=workers or os.cpu_count() or 1,

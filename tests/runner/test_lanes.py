@@ -230,8 +230,14 @@ def test_run_writes_the_same_files_under_each_mode_and_says_which_lane(tmp_path)
         out = tmp_path / mode
         assert main(["run", str(path), "--out", str(out), "--quiet", "--jit", mode]) == 0
         folder = out / "small"
-        summary = json.loads((folder / "summary.json").read_text())
-        assert summary["kernels"] == ("compiled" if mode == "on" else "interpreted")
+        kernels = json.loads((folder / "summary.json").read_text())["kernels"]
+        # auto starts interpreted, and may go on compiled where this process has the kernels
+        # ready and the machine is slow enough for that to pay
+        if mode == "on":
+            assert kernels == "compiled"
+        else:
+            switched = (mode, kernels) == ("auto", "interpreted, then compiled")
+            assert kernels == "interpreted" or switched
         files[mode] = {
             p.relative_to(folder).as_posix(): p.read_bytes()
             for p in sorted(folder.rglob("*"))
@@ -248,9 +254,8 @@ def test_the_projects_table_sets_the_mode(tmp_path, monkeypatch):
     assert main(["run", "small.yaml", "--quiet"]) == 0
     assert json.loads((tmp_path / "out/small/summary.json").read_text())["kernels"] == "compiled"
     assert main(["run", "small.yaml", "--quiet", "--jit", "auto"]) == 0  # the command line wins
-    assert json.loads((tmp_path / "out/small/summary.json").read_text())["kernels"] == (
-        "interpreted"
-    )
+    kernels = json.loads((tmp_path / "out/small/summary.json").read_text())["kernels"]
+    assert kernels.startswith("interpreted")  # (then compiled, where that pays: test above)
     (tmp_path / "pyproject.toml").write_text('[tool.collide2d]\njit = "fast"\n')
     assert main(["run", "small.yaml", "--quiet"]) == 2
 
