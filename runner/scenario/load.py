@@ -362,6 +362,7 @@ class _Reader(ModelReader):
         assemble.check_plugin(self, model, geometry, bodies, lines, top)  # engine.models.protocol
         if model == "exact":
             assemble.check_room(self, world, bodies, geometry, names, listed, lines, table)
+            assemble.check_exact_gravity(self, world, bodies, listed, lines, table)
         return Scenario(
             path=self.file_path,
             name=name,

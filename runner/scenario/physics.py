@@ -129,11 +129,6 @@ class ModelReader(Nodes):
             text = None
             if kind == "paper":
                 text = PAPER_REFUSES.format(key=key)
-            elif kind == "exact" and key == "gravity" and physics.gravity != (0.0, 0.0):
-                text = (
-                    "must be 0 under the exact model, which has no gravity yet; gravity needs "
-                    "model: stepped"
-                )
             elif kind == "exact" and key != "gravity":
                 text = EXACT_REFUSES[key] if getattr(physics, key) != WORLD_PHYSICS[key] else None
             if text is not None:

@@ -276,8 +276,6 @@ def test_model_paper_on_the_command_line_names_the_option():
 @pytest.mark.parametrize(
     "world, objects, needle, fragment",
     [
-        ("gravity: 980", "", "980", "world.gravity must be 0 under the exact model"),
-        ("gravity: [1, 0]", "", "[1, 0]", "world.gravity must be 0 under the exact model"),
         ("restitution: 0.9", "", "0.9", "world.restitution must be 1 under the exact model"),
         ("friction: 0.1", "", "0.1", "world.friction must be 0 under the exact model"),
         ("gravity: 0", BALL, "0.8", "objects[0].restitution must be 1 under the exact model"),
@@ -320,9 +318,38 @@ def test_model_exact_on_the_command_line_names_the_option_and_stepped():
     text = scene(BALL.replace("0.8", "1"), world="gravity: 980")
     err = refused(text, overrides={"model": "exact"})
     lines = str(err).splitlines()
-    assert lines[0].startswith("<string>:2:52: error: --model exact: world.gravity must be 0")
-    assert "--model exact: objects[0].friction must be 0 under the exact model" in lines[1]
-    assert all("model: stepped" in line for line in lines)
+    assert len(lines) == 1
+    assert "--model exact: objects[0].friction must be 0 under the exact model" in lines[0]
+    assert "model: stepped" in lines[0]
+
+
+@pytest.mark.parametrize("gravity", ["980", "[1, 0]", "[0, -3]"])
+def test_the_exact_model_takes_gravity(gravity):
+    s = loads(scene(BOX, world=f"gravity: {gravity}", model="exact"))
+    assert s.world.has_gravity and s.model == "exact"
+
+
+def test_the_exact_model_under_gravity_refuses_a_static_object_at_its_line():
+    text = scene(BOX + FLOOR.replace(", friction: 0.9", ""), world="gravity: 980", model="exact")
+    err = check_refused(text, "{shape: box, size: [200, 5]", "object 1 is static")
+    assert "model: stepped" in err.message
+    loads(text.replace("gravity: 980", "gravity: 0"))  # without gravity it is taken
+
+
+@pytest.mark.parametrize(
+    "gravity, position, velocity",
+    [
+        ("980", "[60, 90]", "[5, 0]"),
+        ("-980", "[60, 0]", "[0, 0]"),
+        ("[-9, 0]", "[0, 40]", "[0, 3]"),
+    ],
+)
+def test_the_exact_model_under_gravity_refuses_a_body_lying_on_a_wall(gravity, position, velocity):
+    box = f"  - {{shape: box, size: 10, position: {position}, velocity: {velocity}}}\n"
+    text = scene(box, world=f"gravity: {gravity}", model="exact")
+    err = check_refused(text, "{shape: box, size: 10", "object 0 lies still on a wall")
+    assert "model: stepped" in err.message
+    loads(text.replace(f"velocity: {velocity}", "velocity: [1, -1]").replace("[60, 0]", "[60, 1]"))
 
 
 def test_every_world_key_the_paper_model_has_not_is_refused_at_once():

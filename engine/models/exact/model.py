@@ -12,8 +12,9 @@ the local re-prediction saves, for tests and `collide2d bench`). Output, per `ad
 wall and pair events in the order they happened, `t` = the exact contact time; positions and
 velocities at the end of the last tick.
 
-Objects fly on straight lines between events. Each keeps its own clock (TLOC: its position is
-valid at that time) and an invalidation counter. Two queues hold what comes next, keyed by (time,
+Objects fly on straight lines between events, or under the world's gravity on parabolas (exact:
+`x + v·t + ½·g·t²`). Each keeps its own clock (TLOC: its position and velocity are valid at that
+time) and an invalidation counter. Two queues hold what comes next, keyed by (time,
 rank, a, b) so that ties go cell crossings first (bookkeeping, never logged), then walls by (id,
 side), then pairs in (a, b) order: each moving object's *horizon*, the first of its next wall
 contact and its next cell crossing, filed by its time in a bucket of a calendar queue that
@@ -55,7 +56,7 @@ error is NoRoom naming them (the hot loop keeps no record for this).
 
 The kernel counts the wall and pair events as they happen, logged or not (`event_counts`).
 
-The parts live in their own modules beside this one: the state layout (floats F (n, 8), ints
+The parts live in their own modules beside this one: the state layout (floats F (n, 10), ints
 N (n, 8), scalar state; state.py), the horizon queue (horizonqueue.py), the event queue (a 4-ary
 heap; heap.py), the grid's per-cell lists (cells.py), the predictions (prediction.py) and a jam's
 objects (jam.py); from the shared engine, objects with no room to move (engine/noroom.py) and the
@@ -119,14 +120,17 @@ from collide2d.engine.models.exact.horizonqueue import (
     next_top,
 )
 from collide2d.engine.models.exact.jam import jammed, listing
-from collide2d.engine.models.exact.prediction import predict, set_job
+from collide2d.engine.models.exact.prediction import predict, set_job, velocity_at
 from collide2d.engine.models.exact.state import (
+    AX,
+    AY,
     CELL,
     CNT,
     DIR_DOWN,
     DIR_LEFT,
     DIR_RIGHT,
     DIR_UP,
+    F_COLUMNS,
     INF,
     INV_MASS,
     J_EXTRA,
@@ -194,10 +198,16 @@ RECENT = 64
 
 @hot
 def _move_to(i, t, F):
-    """Bring object i's position to time t."""
+    """Bring object i's position (and, under gravity, its velocity) to time t."""
     dt = t - F[i, TLOC]
-    F[i, X] += F[i, VX] * dt
-    F[i, Y] += F[i, VY] * dt
+    if F[i, AX] == 0.0 and F[i, AY] == 0.0:
+        F[i, X] += F[i, VX] * dt
+        F[i, Y] += F[i, VY] * dt
+    else:
+        F[i, X] += F[i, VX] * dt + 0.5 * F[i, AX] * dt * dt
+        F[i, Y] += F[i, VY] * dt + 0.5 * F[i, AY] * dt * dt
+        F[i, VX] += F[i, AX] * dt
+        F[i, VY] += F[i, AY] * dt
     F[i, TLOC] = t
 
 
@@ -242,8 +252,10 @@ def _on_pair(a, b, code, nx, ny, t, F, N, jobs):
     one made before, and the local re-prediction then drift from the full one). For the same
     reason a static object never moves its clock: its counter does not change either, so the
     entries of its other pairs stay valid, and they must equal what asking again would give."""
+    vax, vay = velocity_at(a, t, F)
+    vbx, vby = velocity_at(b, t, F)
     vax, vay, vbx, vby, changed = exchange(
-        F[a, VX], F[a, VY], F[b, VX], F[b, VY], F[a, INV_MASS], F[b, INV_MASS], code, nx, ny
+        vax, vay, vbx, vby, F[a, INV_MASS], F[b, INV_MASS], code, nx, ny
     )
     if not changed:
         return 0
@@ -422,6 +434,11 @@ class Model:
             raise ValueError(f"cell_size must be > 0 px, got {cell_size!r}")
         if repredict not in REPREDICT:
             raise ValueError(f"repredict must be one of {REPREDICT}, got {repredict!r}")
+        if world.has_gravity and np.any(bodies.static):
+            raise ValueError(
+                "the exact model does not yet predict a falling body meeting a static object: "
+                "under gravity it takes no static objects"
+            )
         stuck = no_room(world, bodies, geometry)
         if stuck:
             raise NoRoom(
@@ -438,11 +455,13 @@ class Model:
         n = bodies.n
         static = np.asarray(bodies.static, bool)
         cores = build_cores(bodies, geometry)
-        self._F = np.zeros((n, 8))
+        self._F = np.zeros((n, F_COLUMNS))
         self._F[:, X : Y + 1] = bodies.pos
         self._F[:, VX : VY + 1] = np.where(static[:, None], 0.0, bodies.vel)
         self._F[:, SW : SH + 1] = bodies.size
         self._F[:, INV_MASS] = bodies.inv_mass
+        self._F[~static, AX : AY + 1] = world.gravity
+        self.gravity = world.has_gravity
         self._N = np.zeros((n, 8), np.int64)
         self._N[:, PARTNER] = -1
         self._N[:, STATIC] = static
@@ -585,10 +604,17 @@ class Model:
         its own clock; kept inside the world against the last rounding)."""
         F = self._F
         t = self.tick / self._world.fps
-        pos = F[:, X : Y + 1] + F[:, VX : VY + 1] * (t - F[:, TLOC : TLOC + 1])
+        dt = t - F[:, TLOC : TLOC + 1]
+        pos = F[:, X : Y + 1] + F[:, VX : VY + 1] * dt
+        if self.gravity:
+            pos += 0.5 * F[:, AX : AY + 1] * dt * dt
         limit = np.array([self._world.width, self._world.height]) - F[:, SW : SH + 1]
         return np.minimum(np.maximum(pos, 0.0), limit)
 
     def velocities(self) -> np.ndarray:
-        """(n, 2) float64 velocities, px/s."""
-        return self._F[:, VX : VY + 1].copy()
+        """(n, 2) float64 velocities at the last tick's end, px/s."""
+        F = self._F
+        if not self.gravity:
+            return F[:, VX : VY + 1].copy()
+        t = self.tick / self._world.fps
+        return F[:, VX : VY + 1] + F[:, AX : AY + 1] * (t - F[:, TLOC : TLOC + 1])

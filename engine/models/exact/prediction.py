@@ -17,6 +17,8 @@ from collide2d.engine.models.exact.cells import C_HEAD
 from collide2d.engine.models.exact.heap import RANK_CROSS, RANK_PAIR, RANK_WALL, make_key, push
 from collide2d.engine.models.exact.horizonqueue import set_horizon
 from collide2d.engine.models.exact.state import (
+    AX,
+    AY,
     CELL,
     CNT,
     DIR_DOWN,
@@ -44,12 +46,74 @@ from collide2d.engine.models.exact.state import (
     Y,
     hot,
 )
+from collide2d.engine.parabola import meet
 from collide2d.engine.world import KIND_BOX
 
 
 @hot
-def _wall_time(i, F, world):
+def velocity_at(i, t, F):
+    """Object i's velocity at time t (its own, unchanged without acceleration)."""
+    if F[i, AX] == 0.0 and F[i, AY] == 0.0:
+        return F[i, VX], F[i, VY]
+    dt = t - F[i, TLOC]
+    return F[i, VX] + F[i, AX] * dt, F[i, VY] + F[i, AY] * dt
+
+
+@hot
+def _state_at(i, t, F):
+    """Object i's position and velocity at time t (x, y, vx, vy), not stored."""
+    dt = t - F[i, TLOC]
+    if F[i, AX] == 0.0 and F[i, AY] == 0.0:
+        return F[i, X] + F[i, VX] * dt, F[i, Y] + F[i, VY] * dt, F[i, VX], F[i, VY]
+    return (
+        F[i, X] + F[i, VX] * dt + 0.5 * F[i, AX] * dt * dt,
+        F[i, Y] + F[i, VY] * dt + 0.5 * F[i, AY] * dt * dt,
+        F[i, VX] + F[i, AX] * dt,
+        F[i, VY] + F[i, AY] * dt,
+    )
+
+
+@hot
+def _first_of_two(t_lo, t_hi, lo, hi):
+    """(t, what) of the earlier of two meetings, the low one on a tie; (inf, -1) if neither."""
+    if t_lo <= t_hi and t_lo < INF:
+        return t_lo, lo
+    if t_hi < INF:
+        return t_hi, hi
+    return INF, -1
+
+
+@hot
+def _wall_time_falling(i, t_now, F, world):
+    """_wall_time under an acceleration: on each axis the first of its two walls the parabola meets
+    (parabola.meet), from i's state at t_now."""
+    x, y, vx, vy = _state_at(i, t_now, F)
+    sx = world.width - F[i, SW]
+    sy = world.height - F[i, SH]
+    tx, side_x = _first_of_two(
+        meet(max(x, 0.0), vx, F[i, AX]),
+        meet(max(sx - x, 0.0), -vx, -F[i, AX]),
+        SIDE_LEFT,
+        SIDE_RIGHT,
+    )
+    ty, side_y = _first_of_two(
+        meet(max(y, 0.0), vy, F[i, AY]),
+        meet(max(sy - y, 0.0), -vy, -F[i, AY]),
+        SIDE_TOP,
+        SIDE_BOTTOM,
+    )
+    if ty < tx:
+        return t_now + ty, side_y
+    if tx < INF:
+        return t_now + tx, side_x
+    return INF, -1
+
+
+@hot
+def _wall_time(i, t_now, F, world):
     """(t, side) of i's next wall contact (its box touching a wall line), (inf, -1) if none."""
+    if F[i, AX] != 0.0 or F[i, AY] != 0.0:
+        return _wall_time_falling(i, t_now, F, world)
     t_best = INF
     side = -1
     if F[i, VX] > 0.0:
@@ -68,8 +132,34 @@ def _wall_time(i, F, world):
 
 
 @hot
-def _cross_time(i, F, N, world):
+def _cross_time_falling(i, t_now, F, N, world):
+    """_cross_time under an acceleration: on each axis the first of the cell's two sides the
+    centre's parabola meets (parabola.meet; none on the grid's edge), from i's state at t_now."""
+    cell, gnx, gny = world.cell, world.gnx, world.gny
+    gx = N[i, CELL] % gnx
+    gy = N[i, CELL] // gnx
+    x, y, vx, vy = _state_at(i, t_now, F)
+    cx = x + 0.5 * F[i, SW] - gx * cell  # the centre within its cell
+    cy = y + 0.5 * F[i, SH] - gy * cell
+    ax, ay = F[i, AX], F[i, AY]
+    t_left = meet(max(cx, 0.0), vx, ax) if gx > 0 else INF
+    t_right = meet(max(cell - cx, 0.0), -vx, -ax) if gx < gnx - 1 else INF
+    t_up = meet(max(cy, 0.0), vy, ay) if gy > 0 else INF
+    t_down = meet(max(cell - cy, 0.0), -vy, -ay) if gy < gny - 1 else INF
+    tx, dx = _first_of_two(t_left, t_right, DIR_LEFT, DIR_RIGHT)
+    ty, dy = _first_of_two(t_up, t_down, DIR_UP, DIR_DOWN)
+    if ty < tx:
+        return t_now + ty, dy
+    if tx < INF:
+        return t_now + tx, dx
+    return INF, -1
+
+
+@hot
+def _cross_time(i, t_now, F, N, world):
     """(t, direction) when i's box centre next leaves its grid cell, (inf, -1) if never."""
+    if F[i, AX] != 0.0 or F[i, AY] != 0.0:
+        return _cross_time_falling(i, t_now, F, N, world)
     cell, gnx, gny = world.cell, world.gnx, world.gny
     gx = N[i, CELL] % gnx
     gy = N[i, CELL] // gnx
@@ -128,10 +218,14 @@ def _predict_pair(i, j, t_now, limit, S):
     a = min(i, j)
     b = max(i, j)
     t0 = max(F[a, TLOC], F[b, TLOC])
-    qx = (F[b, X] + F[b, VX] * (t0 - F[b, TLOC])) - (F[a, X] + F[a, VX] * (t0 - F[a, TLOC]))
-    qy = (F[b, Y] + F[b, VY] * (t0 - F[b, TLOC])) - (F[a, Y] + F[a, VY] * (t0 - F[a, TLOC]))
-    ux = F[b, VX] - F[a, VX]
-    uy = F[b, VY] - F[a, VY]
+    # (both fall alike, or neither does: their relative path is a straight line; the model
+    # refuses static objects under gravity)
+    xa, ya, vax, vay = _state_at(a, t0, F)
+    xb, yb, vbx, vby = _state_at(b, t0, F)
+    qx = xb - xa
+    qy = yb - ya
+    ux = vbx - vax
+    uy = vby - vay
     if not box_reach(qx, qy, ux, uy, F[a, SW], F[a, SH], F[b, SW], F[b, SH], limit - t0):
         return
     now = t_now - t0
@@ -157,9 +251,9 @@ def predict(jobs, k, t_now, S):
     s_start, s_items = S.s_start, S.s_items
     i, skip, mode = jobs[k, J_OBJ], jobs[k, J_SKIP], jobs[k, J_HIGHER]
     higher = mode == JOB_FIRST
-    t_wall, side = _wall_time(i, F, world)
+    t_wall, side = _wall_time(i, t_now, F, world)
     if mode != JOB_CONTACTS:
-        t_cross, d = _cross_time(i, F, N, world)
+        t_cross, d = _cross_time(i, t_now, F, N, world)
         if t_cross <= t_wall and t_cross < INF:
             t_h, rank, what = max(t_cross, t_now), RANK_CROSS, d
         elif t_wall < INF:

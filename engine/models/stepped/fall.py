@@ -23,14 +23,13 @@ takes energy: the bounce happens where and when the parabola meets it.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from collide2d.engine.errors import FoldLimitExceeded
 from collide2d.engine.events import EV_WALL, SIDE_BOTTOM, SIDE_LEFT, SIDE_RIGHT, SIDE_TOP, log_event
 from collide2d.engine.jit import njit
 from collide2d.engine.models.stepped.move import B_H, B_VX, B_VY, B_W, B_X, B_Y
+from collide2d.engine.parabola import meet
 from collide2d.engine.response import MAX_FOLDS_PER_STEP
 
 INF = np.inf
@@ -39,22 +38,6 @@ INF = np.inf
 ZENO_SPEED = 1e-6
 # An object may meet walls at most this many times in one step (a runaway past it).
 MAX_HITS_PER_STEP = 2 * MAX_FOLDS_PER_STEP
-
-
-@njit(cache=True, inline="always")
-def _meet(h, v, a):
-    """The first instant >= 0 at which a gap h >= 0 closing at rate v (< 0 closing), with
-    acceleration a, is 0; inf when never (module docstring)."""
-    if h <= 0.0 and (v < 0.0 or (v == 0.0 and a < 0.0)):
-        return 0.0
-    if v < 0.0:
-        disc = v * v - 2.0 * a * h
-        if disc < 0.0:
-            return INF
-        return 2.0 * h / (-v + math.sqrt(disc))
-    if a < 0.0:
-        return (v + math.sqrt(v * v - 2.0 * a * h)) / -a
-    return INF
 
 
 @njit(cache=True, inline="always")
@@ -105,8 +88,8 @@ def fall_one(body, i, e, mu, P, dt, sides, hits):
         ay = _acceleration(gy, vy, rest_x, mu, gx) if rest_y == 0 else 0.0
         t, what = left, -1  # what: 0/1 x low/high, 2/3 y low/high, 4/5 x/y stops sliding
         if rest_x == 0:
-            t_lo = _meet(x, vx, ax)
-            t_hi = _meet(sx - x, -vx, -ax)
+            t_lo = meet(x, vx, ax)
+            t_hi = meet(sx - x, -vx, -ax)
             if t_lo < t:
                 t, what = t_lo, 0
             if t_hi < t:
@@ -114,8 +97,8 @@ def fall_one(body, i, e, mu, P, dt, sides, hits):
             if rest_y != 0 and vx * ax < 0.0 and -vx / ax < t:
                 t, what = -vx / ax, 4
         if rest_y == 0:
-            t_lo = _meet(y, vy, ay)
-            t_hi = _meet(sy - y, -vy, -ay)
+            t_lo = meet(y, vy, ay)
+            t_hi = meet(sy - y, -vy, -ay)
             if t_lo < t:
                 t, what = t_lo, 2
             if t_hi < t:
