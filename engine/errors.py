@@ -3,10 +3,11 @@
 A runaway is a scene the model cannot carry forward in bounded work: the exact model's event cap
 (`EventCapExceeded`: more than `max_events_per_tick` events in one tick), an object with no room to
 move on an axis (`NoRoom`: under the exact model it would collide again and again without time
-passing), and the stepped model's fold limit (`FoldLimitExceeded`: an object crossing the world
-too many times in one step). Callers catch `Runaway` and show `str(err)`, which says what stopped
-and why; the engine never prints. `FoldLimitExceeded` is raised inside a compiled kernel, so its
-message is a constant.
+passing), the stepped model's fold limit (`FoldLimitExceeded`: an object crossing the world too
+many times in one step), and what the exact model cannot carry on yet (`NotYetExact`: under
+gravity, a body that comes to rest on a static object). Callers catch `Runaway` and show
+`str(err)`, which says what stopped and why; the engine never prints. `FoldLimitExceeded` is
+raised inside a compiled kernel, so its message is a constant.
 """
 
 from __future__ import annotations
@@ -33,3 +34,12 @@ class NoRoom(Runaway, ValueError):
 
 class FoldLimitExceeded(Runaway, ValueError):
     """An object crosses the world too many times in one step (stepped model)."""
+
+
+class NotYetExact(Runaway, RuntimeError):
+    """The exact model met what it does not yet carry on exactly (a body that comes to rest on a
+    static object under gravity); `objects` lists the ids involved."""
+
+    def __init__(self, message: str, objects: tuple[int, ...] = ()):
+        super().__init__(message)
+        self.objects = tuple(objects)

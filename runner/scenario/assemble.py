@@ -206,9 +206,9 @@ def check_room(reader, world, bodies, geometry, names, listed, lines, table=None
 
 def check_exact_gravity(reader, world, bodies, listed, lines, table=None) -> None:
     """Refuse, at the object, what the exact model does not yet take under gravity
-    (docs/models.md#exact-under-gravity): a static object (a falling body meeting one is not yet
-    predicted), and a moving object at rest on a wall that gravity pulls it into (it would bounce
-    with no speed again and again at one instant; bodies do not rest yet)."""
+    (docs/models.md#exact-under-gravity): a moving object at rest on a wall that gravity pulls it
+    into (it would bounce with no speed again and again at one instant; bodies do not rest
+    yet)."""
     if not world.has_gravity:
         return
     lying = np.zeros(bodies.n, bool)
@@ -216,27 +216,17 @@ def check_exact_gravity(reader, world, bodies, listed, lines, table=None) -> Non
     for axis, g in enumerate(world.gravity):
         on = bodies.pos[:, axis] >= room[:, axis] if g > 0 else bodies.pos[:, axis] <= 0.0
         lying |= (g != 0.0) & on & (bodies.vel[:, axis] == 0.0) & ~bodies.static
-    bad = np.flatnonzero(bodies.static | lying)
-    if not bad.size:
+    if not lying.any():
         return
-    i = int(bad[0])
-    if bodies.static[i]:
-        said = (
-            f"object {i} is static, and the exact model does not yet predict a falling body "
-            "meeting a static object; under gravity use model: stepped, or leave static objects "
-            "out (the walls bound the world)"
-        )
-    else:
-        said = (
-            f"object {i} lies still on a wall that gravity pulls it into, and the exact model does "
-            "not yet let bodies rest; use model: stepped, or start it above the wall or moving "
-            "away from it"
-        )
-    message = reader.prefix(reader.model_from) + said
+    i = int(np.flatnonzero(lying)[0])
+    message = reader.prefix(reader.model_from) + (
+        f"object {i} lies still on a wall that gravity pulls it into, and the exact model does not "
+        "yet let bodies rest; use model: stepped, or start it above the wall or moving away from it"
+    )
     if i < len(listed):
         raise reader.error(listed[i].node, message)
     if table is not None and i < table.n:
-        raise table.error(i, "static" if bodies.static[i] else "y", message)
+        raise table.error(i, "y", message)
     raise ScenarioError(reader.path, lines[i], 1, message)
 
 

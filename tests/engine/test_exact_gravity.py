@@ -1,7 +1,8 @@
 """The exact model under gravity (docs/models.md#exact-under-gravity), held to the closed forms: a
 free fall at every frame, the bounce times of an elastic ball, a projectile's flight, the
-stacked-ball drop, and the energy of an elastic gas under gravity over 10,000 ticks; and what it
-does not take yet, refused by name."""
+stacked-ball drop, bounces on a static box and a static circle (a curved relative path), and the
+energy of an elastic gas under gravity over 10,000 ticks; and what it does not carry on yet (a
+body coming to rest on another), stopped by name."""
 
 from __future__ import annotations
 
@@ -11,9 +12,10 @@ import numpy as np
 import pytest
 from engine_refs import pile_bodies
 
-from collide2d.engine.events import EV_WALL, SIDE_BOTTOM
+from collide2d.engine.errors import NotYetExact
+from collide2d.engine.events import EV_PAIR, EV_WALL, SIDE_BOTTOM
 from collide2d.engine.models import make
-from collide2d.engine.world import Bodies, WorldSpec
+from collide2d.engine.world import KIND_CIRCLE, Bodies, Looks, WorldSpec
 
 G = 980.0
 
@@ -120,9 +122,66 @@ def test_gravity_along_x_or_up_falls_that_way():
         assert np.allclose(m.positions()[0], want, rtol=1e-14)
 
 
-def test_static_objects_under_gravity_are_refused_by_name():
-    world = WorldSpec(100, 100, 10, gravity=(0.0, G))
-    bodies = Bodies.boxes([[10, 10], [10, 80]], 10, [[0, 0], [0, 0]], static=[False, True])
-    with pytest.raises(ValueError, match="static"):
-        make("exact", world, bodies)
-    make("exact", WorldSpec(100, 100, 10), bodies)  # without gravity it is taken
+def _circles(pos, diameters, static) -> Bodies:
+    n = len(pos)
+    d = np.asarray(diameters, float)
+    return Bodies(
+        kind=np.full(n, KIND_CIRCLE, np.int8),
+        pos=np.asarray(pos, float),
+        size=np.stack([d, d], axis=1),
+        vel=np.zeros((n, 2)),
+        mass=np.ones(n),
+        static=np.asarray(static, bool),
+        vert_start=np.zeros(n + 1, np.int64),
+        verts=np.zeros((0, 2), np.int64),
+        looks=Looks(color=np.ones(n, np.uint8), fill=np.zeros(n, bool)),
+    )
+
+
+@pytest.mark.parametrize("shape", ["box", "circle"])
+def test_an_elastic_body_bounces_on_a_static_one_at_the_closed_form_times(shape):
+    # dropped from rest h px above a static object's top (a box's flat top; a circle's crown, met
+    # centre over centre): impacts at t1·(2n - 1), found on the curved relative path
+    world = WorldSpec(200, 1000, 60, gravity=(0.0, G))
+    if shape == "box":
+        bodies = Bodies.boxes([[50, 400], [40, 710]], [[10, 10], [40, 20]], [[0, 0], [0, 0]],
+                              static=[False, True])  # fmt: skip
+        h = 710 - 410
+    else:
+        bodies = _circles([[45, 400], [40, 700]], [10, 20], [False, True])
+        h = 700 - 410
+    m = make("exact", world, bodies)
+    t1 = math.sqrt(2 * h / G)
+    found = m.advance(int(60 * 12 * 2 * t1) + 1)
+    assert len(found) == 12 and set(found["type"].tolist()) == {EV_PAIR}
+    for n, t in enumerate(found["t"], start=1):
+        assert abs(t - t1 * (2 * n - 1)) <= 1e-9
+    assert m.positions()[0, 1] < 700 - 10 + 1e-9  # never inside
+
+
+def test_a_projectile_meets_a_static_wall_where_its_parabola_does():
+    # thrown at a static box standing on the right: it meets its left face at the instant
+    # x(t) = 300 - 10, having fallen 1/2 g t² meanwhile
+    world = WorldSpec(1000, 1000, 30, gravity=(0.0, G))
+    bodies = Bodies.boxes([[10, 100], [300, 0]], [[10, 10], [50, 1000]], [[250, -200], [0, 0]],
+                          static=[False, True])  # fmt: skip
+    m = make("exact", world, bodies)
+    found = m.advance(60)
+    t = (300 - 10 - 10) / 250
+    assert found["type"][0] == EV_PAIR and abs(found["t"][0] - t) <= 1e-12
+    m2 = make("exact", world, bodies)
+    m2.advance(int(t * 30))
+    y = 100 - 200 * (m2.tick / 30) + 0.5 * G * (m2.tick / 30) ** 2
+    assert m2.positions()[0, 1] == pytest.approx(y, rel=1e-13)
+
+
+def test_a_body_that_would_rest_on_a_static_one_stops_the_run_by_name():
+    world = WorldSpec(200, 1000, 60, gravity=(0.0, G))
+    bodies = Bodies.boxes([[50, 700], [40, 710]], [[10, 10], [40, 20]], [[5, 0], [0, 0]],
+                          static=[False, True])  # fmt: skip
+    m = make("exact", world, bodies)
+    with pytest.raises(NotYetExact, match="objects 0 and 1 .* tick 1 .* model: stepped") as info:
+        m.advance(10)
+    assert info.value.objects == (0, 1)
+    with pytest.raises(NotYetExact):  # and stays stopped
+        m.advance(1)

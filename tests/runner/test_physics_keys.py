@@ -329,11 +329,10 @@ def test_the_exact_model_takes_gravity(gravity):
     assert s.world.has_gravity and s.model == "exact"
 
 
-def test_the_exact_model_under_gravity_refuses_a_static_object_at_its_line():
-    text = scene(BOX + FLOOR.replace(", friction: 0.9", ""), world="gravity: 980", model="exact")
-    err = check_refused(text, "{shape: box, size: [200, 5]", "object 1 is static")
-    assert "model: stepped" in err.message
-    loads(text.replace("gravity: 980", "gravity: 0"))  # without gravity it is taken
+def test_the_exact_model_under_gravity_takes_static_objects():
+    floor = FLOOR.replace(", friction: 0.9", "")
+    s = loads(scene(BOX + floor, world="gravity: 980", model="exact"))
+    assert s.bodies.static.tolist() == [False, True]
 
 
 @pytest.mark.parametrize(

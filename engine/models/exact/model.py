@@ -60,11 +60,11 @@ The parts live in their own modules beside this one: the state layout (floats F 
 N (n, 8), scalar state; state.py), the horizon queue (horizonqueue.py), the event queue (a 4-ary
 heap; heap.py), the grid's per-cell lists (cells.py), the predictions (prediction.py) and a jam's
 objects (jam.py); from the shared engine, objects with no room to move (engine/noroom.py) and the
-event log (engine/events.py). This module applies events (`_on_cross`,
-`_on_wall`, `_on_pair`) and runs the main loop, `_run`: take the next event, apply it, predict
-again for what it touched. The kernel `_run` (with `predict` inlined) allocates nothing: growing
-the heap or the event log is done in Python between calls (the kernel stops before an event it has
-no room for, and resumes).
+event log (engine/events.py). The events themselves are applied in apply.py (`on_cross`,
+`on_wall`, `on_pair`); this module runs the main loop, `_run`: take the next event, apply it,
+predict again for what it touched. The kernel `_run` (with `predict` inlined) allocates nothing:
+growing the heap or the event log is done in Python between calls (the kernel stops before an event
+it has no room for, and resumes).
 """
 
 from __future__ import annotations
@@ -72,7 +72,7 @@ from __future__ import annotations
 import numpy as np
 
 from collide2d.engine import events, models
-from collide2d.engine.errors import EventCapExceeded, NoRoom
+from collide2d.engine.errors import EventCapExceeded, NoRoom, NotYetExact
 from collide2d.engine.events import (
     AXIS_NAMES,
     AXIS_X,
@@ -81,13 +81,11 @@ from collide2d.engine.events import (
     EV_WALL,
     SIDE_LEFT,
     SIDE_RIGHT,
-    SIDE_TOP,
     put_event,
 )
+from collide2d.engine.models.exact.apply import on_cross, on_pair, on_wall
 from collide2d.engine.models.exact.cells import (
     build_grid,
-    cell_insert,
-    cell_remove,
     grid_cell,
     grid_dims,
     room_around,
@@ -120,23 +118,18 @@ from collide2d.engine.models.exact.horizonqueue import (
     next_top,
 )
 from collide2d.engine.models.exact.jam import jammed, listing
-from collide2d.engine.models.exact.prediction import predict, set_job, velocity_at
+from collide2d.engine.models.exact.prediction import predict, set_job
 from collide2d.engine.models.exact.state import (
     AX,
     AY,
     CELL,
-    CNT,
-    DIR_DOWN,
-    DIR_LEFT,
-    DIR_RIGHT,
-    DIR_UP,
     F_COLUMNS,
     INF,
     INV_MASS,
     J_EXTRA,
     J_OBJ,
+    J_SKIP,
     JOB_CONTACTS,
-    JOB_CROSS,
     JOB_EVENT,
     JOB_FIRST,
     JOB_ROWS,
@@ -156,6 +149,7 @@ from collide2d.engine.models.exact.state import (
     STATUS_DONE,
     STATUS_HEAP_FULL,
     STATUS_LOG_FULL,
+    STATUS_REST,
     SW,
     TLOC,
     VX,
@@ -165,13 +159,11 @@ from collide2d.engine.models.exact.state import (
     World,
     X,
     Y,
-    hot,
     kernel,
     named,
     plain,
 )
 from collide2d.engine.noroom import no_room, no_room_message
-from collide2d.engine.response import exchange
 from collide2d.engine.shapes import GEOMETRIES, build_cores
 from collide2d.engine.world import Bodies, WorldSpec
 
@@ -192,86 +184,6 @@ HEAP_PER_OBJECT = 4
 # Who a runaway involves: once a tick stops at the cap, the model (stopped for good) runs up to
 # RECENT more events with the log on and looks at them, so the hot loop keeps no record of its own.
 RECENT = 64
-
-# --- events: each changes the state and says which objects to predict again --------------------
-
-
-@hot
-def _move_to(i, t, F):
-    """Bring object i's position (and, under gravity, its velocity) to time t."""
-    dt = t - F[i, TLOC]
-    if F[i, AX] == 0.0 and F[i, AY] == 0.0:
-        F[i, X] += F[i, VX] * dt
-        F[i, Y] += F[i, VY] * dt
-    else:
-        F[i, X] += F[i, VX] * dt + 0.5 * F[i, AX] * dt * dt
-        F[i, Y] += F[i, VY] * dt + 0.5 * F[i, AY] * dt * dt
-        F[i, VX] += F[i, AX] * dt
-        F[i, VY] += F[i, AY] * dt
-    F[i, TLOC] = t
-
-
-@hot
-def _on_cross(i, d, N, cells, world, jobs):
-    """i's centre enters the next cell: refile it. Returns the number of jobs (1)."""
-    gnx = world.gnx
-    gx = N[i, CELL] % gnx + (1 if d == DIR_RIGHT else -1 if d == DIR_LEFT else 0)
-    gy = N[i, CELL] // gnx + (1 if d == DIR_DOWN else -1 if d == DIR_UP else 0)
-    cell_remove(N, cells, i)
-    cell_insert(N, cells, i, gy * gnx + gx)
-    N[i, PARTNER] = -1
-    set_job(jobs, 0, i, d, JOB_CROSS)
-    return 1
-
-
-@hot
-def _on_wall(i, side, t, F, N, world, jobs):
-    """i's box touches a wall: reflect that velocity component, set it exactly on the wall line.
-    Returns the number of jobs (1)."""
-    _move_to(i, t, F)
-    if side == SIDE_LEFT or side == SIDE_RIGHT:
-        F[i, VX] = -F[i, VX]
-        F[i, X] = 0.0 if side == SIDE_LEFT else world.width - F[i, SW]
-    else:
-        F[i, VY] = -F[i, VY]
-        F[i, Y] = 0.0 if side == SIDE_TOP else world.height - F[i, SH]
-    N[i, CNT] += 1
-    N[i, PARTNER] = -1
-    set_job(jobs, 0, i, -1, JOB_EVENT)
-    return 1
-
-
-@hot
-def _on_pair(a, b, code, nx, ny, t, F, N, jobs):
-    """a and b touch: the elastic exchange; then each moving one is predicted again, but not
-    against the other. Returns the number of jobs (0: they were not approaching, no event).
-
-    The exchange reads only velocities, so it is decided before anything moves: a pair that
-    turns out not to approach leaves both objects exactly as they were, clocks included (moving
-    one to t by a rounded step would make a later prediction of it differ in its last bits from
-    one made before, and the local re-prediction then drift from the full one). For the same
-    reason a static object never moves its clock: its counter does not change either, so the
-    entries of its other pairs stay valid, and they must equal what asking again would give."""
-    vax, vay = velocity_at(a, t, F)
-    vbx, vby = velocity_at(b, t, F)
-    vax, vay, vbx, vby, changed = exchange(
-        vax, vay, vbx, vby, F[a, INV_MASS], F[b, INV_MASS], code, nx, ny
-    )
-    if not changed:
-        return 0
-    for i in (a, b):
-        if N[i, STATIC] == 0:  # a static object's clock stays at 0: its entries never go stale
-            _move_to(i, t, F)
-    F[a, VX], F[a, VY], F[b, VX], F[b, VY] = vax, vay, vbx, vby
-    n_jobs = 0
-    for i, other in ((a, b), (b, a)):
-        if N[i, STATIC] == 0:
-            N[i, CNT] += 1
-            N[i, PARTNER] = other
-            set_job(jobs, n_jobs, i, other, JOB_EVENT)
-            n_jobs += 1
-    return n_jobs
-
 
 # --- the kernel ----------------------------------------------------------------------------------
 
@@ -369,7 +281,7 @@ def _run(state, jobs, stack, tick_to, log, cap, everyone, rows, times):
                 t = e.t
             stf[SF_T_NOW] = t
             if rank == RANK_CROSS:
-                n_jobs = _on_cross(a, b, N, cells, world, jobs)
+                n_jobs = on_cross(a, b, N, cells, world, jobs)
             else:
                 st[S_TICK_EVENTS] += 1
                 if st[S_TICK_EVENTS] > cap:  # put it back: a call with a higher cap resumes
@@ -378,11 +290,14 @@ def _run(state, jobs, stack, tick_to, log, cap, everyone, rows, times):
                         push(HT, HI, HN, st, e)
                     return STATUS_CAP
                 if rank == RANK_WALL:
-                    n_jobs = _on_wall(a, b, t, F, N, world, jobs)
+                    n_jobs = on_wall(a, b, t, F, N, world, jobs)
                     kind, b = EV_WALL, -1
                 else:
-                    n_jobs = _on_pair(a, b, code, e.nx, e.ny, t, F, N, jobs)
+                    n_jobs = on_pair(a, b, code, e.nx, e.ny, t, F, N, jobs)
                     kind = EV_PAIR
+                    if n_jobs < 0:  # a body would rest on another: stopped, the pair named
+                        set_job(jobs, 0, a, b, JOB_EVENT)
+                        return STATUS_REST
                 if n_jobs > 0:  # a pair that was not approaching is no event
                     st[S_WALLS if kind == EV_WALL else S_PAIRS] += 1
                     if log:
@@ -434,11 +349,6 @@ class Model:
             raise ValueError(f"cell_size must be > 0 px, got {cell_size!r}")
         if repredict not in REPREDICT:
             raise ValueError(f"repredict must be one of {REPREDICT}, got {repredict!r}")
-        if world.has_gravity and np.any(bodies.static):
-            raise ValueError(
-                "the exact model does not yet predict a falling body meeting a static object: "
-                "under gravity it takes no static objects"
-            )
         stuck = no_room(world, bodies, geometry)
         if stuck:
             raise NoRoom(
@@ -528,6 +438,9 @@ class Model:
             elif status == STATUS_CAP:
                 self._broken = self._runaway()
                 raise self._broken
+            elif status == STATUS_REST:
+                self._broken = self._resting()
+                raise self._broken
             else:
                 break
         self.tick = int(self._st[S_TICK])
@@ -598,6 +511,18 @@ class Model:
                     AXIS_NAMES[axis],
                 )
         return EventCapExceeded(said)
+
+    def _resting(self) -> NotYetExact:
+        """The error of a run stopped where a falling body would come to rest on another (the
+        pair is in the first row of the jobs)."""
+        a, b = int(self._jobs[0, J_OBJ]), int(self._jobs[0, J_SKIP])
+        return NotYetExact(
+            f"objects {a} and {b} meet with no speed between them while gravity presses them "
+            f"together, in tick {int(self._st[S_TICK]) + 1} at t = {float(self._stf[SF_T_NOW])!r} "
+            "s: one would come to rest on the other, which the exact model does not do yet; "
+            "use model: stepped",
+            (a, b),
+        )
 
     def positions(self) -> np.ndarray:
         """(n, 2) float64 top-left corners at the last tick's end, px (each object carried from

@@ -13,6 +13,7 @@ from __future__ import annotations
 from collide2d.engine.contact import box_next_contact, box_reach, next_contact
 from collide2d.engine.events import SIDE_BOTTOM, SIDE_LEFT, SIDE_RIGHT, SIDE_TOP
 from collide2d.engine.jit import njit
+from collide2d.engine.models.exact.arccontact import Arc, Core, arc_contact
 from collide2d.engine.models.exact.cells import C_HEAD
 from collide2d.engine.models.exact.heap import RANK_CROSS, RANK_PAIR, RANK_WALL, make_key, push
 from collide2d.engine.models.exact.horizonqueue import set_horizon
@@ -207,6 +208,20 @@ def _shape_contact(a, b, qx, qy, ux, uy, now, F, N, C):
     )
 
 
+@njit(cache=True)
+def _arc_contact(a, b, path, now, N, C):
+    """arccontact.arc_contact for a pair one of which falls and the other stands (path: their
+    Arc)."""
+    radius, start, verts, normals = C.radius, C.start, C.verts, C.normals
+    core_a = Core(
+        N[a, SHAPE], radius[a], verts[start[a] : start[a + 1]], normals[start[a] : start[a + 1]]
+    )
+    core_b = Core(
+        N[b, SHAPE], radius[b], verts[start[b] : start[b + 1]], normals[start[b] : start[b + 1]]
+    )
+    return arc_contact(path, core_a, core_b, now)
+
+
 @hot
 def _predict_pair(i, j, t_now, limit, S):
     """Push the next contact of i and j if it comes no later than `limit` (s).
@@ -218,14 +233,22 @@ def _predict_pair(i, j, t_now, limit, S):
     a = min(i, j)
     b = max(i, j)
     t0 = max(F[a, TLOC], F[b, TLOC])
-    # (both fall alike, or neither does: their relative path is a straight line; the model
-    # refuses static objects under gravity)
     xa, ya, vax, vay = _state_at(a, t0, F)
     xb, yb, vbx, vby = _state_at(b, t0, F)
     qx = xb - xa
     qy = yb - ya
     ux = vbx - vax
     uy = vby - vay
+    ax = F[b, AX] - F[a, AX]
+    ay = F[b, AY] - F[a, AY]
+    if ax != 0.0 or ay != 0.0:  # one falls, the other stands: a curved relative path
+        path = Arc(qx, qy, ux, uy, ax, ay)
+        t, code, nx, ny = _arc_contact(a, b, path, t_now - t0, N, S.C)
+        t = max(t0 + t, t_now)
+        if t <= limit:
+            e = Entry(t, make_key(RANK_PAIR, a, b, code), N[a, CNT], N[b, CNT], nx, ny)
+            push(S.HT, S.HI, S.HN, S.st, e)
+        return
     if not box_reach(qx, qy, ux, uy, F[a, SW], F[a, SH], F[b, SW], F[b, SH], limit - t0):
         return
     now = t_now - t0

@@ -127,6 +127,7 @@ STATUS_DONE = 0
 STATUS_CAP = 1
 STATUS_HEAP_FULL = 2
 STATUS_LOG_FULL = 3
+STATUS_REST = 4  # a falling body would rest on another (the pair in jobs' first row)
 
 INF = np.inf
 # Small helpers are inlined into the kernels (`hot`). The kernels (`kernel`) allocate nothing and
