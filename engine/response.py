@@ -19,6 +19,8 @@ own sign, and only on an axis along which the pair approaches.
 
 from __future__ import annotations
 
+import math
+
 from collide2d.engine.errors import FoldLimitExceeded
 from collide2d.engine.events import AXIS_XY
 from collide2d.engine.jit import njit
@@ -34,12 +36,57 @@ def exchange_along(vax, vay, vbx, vby, wa, wb, nx, ny):
     v* px/s; wa, wb inverse masses (not both 0). Returns (vax, vay, vbx, vby, changed): the new
     velocities, and changed = True when they were approaching along n (otherwise no change).
     """
+    return impact_along(vax, vay, vbx, vby, wa, wb, nx, ny, 1.0, 0.0)
+
+
+@njit(cache=True, inline="always")
+def impact_along(vax, vay, vbx, vby, wa, wb, nx, ny, e, mu):
+    """The impact of a and b along the unit normal n (from a to b) with restitution e and
+    friction mu (docs/models.md#the-elastic-exchange): the normal impulse leaves the approach
+    speed u at -e·u; the tangential one stops the sliding if that takes at most mu times the
+    normal one, else is mu times it against the sliding. At e = 1 and mu = 0 it is the elastic
+    exchange to the bit ((1 + 1) is 2 exactly, and no friction is computed). Returns (vax, vay,
+    vbx, vby, changed)."""
     u = (vbx - vax) * nx + (vby - vay) * ny
     if not u < 0.0:
         return vax, vay, vbx, vby, False
-    ja = 2.0 * u * (wa / (wa + wb))
-    jb = 2.0 * u * (wb / (wa + wb))
-    return vax + ja * nx, vay + ja * ny, vbx - jb * nx, vby - jb * ny, True
+    ra = wa / (wa + wb)
+    rb = wb / (wa + wb)
+    ja = (1.0 + e) * u * ra
+    jb = (1.0 + e) * u * rb
+    vax, vay = vax + ja * nx, vay + ja * ny
+    vbx, vby = vbx - jb * nx, vby - jb * ny
+    if mu > 0.0:
+        # the sliding of b along a before the impact, and what friction takes of it
+        tx = (vbx - vax) - ((vbx - vax) * nx + (vby - vay) * ny) * nx
+        ty = (vby - vay) - ((vbx - vax) * nx + (vby - vay) * ny) * ny
+        slide = math.sqrt(tx * tx + ty * ty)
+        if slide > 0.0:
+            take = min(slide, mu * (1.0 + e) * -u) / slide
+            vax, vay = vax + take * ra * tx, vay + take * ra * ty
+            vbx, vby = vbx - take * rb * tx, vby - take * rb * ty
+    return vax, vay, vbx, vby, True
+
+
+@njit(cache=True, inline="always")
+def impact(vax, vay, vbx, vby, wa, wb, code, nx, ny, e, mu):
+    """`exchange` with restitution e and friction mu (impact_along); AXIS_XY (a corner) acts on
+    each axis apart, without friction. Returns (vax, vay, vbx, vby, changed)."""
+    if code == AXIS_XY:
+        vax, vay, vbx, vby, done_x = impact_along(vax, vay, vbx, vby, wa, wb, nx, 0.0, e, 0.0)
+        vax, vay, vbx, vby, done_y = impact_along(vax, vay, vbx, vby, wa, wb, 0.0, ny, e, 0.0)
+        return vax, vay, vbx, vby, done_x or done_y
+    return impact_along(vax, vay, vbx, vby, wa, wb, nx, ny, e, mu)
+
+
+@njit(cache=True, inline="always")
+def wall_impact(vn, vt, e, mu):
+    """A wall impact: the velocity component into the wall vn and the one along it vt after, with
+    restitution e and friction mu (at most what stops the sliding)."""
+    if mu > 0.0 and vt != 0.0:
+        take = min(abs(vt), mu * (1.0 + e) * abs(vn))
+        vt = vt - take if vt > 0.0 else vt + take
+    return -e * vn, vt
 
 
 @njit(cache=True, inline="always")

@@ -341,7 +341,8 @@ class _Reader(ModelReader):
         rules = None
         if settings is not FAILED:
             model, geometry = settings.kind, settings.geometry
-            rules = ModelRules.of(model, geometry, self.model_from)
+            falling = world_background is not FAILED and world.has_gravity
+            rules = ModelRules.of(model, geometry, self.model_from, falling)
         objects.check(listed, blocks, world_in, rules, self.fps_from)
         if table is not FAILED:
             table = self.attempt(self.checked, table, fast, world_in, rules)

@@ -84,19 +84,21 @@ class ModelRules:
     whole_velocities: bool = False  # generated velocities are whole numbers (paper)
     polygon_area: bool = False  # polygons have some area (geometry exact)
     origin: str | None = None  # "--model M" when the model came from the command line
-    # restitution 1 and friction 0 only (the exact model, elastic and frictionless for now); the
-    # paper model takes neither (paper_rates)
+    # restitution 1 only (the exact model under gravity, where bodies do not rest yet); the paper
+    # model takes no restitution nor friction at all (paper_rates)
     elastic: bool = False
 
     @classmethod
-    def of(cls, model: str, geometry: str, origin: str | None = None) -> ModelRules:
+    def of(
+        cls, model: str, geometry: str, origin: str | None = None, gravity: bool = False
+    ) -> ModelRules:
         paper = model == "paper"
         return cls(
             paper_rates=paper,
             whole_velocities=paper,
             polygon_area=geometry == "exact",
             origin=origin,
-            elastic=model == "exact",
+            elastic=model == "exact" and gravity,
         )
 
 

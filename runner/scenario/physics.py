@@ -122,14 +122,14 @@ class ModelReader(Nodes):
 
     def check_world_physics(self, physics: WorldPhysics, kind: str) -> None:
         """The world's physics keys the model `kind` does not take, each refused at its value
-        (all of them, when collecting errors): the paper model takes none, the exact model only
-        their defaults."""
+        (all of them, when collecting errors): the paper model takes none, the exact model under
+        gravity no restitution below 1."""
         said = self.prefix(self.model_from)
         for key, (_, vnode) in physics.nodes.items():
             text = None
             if kind == "paper":
                 text = PAPER_REFUSES.format(key=key)
-            elif kind == "exact" and key != "gravity":
+            elif kind == "exact" and key == "restitution" and physics.gravity != (0.0, 0.0):
                 text = EXACT_REFUSES[key] if getattr(physics, key) != WORLD_PHYSICS[key] else None
             if text is not None:
                 self.attempt(_raise, self.error(vnode, f"{said}world.{key} {text}"))

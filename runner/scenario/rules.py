@@ -15,8 +15,8 @@ The rules (docs/scenario-format.md, docs/limits.md):
 - a mass, when given, lies in [MIN_MASS, MAX_MASS], and a static object has none (it is infinite);
 - a velocity component lies in [-MAX_SPEED, MAX_SPEED], and a static object's is 0;
 - a restitution, when given, lies in [0, 1], and a friction in [0, MAX_FRICTION]; the paper model
-  takes neither (the paper has no restitution, friction or gravity), and the exact model, elastic
-  and frictionless for now, takes only restitution 1 and friction 0
+  takes neither (the paper has no restitution, friction or gravity), and the exact model under
+  gravity, where bodies do not rest yet, only restitution 1
   (docs/scenario-format.md#gravity-restitution-and-friction);
 - under the paper model a position is a whole number of pixels and a moving object's velocity
   component is a rate the model can take at the world's fps (`engine.motion.paper_rate`);
@@ -150,8 +150,8 @@ def faults(
     cols: Columns, paper: bool, fps: int | None, world=None, elastic: bool = False
 ) -> list[Fault]:
     """Every rule broken by `cols` (at most MAX_FAULTS rows a rule), in no particular order: those
-    of each object alone under the model (`paper`; `elastic`: the exact model, which takes no
-    restitution below 1 nor friction) at `fps` (None: the paper model's rates wait for it), and,
+    of each object alone under the model (`paper`; `elastic`: the exact model under gravity, which
+    takes no restitution below 1) at `fps` (None: the paper model's rates wait for it), and,
     when `world` (width, height) is given, the world's bounds."""
     out: list[Fault] = []
     size = cols.size
@@ -229,10 +229,8 @@ PAPER_REFUSES = (
     "elastic and weightless); {key} needs model: stepped"
 )
 EXACT_REFUSES = {
-    "restitution": "must be 1 under the exact model, which is elastic for now; a restitution "
-    "below 1 needs model: stepped",
-    "friction": "must be 0 under the exact model, which is frictionless for now; friction needs "
-    "model: stepped",
+    "restitution": "must be 1 under the exact model with gravity, where bodies do not rest yet (a "
+    "ball with a restitution below 1 bounces ever lower, without end); it needs model: stepped",
 }
 
 
@@ -252,7 +250,7 @@ def _contact_faults(cols: Columns, paper: bool, elastic: bool, out: list) -> Non
             bound = "at least 0" if low[r] else f"at most {fmt(hi)}"
             out.append(Fault(r, key, 0, f"must be {bound}, not {fmt(float(v[r]))}"))
         refused = given if paper else given & (v != default) if elastic else None
-        if refused is None:
+        if refused is None or key not in EXACT_REFUSES and not paper:
             continue
         text = PAPER_REFUSES.format(key=key) if paper else EXACT_REFUSES[key]
         for r in _rows(refused & ~low & ~high):

@@ -276,17 +276,25 @@ def test_model_paper_on_the_command_line_names_the_option():
 @pytest.mark.parametrize(
     "world, objects, needle, fragment",
     [
-        ("restitution: 0.9", "", "0.9", "world.restitution must be 1 under the exact model"),
-        ("friction: 0.1", "", "0.1", "world.friction must be 0 under the exact model"),
-        ("gravity: 0", BALL, "0.8", "objects[0].restitution must be 1 under the exact model"),
-        ("gravity: 0", BALL.replace("0.8", "1"), "0.4", "friction must be 0 under the exact"),
+        ("gravity: 980, restitution: 0.9", "", "0.9", "world.restitution must be 1 under the"),
+        ("gravity: [1, 0]", BALL, "0.8", "objects[0].restitution must be 1 under the exact model"),
     ],
 )
-def test_the_exact_model_takes_only_the_defaults_and_names_stepped(
+def test_the_exact_model_under_gravity_takes_no_restitution_below_1_and_names_stepped(
     world, objects, needle, fragment
 ):
     err = check_refused(scene(objects, world=world, model="exact"), needle, fragment)
+    assert "with gravity, where bodies do not rest yet" in err.message
     assert "model: stepped" in err.message
+
+
+def test_the_exact_model_takes_restitution_without_gravity_and_friction_always():
+    s = loads(scene(BALL, world="gravity: 0, restitution: 0.5, friction: 0.2", model="exact"))
+    assert s.bodies.restitution.tolist() == [0.8] and s.bodies.friction.tolist() == [0.4]
+    assert (s.world.restitution, s.world.friction) == (0.5, 0.2)
+    elastic_ball = BALL.replace("0.8", "1")
+    s = loads(scene(elastic_ball, world="gravity: 980, friction: 0.3", model="exact"))
+    assert s.bodies.friction.tolist() == [0.4] and s.world.friction == 0.3
 
 
 def test_the_exact_model_takes_the_defaults_written_out():
@@ -315,11 +323,11 @@ def test_a_model_given_on_the_command_line_drops_the_files_stepped_settings():
 
 
 def test_model_exact_on_the_command_line_names_the_option_and_stepped():
-    text = scene(BALL.replace("0.8", "1"), world="gravity: 980")
+    text = scene(BALL, world="gravity: 980")
     err = refused(text, overrides={"model": "exact"})
     lines = str(err).splitlines()
     assert len(lines) == 1
-    assert "--model exact: objects[0].friction must be 0 under the exact model" in lines[0]
+    assert "--model exact: objects[0].restitution must be 1 under the exact model" in lines[0]
     assert "model: stepped" in lines[0]
 
 

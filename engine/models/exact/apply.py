@@ -4,10 +4,12 @@ predicted again (docs/models.md#exact).
 A cell crossing refiles the object in the grid (cells.py); a wall contact reflects the velocity
 component normal to the wall and sets the object exactly on the wall's line; a pair contact
 exchanges velocities (engine/response.py) at the contact instant, the velocities under gravity
-taken at that instant. Each writes its prediction jobs (state.py) and returns how many; a pair that
-does not approach is no event (0 jobs), and one pressed together with no speed while one of the
-two falls on the other (which would come to rest on it) returns -1: the model stops there.
-`move_to` carries an object's position, and under gravity its velocity, to a time.
+taken at that instant. Both act with the contact's restitution (the smaller of its two sides')
+and friction (the larger): elastic and frictionless at the defaults, to the bit. Each writes its
+prediction jobs (state.py) and returns how many; a pair that does not approach is no event (0
+jobs), and one pressed together with no speed while one of the two falls on the other (which
+would come to rest on it) returns -1: the model stops there. `move_to` carries an object's
+position, and under gravity its velocity, to a time.
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from collide2d.engine.models.exact.state import (
     INV_MASS,
     JOB_CROSS,
     JOB_EVENT,
+    MU,
     PARTNER,
     SH,
     STATIC,
@@ -34,11 +37,12 @@ from collide2d.engine.models.exact.state import (
     TLOC,
     VX,
     VY,
+    E,
     X,
     Y,
     hot,
 )
-from collide2d.engine.response import exchange
+from collide2d.engine.response import impact, wall_impact
 
 
 @hot
@@ -71,14 +75,17 @@ def on_cross(i, d, N, cells, world, jobs):
 
 @hot
 def on_wall(i, side, t, F, N, world, jobs):
-    """i's box touches a wall: reflect that velocity component, set it exactly on the wall line.
-    Returns the number of jobs (1)."""
+    """i's box touches a wall: reflect that velocity component (times the contact's restitution,
+    the smaller of the object's and the walls'; friction, the larger, takes from the component
+    along the wall), set it exactly on the wall line. Returns the number of jobs (1)."""
     move_to(i, t, F)
+    e = min(F[i, E], world.restitution)
+    mu = max(F[i, MU], world.friction)
     if side == SIDE_LEFT or side == SIDE_RIGHT:
-        F[i, VX] = -F[i, VX]
+        F[i, VX], F[i, VY] = wall_impact(F[i, VX], F[i, VY], e, mu)
         F[i, X] = 0.0 if side == SIDE_LEFT else world.width - F[i, SW]
     else:
-        F[i, VY] = -F[i, VY]
+        F[i, VY], F[i, VX] = wall_impact(F[i, VY], F[i, VX], e, mu)
         F[i, Y] = 0.0 if side == SIDE_TOP else world.height - F[i, SH]
     N[i, CNT] += 1
     N[i, PARTNER] = -1
@@ -99,8 +106,10 @@ def on_pair(a, b, code, nx, ny, t, F, N, jobs):
     entries of its other pairs stay valid, and they must equal what asking again would give."""
     vax, vay = velocity_at(a, t, F)
     vbx, vby = velocity_at(b, t, F)
-    vax, vay, vbx, vby, changed = exchange(
-        vax, vay, vbx, vby, F[a, INV_MASS], F[b, INV_MASS], code, nx, ny
+    e = min(F[a, E], F[b, E])
+    mu = max(F[a, MU], F[b, MU])
+    vax, vay, vbx, vby, changed = impact(
+        vax, vay, vbx, vby, F[a, INV_MASS], F[b, INV_MASS], code, nx, ny, e, mu
     )
     # one falls, the other stands: their relative path is curved, and may meet again
     ax = F[b, AX] - F[a, AX]

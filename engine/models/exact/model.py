@@ -56,7 +56,7 @@ error is NoRoom naming them (the hot loop keeps no record for this).
 
 The kernel counts the wall and pair events as they happen, logged or not (`event_counts`).
 
-The parts live in their own modules beside this one: the state layout (floats F (n, 10), ints
+The parts live in their own modules beside this one: the state layout (floats F (n, 12), ints
 N (n, 8), scalar state; state.py), the horizon queue (horizonqueue.py), the event queue (a 4-ary
 heap; heap.py), the grid's per-cell lists (cells.py), the predictions (prediction.py) and a jam's
 objects (jam.py); from the shared engine, objects with no room to move (engine/noroom.py) and the
@@ -133,6 +133,7 @@ from collide2d.engine.models.exact.state import (
     JOB_EVENT,
     JOB_FIRST,
     JOB_ROWS,
+    MU,
     PARTNER,
     S_FIRST,
     S_HEAP_N,
@@ -155,6 +156,7 @@ from collide2d.engine.models.exact.state import (
     VX,
     VY,
     Cores,
+    E,
     State,
     World,
     X,
@@ -371,6 +373,8 @@ class Model:
         self._F[:, SW : SH + 1] = bodies.size
         self._F[:, INV_MASS] = bodies.inv_mass
         self._F[~static, AX : AY + 1] = world.gravity
+        self._F[:, E] = bodies.restitution
+        self._F[:, MU] = bodies.friction
         self.gravity = world.has_gravity
         self._N = np.zeros((n, 8), np.int64)
         self._N[:, PARTNER] = -1
@@ -388,7 +392,14 @@ class Model:
         self.cell_size = float(cell_size)
         gnx, gny = grid_dims(world.width, world.height, self.cell_size)
         self._world = World(
-            float(world.width), float(world.height), float(world.fps), self.cell_size, gnx, gny
+            float(world.width),
+            float(world.height),
+            float(world.fps),
+            self.cell_size,
+            gnx,
+            gny,
+            float(world.restitution),
+            float(world.friction),
         )
         self._G = build_grid(self._F, self._N, self.cell_size, gnx, gny)
         cap = max(64, HEAP_PER_OBJECT * n)

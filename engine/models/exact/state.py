@@ -1,7 +1,7 @@
 """The exact model's state layout: its records, the columns of its arrays, its scalar state, its
 statuses.
 
-The exact model (model.py) keeps its objects in two arrays, floats F (n, 10) and ints
+The exact model (model.py) keeps its objects in two arrays, floats F (n, 12) and ints
 N (n, 8), and its counters in `st` (int64) and `stf` (float64); the event queue (heap.py),
 the grid lists (cells.py) and the predictions (prediction.py) all read them by the names below.
 Its kernels share one record, `State`, read by field, which holds the others: `World` (the
@@ -33,6 +33,8 @@ class World(NamedTuple):
     cell: float  # the grid's cell side, px
     gnx: int  # the grid's columns
     gny: int  # the grid's rows
+    restitution: float  # the walls' e
+    friction: float  # the walls' mu
 
 
 class Cores(NamedTuple):
@@ -71,7 +73,7 @@ class Entry(NamedTuple):
 class State(NamedTuple):
     """The arrays the exact model's kernels share, handed to them as one argument."""
 
-    F: np.ndarray  # (n, 10) float64, columns below
+    F: np.ndarray  # (n, 12) float64, columns below
     N: np.ndarray  # (n, 8) int64, columns below
     C: Cores  # exact shapes
     cells: np.ndarray  # the grid's per-cell lists of movers (cells.py)
@@ -91,11 +93,12 @@ def plain(S: State) -> tuple:
     return tuple(S._replace(C=tuple(S.C), Q=tuple(S.Q), world=tuple(S.world)))
 
 
-# Columns of F (n, 10) float64: position (top-left, px) and velocity (px/s) valid at the object's
+# Columns of F (n, 12) float64: position (top-left, px) and velocity (px/s) valid at the object's
 # own clock TLOC (s), box size (px), inverse mass (0 for static objects), acceleration (px/s²:
-# the world's gravity for a moving object, 0 for a static one and without gravity).
-X, Y, VX, VY, TLOC, SW, SH, INV_MASS, AX, AY = range(10)
-F_COLUMNS = 10
+# the world's gravity for a moving object, 0 for a static one and without gravity), restitution
+# and friction.
+X, Y, VX, VY, TLOC, SW, SH, INV_MASS, AX, AY, E, MU = range(12)
+F_COLUMNS = 12
 # Columns of N (n, 8) int64: invalidation counter, static flag, contact shape kind, grid cell,
 # next / previous object in that cell's list (-1 for none), last query stamp (static objects),
 # the partner of its last event if that was a pair (-1 otherwise).
