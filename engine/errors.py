@@ -5,9 +5,9 @@ A runaway is a scene the model cannot carry forward in bounded work: the exact m
 move on an axis (`NoRoom`: under the exact model it would collide again and again without time
 passing), the stepped model's fold limit (`FoldLimitExceeded`: an object crossing the world too
 many times in one step), and what the exact model cannot carry on yet (`NotYetExact`: under
-gravity, a body that comes to rest on a static object). Callers catch `Runaway` and show
-`str(err)`, which says what stopped and why; the engine never prints. `FoldLimitExceeded` is
-raised inside a compiled kernel, so its message is a constant.
+gravity, a body that comes to rest on a static object or another body). Callers catch `Runaway`
+and show `str(err)`, which says what stopped and why; the engine never prints.
+`FoldLimitExceeded` is raised inside a compiled kernel, so its message is a constant.
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ class FoldLimitExceeded(Runaway, ValueError):
 
 class NotYetExact(Runaway, RuntimeError):
     """The exact model met what it does not yet carry on exactly (a body that comes to rest on a
-    static object under gravity); `objects` lists the ids involved."""
+    static object or another body under gravity); `objects` lists the ids involved."""
 
     def __init__(self, message: str, objects: tuple[int, ...] = ()):
         super().__init__(message)

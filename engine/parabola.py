@@ -1,6 +1,6 @@
 """Motion under a uniform acceleration, shared by the models that have gravity: the first instant
-a gap closes (docs/models.md#stepped-gravity-restitution-and-friction,
-docs/models.md#exact-under-gravity).
+a gap closes, and the acceleration of a body sliding on a wall
+(docs/models.md#stepped-gravity-restitution-and-friction, docs/models.md#exact-under-gravity).
 
 Each axis of a body under gravity is a 1-D motion of constant acceleration, `p + v·t + ½·a·t²`,
 exact for uniform gravity. A gap h >= 0 to something that does not share that acceleration (a
@@ -35,3 +35,18 @@ def meet(h, v, a):
     if a < 0.0:
         return (v + math.sqrt(v * v - 2.0 * a * h)) / -a
     return INF
+
+
+@njit(cache=True, inline="always")
+def slide_acceleration(g, v, mu, pull):
+    """The acceleration along a wall of a body resting on it: gravity along it, g, less friction
+    against the motion, mu times `pull` (gravity's pull into the wall, >= 0); at rest, static
+    friction holds it when strong enough, else it starts sliding the way gravity pulls."""
+    grip = mu * pull
+    if v > 0.0:
+        return g - grip
+    if v < 0.0:
+        return g + grip
+    if abs(g) <= grip:
+        return 0.0
+    return g - grip if g > 0.0 else g + grip

@@ -31,7 +31,7 @@ from __future__ import annotations
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
-from collide2d.engine.events import EV_PAIR, EV_WALL
+from collide2d.engine.events import EV_PAIR
 from collide2d.engine.picture.pixels import dda_line, midpoint_circle
 from collide2d.engine.picture.raster import round_positions
 from collide2d.engine.picture.sprites import sprites
@@ -220,7 +220,7 @@ class Overlay:
                     pen.line(tx, ty, hx, hy, self.index["velocity"])
         if "contacts" in self.names and len(events):
             for rec in events:
-                ids = [int(rec["a"])] + ([int(rec["b"])] if rec["type"] != EV_WALL else [])
+                ids = [int(rec["a"])] + ([int(rec["b"])] if rec["type"] == EV_PAIR else [])
                 for i in ids:
                     x0, y0, x1, y1 = ext[i]
                     side = max(x1 - x0, y1 - y0) + 1 + 2 * RING_GAP_PX

@@ -35,7 +35,7 @@ import zlib
 
 import numpy as np
 
-from collide2d.engine.events import EV_WALL, event_dict
+from collide2d.engine.events import EV_PAIR, event_dict
 from collide2d.engine.picture.raster import round_positions
 from collide2d.engine.picture.sprites import sprites
 from collide2d.runner.scenario.load import ScenarioError
@@ -117,11 +117,11 @@ class Recorder:
         room = MAX_EVENTS - len(self.event_rows)
         for rec in events[: max(room, 0)]:
             d = event_dict(rec)
-            kind = 0 if rec["type"] == EV_WALL else 1
+            kind = int(rec["type"])  # engine.events: wall, pair, rest, stop, wake
             detail = d.get("side") or d.get("axis") or ""
             if "xdiff" in d:
                 detail += f" xdiff {d['xdiff']} ydiff {d['ydiff']}"
-            b = int(rec["b"]) if kind else -1
+            b = int(rec["b"]) if kind == EV_PAIR else -1
             self.event_rows.append([int(rec["tick"]), kind, int(rec["a"]), b, detail])
         self.n_events += len(events)
 

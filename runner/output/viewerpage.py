@@ -243,8 +243,8 @@ _JS = r"""
         (byTick[k - back] || []).forEach(function (li) {
           var e = D.events[li.dataset.index];
           var alpha = 1 - back / FLASH_FRAMES;
-          ctx.strokeStyle = e[1] ? "rgba(255,96,0," + alpha + ")"
-                                 : "rgba(255,230,0," + alpha + ")";
+          ctx.strokeStyle = e[1] === 1 ? "rgba(255,96,0," + alpha + ")"
+                                       : "rgba(255,230,0," + alpha + ")";
           ctx.lineWidth = 2;
           [e[2], e[3]].forEach(function (i) {
             if (i < 0) return;
@@ -346,6 +346,8 @@ _JS = r"""
   }
   function setZoom(z) { zoom = z; zoomSel.value = String(z); draw(); }
 
+  var KINDS = ["wall", "pair", "rest", "stop", "wake"];  // engine/events.py TYPE_NAMES
+
   function buildEvents() {
     document.getElementById("event-count").textContent = D.eventCount > D.events.length
       ? "(first " + D.events.length + " of " + D.eventCount + ")" : "(" + D.eventCount + ")";
@@ -354,9 +356,10 @@ _JS = r"""
       var li = document.createElement("li");
       li.dataset.index = String(idx);
       li.dataset.tick = String(e[0]);
-      var who = e[1] ? D.names[e[2]] + " + " + D.names[e[3]] : D.names[e[2]] + " wall";
-      li.textContent = "tick " + e[0] + ": " + (e[1] ? "pair " : "wall ") + who +
-        " (" + e[4] + ")";
+      var kind = KINDS[e[1]] || "event";
+      var who = e[1] === 1 ? D.names[e[2]] + " + " + D.names[e[3]]
+        : D.names[e[2]] + (e[1] === 0 ? " wall" : "");
+      li.textContent = "tick " + e[0] + ": " + kind + " " + who + " (" + e[4] + ")";
       li.addEventListener("click", function () {
         list.querySelectorAll("li.selected").forEach(function (o) {
           o.classList.remove("selected");

@@ -204,32 +204,6 @@ def check_room(reader, world, bodies, geometry, names, listed, lines, table=None
     raise ScenarioError(reader.path, lines[i], 1, message)
 
 
-def check_exact_gravity(reader, world, bodies, listed, lines, table=None) -> None:
-    """Refuse, at the object, what the exact model does not yet take under gravity
-    (docs/models.md#exact-under-gravity): a moving object at rest on a wall that gravity pulls it
-    into (it would bounce with no speed again and again at one instant; bodies do not rest
-    yet)."""
-    if not world.has_gravity:
-        return
-    lying = np.zeros(bodies.n, bool)
-    room = np.array([world.width, world.height], dtype=np.float64) - bodies.size
-    for axis, g in enumerate(world.gravity):
-        on = bodies.pos[:, axis] >= room[:, axis] if g > 0 else bodies.pos[:, axis] <= 0.0
-        lying |= (g != 0.0) & on & (bodies.vel[:, axis] == 0.0) & ~bodies.static
-    if not lying.any():
-        return
-    i = int(np.flatnonzero(lying)[0])
-    message = reader.prefix(reader.model_from) + (
-        f"object {i} lies still on a wall that gravity pulls it into, and the exact model does not "
-        "yet let bodies rest; use model: stepped, or start it above the wall or moving away from it"
-    )
-    if i < len(listed):
-        raise reader.error(listed[i].node, message)
-    if table is not None and i < table.n:
-        raise table.error(i, "y", message)
-    raise ScenarioError(reader.path, lines[i], 1, message)
-
-
 def check_names(reader: Nodes, names, listed, blocks, lines) -> None:
     """No two objects share a name (a generate block's `name` names its objects NAME-0, ...); a
     repeat is refused at the later object: its node, its table cell, or its block's line."""

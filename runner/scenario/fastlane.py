@@ -396,7 +396,7 @@ def table(split_: Split, world, model, max_objects: int):
     # every rule of objects (runner.scenario.rules): any fault is the general path's to say
     found = rules.Columns(size, pos, vel, mass, static, **contact)
     bounds = (world.width, world.height)
-    if rules.faults(found, model.paper_rates, world.fps, bounds, model.elastic):
+    if rules.faults(found, model.paper_rates, world.fps, bounds):
         raise FallBack
     color_word = words("color")
     unique, first, of = np.unique(color_word, return_index=True, return_inverse=True)

@@ -341,8 +341,7 @@ class _Reader(ModelReader):
         rules = None
         if settings is not FAILED:
             model, geometry = settings.kind, settings.geometry
-            falling = world_background is not FAILED and world.has_gravity
-            rules = ModelRules.of(model, geometry, self.model_from, falling)
+            rules = ModelRules.of(model, geometry, self.model_from)
         objects.check(listed, blocks, world_in, rules, self.fps_from)
         if table is not FAILED:
             table = self.attempt(self.checked, table, fast, world_in, rules)
@@ -363,7 +362,6 @@ class _Reader(ModelReader):
         assemble.check_plugin(self, model, geometry, bodies, lines, top)  # engine.models.protocol
         if model == "exact":
             assemble.check_room(self, world, bodies, geometry, names, listed, lines, table)
-            assemble.check_exact_gravity(self, world, bodies, listed, lines, table)
         return Scenario(
             path=self.file_path,
             name=name,
@@ -485,8 +483,7 @@ class _Reader(ModelReader):
         if fast is not None and world is not None and rules is not None:
             return yamlfast.table(fast, world, rules, self.limits.max_objects)
         if table is not None:
-            paper, elastic = (rules.paper_rates, rules.elastic) if rules else (False, False)
-            table = tables.checked(table, world, paper, elastic)
+            table = tables.checked(table, world, rules.paper_rates if rules else False)
         return table
 
     def ticks(self, top: dict, fps: int) -> int:

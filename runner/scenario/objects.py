@@ -84,21 +84,15 @@ class ModelRules:
     whole_velocities: bool = False  # generated velocities are whole numbers (paper)
     polygon_area: bool = False  # polygons have some area (geometry exact)
     origin: str | None = None  # "--model M" when the model came from the command line
-    # restitution 1 only (the exact model under gravity, where bodies do not rest yet); the paper
-    # model takes no restitution nor friction at all (paper_rates)
-    elastic: bool = False
 
     @classmethod
-    def of(
-        cls, model: str, geometry: str, origin: str | None = None, gravity: bool = False
-    ) -> ModelRules:
+    def of(cls, model: str, geometry: str, origin: str | None = None) -> ModelRules:
         paper = model == "paper"
         return cls(
             paper_rates=paper,
             whole_velocities=paper,
             polygon_area=geometry == "exact",
             origin=origin,
-            elastic=model == "exact" and gravity,
         )
 
 
@@ -394,7 +388,7 @@ class ObjectReader(Nodes):
         cols = _columns(listed, [o.written for o in listed], [o.vel for o in listed])
         cols.corner = np.array([o.pos for o in listed], np.float64).reshape(-1, 2)
         fps, bounds = (world.fps, (world.width, world.height)) if world else (None, None)
-        found = rule.faults(cols, model.paper_rates, fps, bounds, model.elastic)
+        found = rule.faults(cols, model.paper_rates, fps, bounds)
         for f in rule.first_per_row(found):
             if f.row not in refused:
                 self.attempt(_raise, self.fault(listed, f, model, fps_from, "objects"))
@@ -526,7 +520,7 @@ class ObjectReader(Nodes):
             b.spec = dataclasses.replace(b.spec, whole=model.whole_velocities)
         speed = [(b.spec.speed or 0.0,) * 2 for b in blocks]
         cols = _columns(blocks, np.zeros((len(blocks), 2)), speed)
-        found = rule.first_per_row(rule.faults(cols, model.paper_rates, fps, None, model.elastic))
+        found = rule.first_per_row(rule.faults(cols, model.paper_rates, fps, None))
         refused = {f.row for f in found}
         for f in found:
             self.attempt(_raise, self.fault(blocks, f, model, fps_from, "generate"))

@@ -10,10 +10,10 @@ geometry, the exact model's event cap, and the stepped model's settings for cont
 that the model's own default holds); `world_physics` reads `world.gravity` (`[gx, gy]` px/s², or
 one number g meaning `[0, g]`, y down), `world.restitution` and `world.friction` (the walls'), and
 `check_world_physics` holds them against the model once both are known: the paper model takes
-none of them (the paper has none), and the exact model, elastic, frictionless and weightless
-until it learns them, takes only their defaults, each refused at its line with a message naming
-`stepped`. A setting given to a model that does not take it is refused at its line. An object's
-restitution and friction follow the rules of objects (`runner.scenario.rules`).
+none of them (the paper has none), each refused at its line with a message naming `stepped`;
+the stepped and exact models take them all. A setting given to a model that does not take it is
+refused at its line. An object's restitution and friction follow the rules of objects
+(`runner.scenario.rules`).
 
 Bounds: a gravity component lies within MAX_GRAVITY px/s². With the world's side and the mass
 bounded (runner.scenario.load, "Numbers"), a body falling across the whole world gains at most
@@ -31,7 +31,7 @@ import yaml
 from collide2d.engine.models import MAX_EVENTS_PER_TICK, names_for
 from collide2d.engine.shapes import GEOMETRIES
 from collide2d.runner.scenario.nodes import Nodes, _raise
-from collide2d.runner.scenario.rules import EXACT_REFUSES, MAX_FRICTION, MAX_SPEED, PAPER_REFUSES
+from collide2d.runner.scenario.rules import MAX_FRICTION, MAX_SPEED, PAPER_REFUSES
 
 MAX_SUBSTEPS = 10_000  # substeps per tick of the stepped model
 MAX_ITERATIONS = 1_000  # velocity passes per step of the stepped model (peers use 4 to 10)
@@ -122,17 +122,13 @@ class ModelReader(Nodes):
 
     def check_world_physics(self, physics: WorldPhysics, kind: str) -> None:
         """The world's physics keys the model `kind` does not take, each refused at its value
-        (all of them, when collecting errors): the paper model takes none, the exact model under
-        gravity no restitution below 1."""
+        (all of them, when collecting errors): the paper model takes none."""
+        if kind != "paper":
+            return
         said = self.prefix(self.model_from)
         for key, (_, vnode) in physics.nodes.items():
-            text = None
-            if kind == "paper":
-                text = PAPER_REFUSES.format(key=key)
-            elif kind == "exact" and key == "restitution" and physics.gravity != (0.0, 0.0):
-                text = EXACT_REFUSES[key] if getattr(physics, key) != WORLD_PHYSICS[key] else None
-            if text is not None:
-                self.attempt(_raise, self.error(vnode, f"{said}world.{key} {text}"))
+            text = PAPER_REFUSES.format(key=key)
+            self.attempt(_raise, self.error(vnode, f"{said}world.{key} {text}"))
 
     def model(self, top: dict) -> ModelSettings:
         """The ModelSettings of `model` and the overrides."""

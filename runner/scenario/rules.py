@@ -15,9 +15,8 @@ The rules (docs/scenario-format.md, docs/limits.md):
 - a mass, when given, lies in [MIN_MASS, MAX_MASS], and a static object has none (it is infinite);
 - a velocity component lies in [-MAX_SPEED, MAX_SPEED], and a static object's is 0;
 - a restitution, when given, lies in [0, 1], and a friction in [0, MAX_FRICTION]; the paper model
-  takes neither (the paper has no restitution, friction or gravity), and the exact model under
-  gravity, where bodies do not rest yet, only restitution 1
-  (docs/scenario-format.md#gravity-restitution-and-friction);
+  takes neither (the paper has no restitution, friction or gravity;
+  docs/scenario-format.md#gravity-restitution-and-friction);
 - under the paper model a position is a whole number of pixels and a moving object's velocity
   component is a rate the model can take at the world's fps (`engine.motion.paper_rate`);
 - with the world known, every object's box lies inside it, and at the start no two objects overlap
@@ -147,12 +146,11 @@ def _cells(bad: np.ndarray) -> list[tuple[int, int]]:
 
 
 def faults(
-    cols: Columns, paper: bool, fps: int | None, world=None, elastic: bool = False
+    cols: Columns, paper: bool, fps: int | None, world=None
 ) -> list[Fault]:
     """Every rule broken by `cols` (at most MAX_FAULTS rows a rule), in no particular order: those
-    of each object alone under the model (`paper`; `elastic`: the exact model under gravity, which
-    takes no restitution below 1) at `fps` (None: the paper model's rates wait for it), and,
-    when `world` (width, height) is given, the world's bounds."""
+    of each object alone under the model (`paper`) at `fps` (None: the paper model's rates wait
+    for it), and, when `world` (width, height) is given, the world's bounds."""
     out: list[Fault] = []
     size = cols.size
     fraction = size != np.floor(size)
@@ -174,7 +172,7 @@ def faults(
             out.append(Fault(r, "position", a, text, ("model",)))
     _mass_faults(cols, out)
     _velocity_faults(cols, paper, fps, out)
-    _contact_faults(cols, paper, elastic, out)
+    _contact_faults(cols, paper, out)
     if world is not None:
         out += outside(cols, *world)
     return out
@@ -222,25 +220,18 @@ def _velocity_faults(cols: Columns, paper: bool, fps: int, out: list) -> None:
             )
 
 
-# What a model without gravity, restitution or friction says of an object's restitution or
-# friction (the subject is the value: `objects[2].restitution cannot be given: ...`).
+# What the paper model, without gravity, restitution or friction, says of an object's restitution
+# or friction (the subject is the value: `objects[2].restitution cannot be given: ...`).
 PAPER_REFUSES = (
     "cannot be given: the paper model has no {key} (the paper's objects bounce by its flip rule, "
     "elastic and weightless); {key} needs model: stepped"
 )
-EXACT_REFUSES = {
-    "restitution": "must be 1 under the exact model with gravity, where bodies do not rest yet (a "
-    "ball with a restitution below 1 bounces ever lower, without end); it needs model: stepped",
-}
 
 
-def _contact_faults(cols: Columns, paper: bool, elastic: bool, out: list) -> None:
-    """Restitution in [0, 1], friction in [0, MAX_FRICTION], each where given, and what the
-    model takes of them."""
-    for key, hi, default in (
-        ("restitution", 1.0, DEFAULT_RESTITUTION),
-        ("friction", MAX_FRICTION, DEFAULT_FRICTION),
-    ):
+def _contact_faults(cols: Columns, paper: bool, out: list) -> None:
+    """Restitution in [0, 1], friction in [0, MAX_FRICTION], each where given; the paper model
+    takes neither."""
+    for key, hi in (("restitution", 1.0), ("friction", MAX_FRICTION)):
         v = getattr(cols, key)
         if v is None:
             continue
@@ -249,12 +240,9 @@ def _contact_faults(cols: Columns, paper: bool, elastic: bool, out: list) -> Non
         for r in _rows(low | high):
             bound = "at least 0" if low[r] else f"at most {fmt(hi)}"
             out.append(Fault(r, key, 0, f"must be {bound}, not {fmt(float(v[r]))}"))
-        refused = given if paper else given & (v != default) if elastic else None
-        if refused is None or key not in EXACT_REFUSES and not paper:
-            continue
-        text = PAPER_REFUSES.format(key=key) if paper else EXACT_REFUSES[key]
-        for r in _rows(refused & ~low & ~high):
-            out.append(Fault(r, key, 0, text, ("model",)))
+        if paper:
+            for r in _rows(given & ~low & ~high):
+                out.append(Fault(r, key, 0, PAPER_REFUSES.format(key=key), ("model",)))
 
 
 def outside(cols: Columns, width: int, height: int) -> list[Fault]:

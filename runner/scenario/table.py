@@ -282,10 +282,10 @@ _COLUMN_OF = {
 }
 
 
-def checked(table: Table, world, paper: bool, elastic: bool = False) -> Table:
+def checked(table: Table, world, paper: bool) -> Table:
     """The table with every rule of objects checked (runner.scenario.rules) in `world` (None:
-    its bounds and rates wait for a good world), under the paper model's rules when `paper` (the
-    exact model's when `elastic`): the first fault of a cell, in row order and then the file's
+    its bounds and rates wait for a good world), under the paper model's rules when `paper`: the
+    first fault of a cell, in row order and then the file's
     column order, raised at its cell; else the table, static objects still and of infinite
     mass."""
     cols = rule.Columns(
@@ -295,7 +295,7 @@ def checked(table: Table, world, paper: bool, elastic: bool = False) -> Table:
     problems = list(table.problems)
     header = table.where.header
     fps, bounds = (world.fps, (world.width, world.height)) if world is not None else (None, None)
-    for f in rule.faults(cols, paper, fps, bounds, elastic):
+    for f in rule.faults(cols, paper, fps, bounds):
         column = _COLUMN_OF[f.field][f.axis]
         problems.append((f.row, header.index(column), len(problems), column, f.text))
     if problems:

@@ -13,7 +13,7 @@ import pytest
 from engine_refs import pile_bodies
 
 from collide2d.engine.errors import NotYetExact
-from collide2d.engine.events import EV_PAIR, EV_WALL, SIDE_BOTTOM
+from collide2d.engine.events import EV_PAIR, EV_WALL, SIDE_BOTTOM, TYPE_NAMES
 from collide2d.engine.models import make
 from collide2d.engine.world import KIND_CIRCLE, Bodies, Looks, WorldSpec
 
@@ -67,8 +67,7 @@ def test_a_projectile_lands_after_the_closed_form_flight_and_range():
     assert v * v * math.sin(2 * theta) / G == pytest.approx(v * math.cos(theta) * flight)
 
 
-# (at m/M = 1/3 the heavy one is left still on the floor: a body at rest, not taken yet)
-@pytest.mark.parametrize("ratio", [0.1, 0.25, 0.5, 1.0])
+@pytest.mark.parametrize("ratio", [0.1, 0.25, 1 / 3, 0.5, 1.0])
 def test_the_stacked_ball_drop_sends_the_light_one_up_by_the_closed_form(ratio):
     # a light box (m) resting on a heavy one (M), dropped together from h: the heavy one bounces
     # off the floor and meets the light one at once; the light one rises ((3M - m)/(M + m))²·h
@@ -185,3 +184,85 @@ def test_a_body_that_would_rest_on_a_static_one_stops_the_run_by_name():
     assert info.value.objects == (0, 1)
     with pytest.raises(NotYetExact):  # and stays stopped
         m.advance(1)
+
+
+def with_(bodies: Bodies, **columns) -> Bodies:
+    return Bodies(**{**bodies.__dict__, **columns})
+
+
+@pytest.mark.parametrize("e", [0.5, 0.8, 0.9])
+def test_a_ball_bounces_at_the_closed_form_times_then_rests_exactly_on_the_floor(e):
+    # t_n = t1·(1 + 2e(1 - e^(n-1))/(1 - e)); at rest before t_inf = t1·(1 + e)/(1 - e)
+    h = 300.0
+    world = WorldSpec(50, 400, 60, gravity=(0.0, G))
+    m = make("exact", world, with_(Bodies.boxes([[20, 90]], 10, [[0, 0]]), restitution=[e]))
+    t1 = math.sqrt(2 * h / G)
+    t_inf = t1 * (1 + e) / (1 - e)
+    found = m.advance(int(t_inf * 60) + 2)
+    walls = found[found["type"] == EV_WALL]
+    # impact n leaves the ball to rise h·e^(2n): the first one under rest_height (0.01 px) ends it
+    impacts = math.ceil(math.log(0.01 / h) / math.log(e * e))
+    assert len(walls) == impacts and (e < 0.8 or impacts >= 12)
+    for n in range(1, len(walls) + 1):
+        want = t1 * (1 + 2 * e * (1 - e ** (n - 1)) / (1 - e))
+        assert abs(walls["t"][n - 1] - want) <= 1e-9
+    assert [TYPE_NAMES[k] for k in found["type"][-2:]] == ["wall", "rest"]
+    assert found["t"][-1] < t_inf and found["code"][-1] == SIDE_BOTTOM
+    assert m.positions()[0].tolist() == [20.0, 390.0] and m.velocities()[0].tolist() == [0.0, 0.0]
+    assert len(m.advance(120)) == 0 and m.positions()[0].tolist() == [20.0, 390.0]  # for good
+
+
+@pytest.mark.parametrize("v0, mu", [(200.0, 0.5), (90.0, 0.1), (300.0, 2.0)])
+def test_a_block_slides_to_a_stop_at_the_closed_form_time_and_distance(v0, mu):
+    world = WorldSpec(4000, 100, 60, gravity=(0.0, G))
+    bodies = with_(Bodies.boxes([[10, 90]], 10, [[v0, 0]]), friction=[mu])
+    m = make("exact", world, bodies)
+    found = m.advance(int(v0 / (mu * G) * 60) + 30)
+    assert [TYPE_NAMES[k] for k in found["type"]] == ["stop"]
+    assert abs(found["t"][0] - v0 / (mu * G)) <= 1e-9
+    assert abs((m.positions()[0, 0] - 10) - v0 * v0 / (2 * mu * G)) <= 1e-9
+    assert m.velocities()[0].tolist() == [0.0, 0.0] and m.positions()[0, 1] == 90.0
+
+
+@pytest.mark.parametrize("gx, moves", [(300.0, False), (600.0, True)])
+def test_a_block_on_the_floor_holds_while_friction_can_hold_it(gx, moves):
+    # gravity down 980 and sideways gx; mu 0.5 holds up to 490 px/s² along the floor
+    world = WorldSpec(4000, 100, 10, gravity=(gx, G))
+    m = make("exact", world, with_(Bodies.boxes([[10, 90]], 10, [[0, 0]]), friction=[0.5]))
+    assert len(m.advance(10)) == 0
+    t = 1.0
+    want = 10 + 0.5 * (gx - 0.5 * G) * t * t if moves else 10.0
+    assert m.positions()[0, 0] == pytest.approx(want, rel=1e-13)
+    assert m.positions()[0, 1] == 90.0
+
+
+def test_a_resting_box_knocked_off_the_floor_wakes_and_energy_never_rises():
+    world = WorldSpec(200, 400, 60, gravity=(0.0, G))
+    # thrown sideways onto the box, the ball bounces off it and lands on the floor beyond
+    bodies = Bodies.boxes([[60, 100], [90, 380]], [[10, 10], [20, 20]], [[50, 0], [0, 0]],
+                          mass=[1.0, 2.0])  # fmt: skip
+    bodies = with_(bodies, restitution=np.array([0.9, 0.5]))
+    m = make("exact", world, bodies)
+    before = energy(m, bodies, world)
+    kinds = []
+    for _ in range(120):
+        found = m.advance(1)
+        kinds += [TYPE_NAMES[k] for k in found["type"]]
+        now = energy(m, bodies, world)
+        assert now <= before + 1e-9 * abs(before)
+        before = now
+    # the ball meets the resting box, which is pressed into the floor: it wakes and bounces
+    assert kinds[:3] == ["pair", "wake", "wall"]
+    assert "rest" in kinds
+
+
+def test_a_cradle_resting_on_a_frictionless_floor_is_the_zero_g_cradle():
+    pos = [[20 + 12 * k, 90] for k in range(5)]
+    vel = [[80.0, 0.0]] + [[0.0, 0.0]] * 4
+    runs = []
+    for g in (0.0, G):
+        m = make("exact", WorldSpec(200, 100, 30, gravity=(0.0, g)), Bodies.boxes(pos, 10, vel))
+        runs.append((m.advance(300), m.positions(), m.velocities()))
+    (ev0, p0, v0), (ev1, p1, v1) = runs
+    assert len(ev0) > 10 and ev0.tobytes() == ev1.tobytes()
+    assert np.array_equal(p0, p1) and np.array_equal(v0, v1)

@@ -14,7 +14,9 @@ position, and under gravity its velocity, to a time.
 
 from __future__ import annotations
 
-from collide2d.engine.events import SIDE_LEFT, SIDE_RIGHT, SIDE_TOP
+import numpy as np
+
+from collide2d.engine.events import SIDE_BOTTOM, SIDE_LEFT, SIDE_RIGHT, SIDE_TOP
 from collide2d.engine.models.exact.cells import cell_insert, cell_remove
 from collide2d.engine.models.exact.prediction import set_job, velocity_at
 from collide2d.engine.models.exact.state import (
@@ -31,6 +33,7 @@ from collide2d.engine.models.exact.state import (
     JOB_EVENT,
     MU,
     PARTNER,
+    REST,
     SH,
     STATIC,
     SW,
@@ -42,6 +45,7 @@ from collide2d.engine.models.exact.state import (
     Y,
     hot,
 )
+from collide2d.engine.parabola import slide_acceleration
 from collide2d.engine.response import impact, wall_impact
 
 
@@ -74,19 +78,82 @@ def on_cross(i, d, N, cells, world, jobs):
 
 
 @hot
+def pull(side, world):
+    """Gravity's pull into the wall `side`, px/s² (> 0: toward it)."""
+    if side == SIDE_LEFT:
+        return -world.gx
+    if side == SIDE_RIGHT:
+        return world.gx
+    if side == SIDE_TOP:
+        return -world.gy
+    return world.gy
+
+
+@hot
+def slide(i, F, N, world):
+    """Set resting object i's acceleration: none into its wall, and along it gravity less friction
+    against its sliding (parabola.slide_acceleration); none either against a wall it touches
+    along its slide with no speed (it sits in the corner)."""
+    side = N[i, REST]
+    mu = max(F[i, MU], world.friction)
+    if side == SIDE_LEFT or side == SIDE_RIGHT:
+        a = slide_acceleration(world.gy, F[i, VY], mu, pull(side, world))
+        span, p, v = world.height - F[i, SH], F[i, Y], F[i, VY]
+        F[i, AX] = 0.0
+    else:
+        a = slide_acceleration(world.gx, F[i, VX], mu, pull(side, world))
+        span, p, v = world.width - F[i, SW], F[i, X], F[i, VX]
+        F[i, AY] = 0.0
+    if v == 0.0 and ((a < 0.0 and p <= 0.0) or (a > 0.0 and p >= span)):
+        a = 0.0
+    if side == SIDE_LEFT or side == SIDE_RIGHT:
+        F[i, AY] = a
+    else:
+        F[i, AX] = a
+
+
+@hot
+def _settles(v, a, world):
+    """A speed v away from a wall that an acceleration a (< 0: back toward it) would bring back
+    within `rest_height` of rise: the bounce is over."""
+    return a < 0.0 and v * v <= -2.0 * a * world.rest_height
+
+
+@hot
 def on_wall(i, side, t, F, N, world, jobs):
     """i's box touches a wall: reflect that velocity component (times the contact's restitution,
     the smaller of the object's and the walls'; friction, the larger, takes from the component
-    along the wall), set it exactly on the wall line. Returns the number of jobs (1)."""
+    along the wall), set it exactly on the wall line. Under gravity a bounce that would rise less
+    than `rest_height` ends there: the object comes to rest on that wall (N's REST), or, resting
+    on another and sliding into this one, stops against it. Returns the number of jobs (1)."""
     move_to(i, t, F)
     e = min(F[i, E], world.restitution)
     mu = max(F[i, MU], world.friction)
-    if side == SIDE_LEFT or side == SIDE_RIGHT:
+    x_side = side == SIDE_LEFT or side == SIDE_RIGHT
+    if x_side:
         F[i, VX], F[i, VY] = wall_impact(F[i, VX], F[i, VY], e, mu)
         F[i, X] = 0.0 if side == SIDE_LEFT else world.width - F[i, SW]
     else:
         F[i, VY], F[i, VX] = wall_impact(F[i, VY], F[i, VX], e, mu)
         F[i, Y] = 0.0 if side == SIDE_TOP else world.height - F[i, SH]
+    out = 1.0 if side == SIDE_LEFT or side == SIDE_TOP else -1.0  # away from this wall
+    away = out * (F[i, VX] if x_side else F[i, VY])
+    if N[i, REST] >= 0:  # sliding on another wall into this one
+        slide(i, F, N, world)
+        a = out * (F[i, AX] if x_side else F[i, AY])
+        if _settles(away, a, world):
+            if x_side:
+                F[i, VX] = 0.0
+            else:
+                F[i, VY] = 0.0
+            slide(i, F, N, world)
+    elif _settles(away, -pull(side, world), world):
+        N[i, REST] = side
+        if x_side:
+            F[i, VX] = 0.0
+        else:
+            F[i, VY] = 0.0
+        slide(i, F, N, world)
     N[i, CNT] += 1
     N[i, PARTNER] = -1
     set_job(jobs, 0, i, -1, JOB_EVENT)
@@ -94,9 +161,42 @@ def on_wall(i, side, t, F, N, world, jobs):
 
 
 @hot
-def on_pair(a, b, code, nx, ny, t, F, N, jobs):
-    """a and b touch: the elastic exchange; then each moving one is predicted again, but not
-    against the other. Returns the number of jobs (0: they were not approaching, no event).
+def on_stop(i, t, F, N, world, jobs):
+    """Resting object i stops sliding: its speed along its wall is 0 from here, and static
+    friction holds it or gravity starts it the other way. Returns the number of jobs (1)."""
+    move_to(i, t, F)
+    if N[i, REST] == SIDE_LEFT or N[i, REST] == SIDE_RIGHT:
+        F[i, VY] = 0.0
+    else:
+        F[i, VX] = 0.0
+    slide(i, F, N, world)
+    N[i, CNT] += 1
+    N[i, PARTNER] = -1
+    set_job(jobs, 0, i, -1, JOB_EVENT)
+    return 1
+
+
+@hot
+def wake_or_slide(i, F, N, world):
+    """After a pair event, resting object i wakes (flies under gravity again) when it has a speed
+    off its wall, into it or away; else it goes on sliding. Returns whether it woke."""
+    side = N[i, REST]
+    normal = F[i, VX] if side == SIDE_LEFT or side == SIDE_RIGHT else F[i, VY]
+    if normal != 0.0:
+        N[i, REST] = -1
+        F[i, AX], F[i, AY] = world.gx, world.gy
+        return True
+    slide(i, F, N, world)
+    return False
+
+
+@hot
+def on_pair(a, b, code, nx, ny, t, F, N, world, jobs):
+    """a and b touch: the impact; then each moving one is predicted again, but not against the
+    other (unless one falls and the other stands: on a curved relative path they may meet again),
+    and a resting one wakes if knocked off its wall (wake_or_slide). Returns the number of jobs
+    (0: they were not approaching, no event; -1: one would come to rest on the other, pressed
+    against it with no speed, or with a bounce that would rise less than `rest_height`: not yet).
 
     The exchange reads only velocities, so it is decided before anything moves: a pair that
     turns out not to approach leaves both objects exactly as they were, clocks included (moving
@@ -119,10 +219,15 @@ def on_pair(a, b, code, nx, ny, t, F, N, jobs):
         if curved and ax * nx + ay * ny < 0.0:
             return -1  # pressed together with no speed: it would rest on the other (not yet)
         return 0
+    if curved and _settles((vbx - vax) * nx + (vby - vay) * ny, ax * nx + ay * ny, world):
+        return -1  # a bounce that dies away on the other: it would rest on it (not yet)
     for i in (a, b):
         if N[i, STATIC] == 0:  # a static object's clock stays at 0: its entries never go stale
             move_to(i, t, F)
     F[a, VX], F[a, VY], F[b, VX], F[b, VY] = vax, vay, vbx, vby
+    for i in (a, b):
+        if N[i, REST] >= 0:
+            wake_or_slide(i, F, N, world)
     n_jobs = 0
     for i, other in ((a, b), (b, a)):
         if N[i, STATIC] == 0:
@@ -131,3 +236,19 @@ def on_pair(a, b, code, nx, ny, t, F, N, jobs):
             set_job(jobs, n_jobs, i, -1 if curved else other, JOB_EVENT)
             n_jobs += 1
     return n_jobs
+
+
+def start_resting(F, N, world) -> None:
+    """Moving objects that start still against a wall gravity pulls them into rest on it (sliding
+    along it at their speed there): on the floor, or the ceiling, before on a side wall. Python,
+    called once when the model is built."""
+    span = np.array([world.width, world.height]) - F[:, SW : SH + 1]
+    walls = ((1, world.gy, SIDE_TOP, SIDE_BOTTOM), (0, world.gx, SIDE_LEFT, SIDE_RIGHT))
+    for axis, g, low, high in walls:
+        if g == 0.0:
+            continue
+        on = F[:, X + axis] >= span[:, axis] if g > 0 else F[:, X + axis] <= 0.0
+        still = (F[:, VX + axis] == 0.0) & (N[:, STATIC] == 0) & (N[:, REST] < 0)
+        for i in np.flatnonzero(on & still):
+            N[i, REST] = high if g > 0 else low
+            slide(int(i), F, N, world)

@@ -18,8 +18,9 @@ much walking finding the next takes.
 The queue is one record Q (state.Horizons), small, as the event loop's memory traffic is most
 of its time, read by field (the kernels name the fields QT, QC, QL, QH, QS): each object's horizon
 time QT = Q.time (n,) float64 (inf: none, or a static object; the bucket of a finite one is
-QT·Q.rate, rounded down) and what it is, QC = Q.code (n,) int8 (rank × 4 + side or direction: its
-event queue key, heap.py, is `horizon_key`, so ties go crossings first, then walls, by id); its
+QT·Q.rate, rounded down) and what it is, QC = Q.code (n,) int8 (rank × 8 + side, direction or
+STOP: its event queue key, heap.py, is `horizon_key`, so ties go crossings first, then walls and
+stops, by id); its
 links QL = Q.links (n, 2) int32 (next and previous object in its bucket's list, -1 for none); the
 first object of each ring slot QH = Q.heads (slots,) int32 (-1: empty; slots a power of two); the
 scalar state QS = Q.state (the bucket the walk is at, every filed horizon's bucket being at least
@@ -73,7 +74,7 @@ def new_horizons(static: np.ndarray, width: float) -> Horizons:
     while slots < SLOTS_PER_OBJECT * int((~static).sum()):
         slots *= 2
     QT = np.full(n, INF)
-    QC = np.full(n, RANK_WALL * 4, np.int8)
+    QC = np.full(n, RANK_WALL * 8, np.int8)
     QL = np.full((n, 2), -1, np.int32)
     QH = np.full(slots, -1, np.int32)
     QS = np.zeros(3, np.int64)
@@ -85,7 +86,7 @@ def new_horizons(static: np.ndarray, width: float) -> Horizons:
 def horizon_key(Q, i):
     """Object i's horizon as an event queue key (rank, i, side or direction)."""
     c = int(Q.code[i])
-    return make_key(c >> 2, int(i), c & 3, c & 3)
+    return make_key(c >> 3, int(i), c & 7, c & 7)
 
 
 @hot
@@ -98,7 +99,7 @@ def _bucket(t, rate):
 @hot
 def _order(QC, i):
     """Where object i's horizon key goes among other objects': by (rank, id)."""
-    return ((int(QC[i]) >> 2) << ID_BITS) | int(i)
+    return ((int(QC[i]) >> 3) << ID_BITS) | int(i)
 
 
 @hot
@@ -126,7 +127,7 @@ def set_horizon(Q, i, t, rank, d):
             QL[nxt, Q_PREV] = prv
         QS[QS_FILED] -= 1
     top = QS[QS_TOP]
-    code = rank * 4 + d
+    code = rank * 8 + d
     later = top == i and (t > QT[i] or (t == QT[i] and code > QC[i]))
     QT[i] = t
     QC[i] = code

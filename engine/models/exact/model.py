@@ -12,17 +12,20 @@ the local re-prediction saves, for tests and `collide2d bench`). Output, per `ad
 wall and pair events in the order they happened, `t` = the exact contact time; positions and
 velocities at the end of the last tick.
 
-Objects fly on straight lines between events, or under the world's gravity on parabolas (exact:
-`x + v·t + ½·g·t²`). Each keeps its own clock (TLOC: its position and velocity are valid at that
-time) and an invalidation counter. Two queues hold what comes next, keyed by (time,
-rank, a, b) so that ties go cell crossings first (bookkeeping, never logged), then walls by (id,
-side), then pairs in (a, b) order: each moving object's *horizon*, the first of its next wall
-contact and its next cell crossing, filed by its time in a bucket of a calendar queue that
-predicting the object again moves it out of and into in constant time (horizonqueue.py); and the
-predicted contacts, in a 4-ary heap in preallocated arrays that grow when full (heap.py),
-each entry recording the counters of its objects when predicted and skipped as stale if either
-has changed since. The next event is, of
-the events at the earliest one's instant, the one of the smallest key.
+Objects fly on straight lines between events, or under the world's gravity on parabolas (exact: `x +
+v·t + ½·g·t²`). Under gravity an object whose bounce on a wall would rise less than `rest_height`
+(px, an option) rests on that wall (N's REST): no speed nor gravity into it, sliding along it
+against friction until it stops, an event due like a wall contact (its horizon); a pair event that
+leaves it a speed off the wall wakes it (apply.py). Each object keeps its own clock (TLOC: its
+position and velocity are valid at that time) and an invalidation counter. Two queues hold what
+comes next, keyed by (time, rank, a, b) so that ties go cell crossings first (bookkeeping, never
+logged), then walls by (id, side), then pairs in (a, b) order: each moving object's *horizon*, the
+first of its next wall contact and its next cell crossing, filed by its time in a bucket of a
+calendar queue that predicting the object again moves it out of and into in constant time
+(horizonqueue.py); and the predicted contacts, in a 4-ary heap in preallocated arrays that grow when
+full (heap.py), each entry recording the counters of its objects when predicted and skipped as stale
+if either has changed since. The next event is, of the events at the earliest one's instant, the one
+of the smallest key.
 
 Prediction stays local. Moving objects are filed in a uniform grid (cells.py) by their box
 centre. When its velocity changes (a wall, a pair; and at the first prediction) an object's
@@ -78,12 +81,15 @@ from collide2d.engine.events import (
     AXIS_X,
     AXIS_Y,
     EV_PAIR,
+    EV_REST,
+    EV_STOP,
+    EV_WAKE,
     EV_WALL,
     SIDE_LEFT,
     SIDE_RIGHT,
     put_event,
 )
-from collide2d.engine.models.exact.apply import on_cross, on_pair, on_wall
+from collide2d.engine.models.exact.apply import on_cross, on_pair, on_stop, on_wall, start_resting
 from collide2d.engine.models.exact.cells import (
     build_grid,
     grid_cell,
@@ -98,6 +104,7 @@ from collide2d.engine.models.exact.heap import (
     INSTANT_STACK,
     MAX_OBJECTS,
     RANK_CROSS,
+    RANK_PAIR,
     RANK_WALL,
     compact,
     first_of_instant,
@@ -134,7 +141,9 @@ from collide2d.engine.models.exact.state import (
     JOB_FIRST,
     JOB_ROWS,
     MU,
+    N_COLUMNS,
     PARTNER,
+    REST,
     S_FIRST,
     S_HEAP_N,
     S_LOGGED,
@@ -151,6 +160,7 @@ from collide2d.engine.models.exact.state import (
     STATUS_HEAP_FULL,
     STATUS_LOG_FULL,
     STATUS_REST,
+    STOP,
     SW,
     TLOC,
     VX,
@@ -182,6 +192,11 @@ REPREDICT = ("touched", "all")
 ONE_CELL_MOVERS = 16
 # Heap entries to start with per object (the heap drops stale entries, or doubles, when full).
 HEAP_PER_OBJECT = 4
+# Event log rows one event may write: a pair event and the rests it ends (wake), or a wall event
+# and the rest it begins.
+ROWS_PER_EVENT = 3
+# A bounce on a wall that would rise less than this (px) under gravity ends it: the object rests.
+REST_HEIGHT = 0.01
 
 # Who a runaway involves: once a tick stops at the cap, the model (stopped for good) runs up to
 # RECENT more events with the log on and looks at them, so the hot loop keeps no record of its own.
@@ -272,7 +287,7 @@ def _run(state, jobs, stack, tick_to, log, cap, everyone, rows, times):
                 if compact(HT, HI, HN, st, N) < room:
                     return STATUS_HEAP_FULL
                 continue  # the entries moved: pick again
-            if log and st[S_LOGGED] == rows.shape[0]:
+            if log and st[S_LOGGED] + ROWS_PER_EVENT > rows.shape[0]:
                 return STATUS_LOG_FULL
             # apply it: refile (a cell crossing), reflect (a wall) or exchange (a pair); count, log.
             # (A horizon stays in its slot: predicting the object again replaces it.)
@@ -291,20 +306,36 @@ def _run(state, jobs, stack, tick_to, log, cap, everyone, rows, times):
                     if not horizon:
                         push(HT, HI, HN, st, e)
                     return STATUS_CAP
-                if rank == RANK_WALL:
+                rest_a = N[a, REST]  # what a (and b) rested on before: -1 nothing
+                rest_b = N[b, REST] if rank == RANK_PAIR else -1
+                if rank == RANK_WALL and b == STOP:
+                    n_jobs = on_stop(a, t, F, N, world, jobs)
+                    kind, b, code = EV_STOP, -1, rest_a
+                elif rank == RANK_WALL:
                     n_jobs = on_wall(a, b, t, F, N, world, jobs)
                     kind, b = EV_WALL, -1
                 else:
-                    n_jobs = on_pair(a, b, code, e.nx, e.ny, t, F, N, jobs)
+                    n_jobs = on_pair(a, b, code, e.nx, e.ny, t, F, N, world, jobs)
                     kind = EV_PAIR
                     if n_jobs < 0:  # a body would rest on another: stopped, the pair named
                         set_job(jobs, 0, a, b, JOB_EVENT)
                         return STATUS_REST
                 if n_jobs > 0:  # a pair that was not approaching is no event
-                    st[S_WALLS if kind == EV_WALL else S_PAIRS] += 1
+                    if kind == EV_WALL:
+                        st[S_WALLS] += 1
+                    elif kind == EV_PAIR:
+                        st[S_PAIRS] += 1
                     if log:
                         put_event(rows, times, st[S_LOGGED], tick, t, kind, a, b, code)
                         st[S_LOGGED] += 1
+                        # the modes the event changed: a rest it began, the rests it ended
+                        if kind == EV_WALL and rest_a < 0 and N[a, REST] >= 0:
+                            put_event(rows, times, st[S_LOGGED], tick, t, EV_REST, a, -1, code)
+                            st[S_LOGGED] += 1
+                        for i, was in ((a, rest_a), (b, rest_b)):
+                            if kind == EV_PAIR and was >= 0 and N[i, REST] < 0:
+                                put_event(rows, times, st[S_LOGGED], tick, t, EV_WAKE, i, -1, was)
+                                st[S_LOGGED] += 1
         # predict again for what the step touched (and after an event with `everyone`, for
         # every other moving object: contacts only, not against the partner of its last pair)
         extra = 0 if everyone and not first and n_jobs > 0 else n
@@ -339,6 +370,7 @@ class Model:
         max_events_per_tick: int = MAX_EVENTS_PER_TICK,
         cell_size: float | None = None,
         repredict: str = "touched",
+        rest_height: float = REST_HEIGHT,
     ):
         geometry = "exact" if geometry is None else geometry
         if geometry not in GEOMETRIES:
@@ -351,6 +383,8 @@ class Model:
             raise ValueError(f"cell_size must be > 0 px, got {cell_size!r}")
         if repredict not in REPREDICT:
             raise ValueError(f"repredict must be one of {REPREDICT}, got {repredict!r}")
+        if not rest_height >= 0:
+            raise ValueError(f"rest_height must be >= 0 px, got {rest_height!r}")
         stuck = no_room(world, bodies, geometry)
         if stuck:
             raise NoRoom(
@@ -376,8 +410,9 @@ class Model:
         self._F[:, E] = bodies.restitution
         self._F[:, MU] = bodies.friction
         self.gravity = world.has_gravity
-        self._N = np.zeros((n, 8), np.int64)
+        self._N = np.zeros((n, N_COLUMNS), np.int64)
         self._N[:, PARTNER] = -1
+        self._N[:, REST] = -1
         self._N[:, STATIC] = static
         self._N[:, SHAPE] = cores.shape
         self._C = Cores(cores.radius, cores.start, cores.verts, cores.normals)
@@ -400,7 +435,11 @@ class Model:
             gny,
             float(world.restitution),
             float(world.friction),
+            float(world.gravity[0]),
+            float(world.gravity[1]),
+            float(rest_height),
         )
+        start_resting(self._F, self._N, self._world)
         self._G = build_grid(self._F, self._N, self.cell_size, gnx, gny)
         cap = max(64, HEAP_PER_OBJECT * n)
         self._heap = [np.empty(cap), np.empty((cap, 3), np.int64), np.empty((cap, 2))]

@@ -34,10 +34,12 @@ from collide2d.engine.models.exact.state import (
     JOB_CROSS,
     JOB_FIRST,
     NEXT,
+    REST,
     S_STAMP,
     SH,
     SHAPE,
     STAMP,
+    STOP,
     SW,
     TLOC,
     VX,
@@ -108,6 +110,17 @@ def _wall_time_falling(i, t_now, F, world):
     if tx < INF:
         return t_now + tx, side_x
     return INF, -1
+
+
+@hot
+def _stop_time(i, t_now, F, N):
+    """When resting object i, sliding against friction, stops (inf: never)."""
+    x, y, vx, vy = _state_at(i, t_now, F)
+    side = N[i, REST]
+    v, a = (vy, F[i, AY]) if side == SIDE_LEFT or side == SIDE_RIGHT else (vx, F[i, AX])
+    if v * a < 0.0:
+        return t_now + -v / a
+    return INF
 
 
 @hot
@@ -275,6 +288,10 @@ def predict(jobs, k, t_now, S):
     i, skip, mode = jobs[k, J_OBJ], jobs[k, J_SKIP], jobs[k, J_HIGHER]
     higher = mode == JOB_FIRST
     t_wall, side = _wall_time(i, t_now, F, world)
+    if N[i, REST] >= 0:  # resting: its stop, when it comes first, is what changes it next
+        t_stop = _stop_time(i, t_now, F, N)
+        if t_stop < t_wall:
+            t_wall, side = t_stop, STOP
     if mode != JOB_CONTACTS:
         t_cross, d = _cross_time(i, t_now, F, N, world)
         if t_cross <= t_wall and t_cross < INF:

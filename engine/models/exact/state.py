@@ -2,7 +2,7 @@
 statuses.
 
 The exact model (model.py) keeps its objects in two arrays, floats F (n, 12) and ints
-N (n, 8), and its counters in `st` (int64) and `stf` (float64); the event queue (heap.py),
+N (n, 9), and its counters in `st` (int64) and `stf` (float64); the event queue (heap.py),
 the grid lists (cells.py) and the predictions (prediction.py) all read them by the names below.
 Its kernels share one record, `State`, read by field, which holds the others: `World` (the
 world's sides, fps and grid), `Cores` (the exact shapes) and `Horizons` (the horizon queue,
@@ -35,6 +35,9 @@ class World(NamedTuple):
     gny: int  # the grid's rows
     restitution: float  # the walls' e
     friction: float  # the walls' mu
+    gx: float  # gravity, px/s²
+    gy: float
+    rest_height: float  # px: a bounce on a wall that would rise less comes to rest on it
 
 
 class Cores(NamedTuple):
@@ -74,7 +77,7 @@ class State(NamedTuple):
     """The arrays the exact model's kernels share, handed to them as one argument."""
 
     F: np.ndarray  # (n, 12) float64, columns below
-    N: np.ndarray  # (n, 8) int64, columns below
+    N: np.ndarray  # (n, 9) int64, columns below
     C: Cores  # exact shapes
     cells: np.ndarray  # the grid's per-cell lists of movers (cells.py)
     s_start: np.ndarray  # each cell's first entry in s_items (static objects)
@@ -99,10 +102,14 @@ def plain(S: State) -> tuple:
 # and friction.
 X, Y, VX, VY, TLOC, SW, SH, INV_MASS, AX, AY, E, MU = range(12)
 F_COLUMNS = 12
-# Columns of N (n, 8) int64: invalidation counter, static flag, contact shape kind, grid cell,
+# Columns of N (n, 9) int64: invalidation counter, static flag, contact shape kind, grid cell,
 # next / previous object in that cell's list (-1 for none), last query stamp (static objects),
-# the partner of its last event if that was a pair (-1 otherwise).
-CNT, STATIC, SHAPE, CELL, NEXT, PREV, STAMP, PARTNER = range(8)
+# the partner of its last event if that was a pair (-1 otherwise), the wall side it rests on
+# (-1: it does not rest).
+CNT, STATIC, SHAPE, CELL, NEXT, PREV, STAMP, PARTNER, REST = range(9)
+N_COLUMNS = 9
+# A horizon's `what` (besides wall sides 0-3 and directions 0-3): a resting object stops sliding.
+STOP = 4
 
 # A prediction job (one row of `jobs`): the object, the partner to leave out (-1: none; for
 # JOB_CROSS, the direction it crossed in), and its mode: JOB_EVENT (after an event of the object),

@@ -29,7 +29,7 @@ from collide2d.engine.errors import FoldLimitExceeded
 from collide2d.engine.events import EV_WALL, SIDE_BOTTOM, SIDE_LEFT, SIDE_RIGHT, SIDE_TOP, log_event
 from collide2d.engine.jit import njit
 from collide2d.engine.models.stepped.move import B_H, B_VX, B_VY, B_W, B_X, B_Y
-from collide2d.engine.parabola import meet
+from collide2d.engine.parabola import meet, slide_acceleration
 from collide2d.engine.response import MAX_FOLDS_PER_STEP
 
 INF = np.inf
@@ -46,14 +46,7 @@ def _acceleration(g, v, rest_other, mu, g_other):
     on a wall of the other axis (static friction holding it when at rest and strong enough)."""
     if rest_other == 0 or mu == 0.0:
         return g
-    grip = mu * abs(g_other)
-    if v > 0.0:
-        return g - grip
-    if v < 0.0:
-        return g + grip
-    if abs(g) <= grip:
-        return 0.0
-    return g - grip if g > 0.0 else g + grip
+    return slide_acceleration(g, v, mu, abs(g_other))
 
 
 @njit(cache=True, inline="always")
