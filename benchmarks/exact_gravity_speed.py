@@ -8,7 +8,7 @@ and loads the kernels; then a scene of 1,000 balls of restitution 0.9 dropped on
 which bounce, come to rest and slide. Prints the median events per second of each, and the ratio
 under gravity / without. Usage:
 
-    python benchmarks/exact_gravity_speed.py [--n 10000] [--ticks 60] [--rounds 3]
+    python benchmarks/exact_gravity_speed.py [--n 10000] [--ticks 600] [--rounds 3]
 """
 
 from __future__ import annotations
@@ -72,7 +72,7 @@ def events_per_s(bodies: Bodies, gravity: float, ticks: int) -> tuple[float, int
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--n", type=int, default=10_000)
-    parser.add_argument("--ticks", type=int, default=60)
+    parser.add_argument("--ticks", type=int, default=600)
     parser.add_argument("--rounds", type=int, default=3)
     args = parser.parse_args()
     bodies = gas(args.n)

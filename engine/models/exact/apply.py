@@ -43,6 +43,7 @@ from collide2d.engine.models.exact.state import (
     E,
     X,
     Y,
+    falls,
     hot,
 )
 from collide2d.engine.parabola import slide_acceleration
@@ -50,10 +51,10 @@ from collide2d.engine.response import impact, wall_impact
 
 
 @hot
-def move_to(i, t, F):
+def move_to(i, t, F, world):
     """Bring object i's position (and, under gravity, its velocity) to time t."""
     dt = t - F[i, TLOC]
-    if F[i, AX] == 0.0 and F[i, AY] == 0.0:
+    if not falls(world) or (F[i, AX] == 0.0 and F[i, AY] == 0.0):
         F[i, X] += F[i, VX] * dt
         F[i, Y] += F[i, VY] * dt
     else:
@@ -120,13 +121,36 @@ def _settles(v, a, world):
 
 
 @hot
+def _settle(i, side, F, N, world):
+    """After i's bounce on wall `side` under gravity: a bounce that would rise less than
+    `rest_height` ends there, i coming to rest on that wall, or, resting on another and sliding
+    into this one, stopping against it."""
+    x_side = side == SIDE_LEFT or side == SIDE_RIGHT
+    out = 1.0 if side == SIDE_LEFT or side == SIDE_TOP else -1.0  # away from this wall
+    away = out * (F[i, VX] if x_side else F[i, VY])
+    if N[i, REST] >= 0:  # sliding on another wall into this one
+        slide(i, F, N, world)
+        if not _settles(away, out * (F[i, AX] if x_side else F[i, AY]), world):
+            return
+    elif _settles(away, -pull(side, world), world):
+        N[i, REST] = side
+    else:
+        return
+    if x_side:
+        F[i, VX] = 0.0
+    else:
+        F[i, VY] = 0.0
+    slide(i, F, N, world)
+
+
+@hot
 def on_wall(i, side, t, F, N, world, jobs):
     """i's box touches a wall: reflect that velocity component (times the contact's restitution,
     the smaller of the object's and the walls'; friction, the larger, takes from the component
     along the wall), set it exactly on the wall line. Under gravity a bounce that would rise less
     than `rest_height` ends there: the object comes to rest on that wall (N's REST), or, resting
     on another and sliding into this one, stops against it. Returns the number of jobs (1)."""
-    move_to(i, t, F)
+    move_to(i, t, F, world)
     e = min(F[i, E], world.restitution)
     mu = max(F[i, MU], world.friction)
     x_side = side == SIDE_LEFT or side == SIDE_RIGHT
@@ -136,24 +160,8 @@ def on_wall(i, side, t, F, N, world, jobs):
     else:
         F[i, VY], F[i, VX] = wall_impact(F[i, VY], F[i, VX], e, mu)
         F[i, Y] = 0.0 if side == SIDE_TOP else world.height - F[i, SH]
-    out = 1.0 if side == SIDE_LEFT or side == SIDE_TOP else -1.0  # away from this wall
-    away = out * (F[i, VX] if x_side else F[i, VY])
-    if N[i, REST] >= 0:  # sliding on another wall into this one
-        slide(i, F, N, world)
-        a = out * (F[i, AX] if x_side else F[i, AY])
-        if _settles(away, a, world):
-            if x_side:
-                F[i, VX] = 0.0
-            else:
-                F[i, VY] = 0.0
-            slide(i, F, N, world)
-    elif _settles(away, -pull(side, world), world):
-        N[i, REST] = side
-        if x_side:
-            F[i, VX] = 0.0
-        else:
-            F[i, VY] = 0.0
-        slide(i, F, N, world)
+    if falls(world):
+        _settle(i, side, F, N, world)
     N[i, CNT] += 1
     N[i, PARTNER] = -1
     set_job(jobs, 0, i, -1, JOB_EVENT)
@@ -164,7 +172,7 @@ def on_wall(i, side, t, F, N, world, jobs):
 def on_stop(i, t, F, N, world, jobs):
     """Resting object i stops sliding: its speed along its wall is 0 from here, and static
     friction holds it or gravity starts it the other way. Returns the number of jobs (1)."""
-    move_to(i, t, F)
+    move_to(i, t, F, world)
     if N[i, REST] == SIDE_LEFT or N[i, REST] == SIDE_RIGHT:
         F[i, VY] = 0.0
     else:
@@ -204,16 +212,18 @@ def on_pair(a, b, code, nx, ny, t, F, N, world, jobs):
     one made before, and the local re-prediction then drift from the full one). For the same
     reason a static object never moves its clock: its counter does not change either, so the
     entries of its other pairs stay valid, and they must equal what asking again would give."""
-    vax, vay = velocity_at(a, t, F)
-    vbx, vby = velocity_at(b, t, F)
+    vax, vay = velocity_at(a, t, F, world)
+    vbx, vby = velocity_at(b, t, F, world)
     e = min(F[a, E], F[b, E])
     mu = max(F[a, MU], F[b, MU])
     vax, vay, vbx, vby, changed = impact(
         vax, vay, vbx, vby, F[a, INV_MASS], F[b, INV_MASS], code, nx, ny, e, mu
     )
     # one falls, the other stands: their relative path is curved, and may meet again
-    ax = F[b, AX] - F[a, AX]
-    ay = F[b, AY] - F[a, AY]
+    ax = ay = 0.0
+    if falls(world):
+        ax = F[b, AX] - F[a, AX]
+        ay = F[b, AY] - F[a, AY]
     curved = ax != 0.0 or ay != 0.0
     if not changed:
         if curved and ax * nx + ay * ny < 0.0:
@@ -223,10 +233,10 @@ def on_pair(a, b, code, nx, ny, t, F, N, world, jobs):
         return -1  # a bounce that dies away on the other: it would rest on it (not yet)
     for i in (a, b):
         if N[i, STATIC] == 0:  # a static object's clock stays at 0: its entries never go stale
-            move_to(i, t, F)
+            move_to(i, t, F, world)
     F[a, VX], F[a, VY], F[b, VX], F[b, VY] = vax, vay, vbx, vby
     for i in (a, b):
-        if N[i, REST] >= 0:
+        if falls(world) and N[i, REST] >= 0:
             wake_or_slide(i, F, N, world)
     n_jobs = 0
     for i, other in ((a, b), (b, a)):

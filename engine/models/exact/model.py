@@ -171,6 +171,7 @@ from collide2d.engine.models.exact.state import (
     World,
     X,
     Y,
+    falls,
     kernel,
     named,
     plain,
@@ -306,8 +307,9 @@ def _run(state, jobs, stack, tick_to, log, cap, everyone, rows, times):
                     if not horizon:
                         push(HT, HI, HN, st, e)
                     return STATUS_CAP
-                rest_a = N[a, REST]  # what a (and b) rested on before: -1 nothing
-                rest_b = N[b, REST] if rank == RANK_PAIR else -1
+                # what a (and b) rested on before: -1 nothing (nothing rests without gravity)
+                rest_a = N[a, REST] if falls(world) else -1
+                rest_b = N[b, REST] if falls(world) and rank == RANK_PAIR else -1
                 if rank == RANK_WALL and b == STOP:
                     n_jobs = on_stop(a, t, F, N, world, jobs)
                     kind, b, code = EV_STOP, -1, rest_a

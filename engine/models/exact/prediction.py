@@ -47,6 +47,7 @@ from collide2d.engine.models.exact.state import (
     Entry,
     X,
     Y,
+    falls,
     hot,
 )
 from collide2d.engine.parabola import meet
@@ -54,9 +55,9 @@ from collide2d.engine.world import KIND_BOX
 
 
 @hot
-def velocity_at(i, t, F):
+def velocity_at(i, t, F, world):
     """Object i's velocity at time t (its own, unchanged without acceleration)."""
-    if F[i, AX] == 0.0 and F[i, AY] == 0.0:
+    if not falls(world) or (F[i, AX] == 0.0 and F[i, AY] == 0.0):
         return F[i, VX], F[i, VY]
     dt = t - F[i, TLOC]
     return F[i, VX] + F[i, AX] * dt, F[i, VY] + F[i, AY] * dt
@@ -126,7 +127,7 @@ def _stop_time(i, t_now, F, N):
 @hot
 def _wall_time(i, t_now, F, world):
     """(t, side) of i's next wall contact (its box touching a wall line), (inf, -1) if none."""
-    if F[i, AX] != 0.0 or F[i, AY] != 0.0:
+    if falls(world) and (F[i, AX] != 0.0 or F[i, AY] != 0.0):
         return _wall_time_falling(i, t_now, F, world)
     t_best = INF
     side = -1
@@ -172,7 +173,7 @@ def _cross_time_falling(i, t_now, F, N, world):
 @hot
 def _cross_time(i, t_now, F, N, world):
     """(t, direction) when i's box centre next leaves its grid cell, (inf, -1) if never."""
-    if F[i, AX] != 0.0 or F[i, AY] != 0.0:
+    if falls(world) and (F[i, AX] != 0.0 or F[i, AY] != 0.0):
         return _cross_time_falling(i, t_now, F, N, world)
     cell, gnx, gny = world.cell, world.gnx, world.gny
     gx = N[i, CELL] % gnx
@@ -246,22 +247,25 @@ def _predict_pair(i, j, t_now, limit, S):
     a = min(i, j)
     b = max(i, j)
     t0 = max(F[a, TLOC], F[b, TLOC])
-    xa, ya, vax, vay = _state_at(a, t0, F)
-    xb, yb, vbx, vby = _state_at(b, t0, F)
-    qx = xb - xa
-    qy = yb - ya
-    ux = vbx - vax
-    uy = vby - vay
-    ax = F[b, AX] - F[a, AX]
-    ay = F[b, AY] - F[a, AY]
-    if ax != 0.0 or ay != 0.0:  # one falls, the other stands: a curved relative path
-        path = Arc(qx, qy, ux, uy, ax, ay)
-        t, code, nx, ny = _arc_contact(a, b, path, t_now - t0, N, S.C)
-        t = max(t0 + t, t_now)
-        if t <= limit:
-            e = Entry(t, make_key(RANK_PAIR, a, b, code), N[a, CNT], N[b, CNT], nx, ny)
-            push(S.HT, S.HI, S.HN, S.st, e)
-        return
+    if falls(S.world):
+        xa, ya, vax, vay = _state_at(a, t0, F)
+        xb, yb, vbx, vby = _state_at(b, t0, F)
+        qx, qy, ux, uy = xb - xa, yb - ya, vbx - vax, vby - vay
+        ax = F[b, AX] - F[a, AX]
+        ay = F[b, AY] - F[a, AY]
+        if ax != 0.0 or ay != 0.0:  # one falls, the other stands: a curved relative path
+            path = Arc(qx, qy, ux, uy, ax, ay)
+            t, code, nx, ny = _arc_contact(a, b, path, t_now - t0, N, S.C)
+            t = max(t0 + t, t_now)
+            if t <= limit:
+                e = Entry(t, make_key(RANK_PAIR, a, b, code), N[a, CNT], N[b, CNT], nx, ny)
+                push(S.HT, S.HI, S.HN, S.st, e)
+            return
+    else:
+        qx = (F[b, X] + F[b, VX] * (t0 - F[b, TLOC])) - (F[a, X] + F[a, VX] * (t0 - F[a, TLOC]))
+        qy = (F[b, Y] + F[b, VY] * (t0 - F[b, TLOC])) - (F[a, Y] + F[a, VY] * (t0 - F[a, TLOC]))
+        ux = F[b, VX] - F[a, VX]
+        uy = F[b, VY] - F[a, VY]
     if not box_reach(qx, qy, ux, uy, F[a, SW], F[a, SH], F[b, SW], F[b, SH], limit - t0):
         return
     now = t_now - t0
@@ -288,7 +292,7 @@ def predict(jobs, k, t_now, S):
     i, skip, mode = jobs[k, J_OBJ], jobs[k, J_SKIP], jobs[k, J_HIGHER]
     higher = mode == JOB_FIRST
     t_wall, side = _wall_time(i, t_now, F, world)
-    if N[i, REST] >= 0:  # resting: its stop, when it comes first, is what changes it next
+    if falls(world) and N[i, REST] >= 0:  # resting: its stop, if first, changes it next
         t_stop = _stop_time(i, t_now, F, N)
         if t_stop < t_wall:
             t_wall, side = t_stop, STOP

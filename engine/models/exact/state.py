@@ -150,6 +150,13 @@ kernel = njit(cache=True, _nrt=False)
 
 
 @hot
+def falls(world):
+    """Whether the world has gravity: without it no object has an acceleration or rests, and the
+    kernels read neither (a branch on the world, the same at every call)."""
+    return world.gx != 0.0 or world.gy != 0.0
+
+
+@hot
 def named(state):
     """The State record of `state`, the plain tuples `plain` makes."""
     S = State(*state)
