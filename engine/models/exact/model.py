@@ -59,8 +59,8 @@ error is NoRoom naming them (the hot loop keeps no record for this).
 
 The kernel counts the wall and pair events as they happen, logged or not (`event_counts`).
 
-The parts live in their own modules beside this one: the state layout (floats F (n, 12), ints
-N (n, 8), scalar state; state.py), the horizon queue (horizonqueue.py), the event queue (a 4-ary
+The parts live in their own modules beside this one: the state layout (floats F (n, 16), ints
+N (n, 16), scalar state; state.py), the horizon queue (horizonqueue.py), the event queue (a 4-ary
 heap; heap.py), the grid's per-cell lists (cells.py), the predictions (prediction.py) and a jam's
 objects (jam.py); from the shared engine, objects with no room to move (engine/noroom.py) and the
 event log (engine/events.py). The events themselves are applied in apply.py (`on_cross`,
