@@ -33,7 +33,6 @@ from collide2d.engine.models.exact.state import (
     JOB_EVENT,
     MU,
     PARTNER,
-    REST,
     SH,
     STATIC,
     SW,
@@ -51,17 +50,17 @@ from collide2d.engine.response import impact, wall_impact
 
 
 @hot
-def move_to(i, t, F, world):
+def move_to(i, t, F, P, world):
     """Bring object i's position (and, under gravity, its velocity) to time t."""
     dt = t - F[i, TLOC]
-    if not falls(world) or (F[i, AX] == 0.0 and F[i, AY] == 0.0):
+    if not falls(world) or (P[i, AX] == 0.0 and P[i, AY] == 0.0):
         F[i, X] += F[i, VX] * dt
         F[i, Y] += F[i, VY] * dt
     else:
-        F[i, X] += F[i, VX] * dt + 0.5 * F[i, AX] * dt * dt
-        F[i, Y] += F[i, VY] * dt + 0.5 * F[i, AY] * dt * dt
-        F[i, VX] += F[i, AX] * dt
-        F[i, VY] += F[i, AY] * dt
+        F[i, X] += F[i, VX] * dt + 0.5 * P[i, AX] * dt * dt
+        F[i, Y] += F[i, VY] * dt + 0.5 * P[i, AY] * dt * dt
+        F[i, VX] += P[i, AX] * dt
+        F[i, VY] += P[i, AY] * dt
     F[i, TLOC] = t
 
 
@@ -91,26 +90,26 @@ def pull(side, world):
 
 
 @hot
-def slide(i, F, N, world):
+def slide(i, F, P, R, world):
     """Set resting object i's acceleration: none into its wall, and along it gravity less friction
     against its sliding (parabola.slide_acceleration); none either against a wall it touches
     along its slide with no speed (it sits in the corner)."""
-    side = N[i, REST]
-    mu = max(F[i, MU], world.friction)
+    side = R[i]
+    mu = max(P[i, MU], world.friction)
     if side == SIDE_LEFT or side == SIDE_RIGHT:
         a = slide_acceleration(world.gy, F[i, VY], mu, pull(side, world))
         span, p, v = world.height - F[i, SH], F[i, Y], F[i, VY]
-        F[i, AX] = 0.0
+        P[i, AX] = 0.0
     else:
         a = slide_acceleration(world.gx, F[i, VX], mu, pull(side, world))
         span, p, v = world.width - F[i, SW], F[i, X], F[i, VX]
-        F[i, AY] = 0.0
+        P[i, AY] = 0.0
     if v == 0.0 and ((a < 0.0 and p <= 0.0) or (a > 0.0 and p >= span)):
         a = 0.0
     if side == SIDE_LEFT or side == SIDE_RIGHT:
-        F[i, AY] = a
+        P[i, AY] = a
     else:
-        F[i, AX] = a
+        P[i, AX] = a
 
 
 @hot
@@ -121,38 +120,39 @@ def _settles(v, a, world):
 
 
 @hot
-def _settle(i, side, F, N, world):
+def _settle(i, side, F, P, R, world):
     """After i's bounce on wall `side` under gravity: a bounce that would rise less than
     `rest_height` ends there, i coming to rest on that wall, or, resting on another and sliding
     into this one, stopping against it."""
     x_side = side == SIDE_LEFT or side == SIDE_RIGHT
     out = 1.0 if side == SIDE_LEFT or side == SIDE_TOP else -1.0  # away from this wall
     away = out * (F[i, VX] if x_side else F[i, VY])
-    if N[i, REST] >= 0:  # sliding on another wall into this one
-        slide(i, F, N, world)
-        if not _settles(away, out * (F[i, AX] if x_side else F[i, AY]), world):
+    if R[i] >= 0:  # sliding on another wall into this one
+        slide(i, F, P, R, world)
+        if not _settles(away, out * (P[i, AX] if x_side else P[i, AY]), world):
             return
     elif _settles(away, -pull(side, world), world):
-        N[i, REST] = side
+        R[i] = side
     else:
         return
     if x_side:
         F[i, VX] = 0.0
     else:
         F[i, VY] = 0.0
-    slide(i, F, N, world)
+    slide(i, F, P, R, world)
 
 
 @hot
-def on_wall(i, side, t, F, N, world, jobs):
+def on_wall(i, side, t, S, jobs):
     """i's box touches a wall: reflect that velocity component (times the contact's restitution,
     the smaller of the object's and the walls'; friction, the larger, takes from the component
     along the wall), set it exactly on the wall line. Under gravity a bounce that would rise less
     than `rest_height` ends there: the object comes to rest on that wall (N's REST), or, resting
     on another and sliding into this one, stops against it. Returns the number of jobs (1)."""
-    move_to(i, t, F, world)
-    e = min(F[i, E], world.restitution)
-    mu = max(F[i, MU], world.friction)
+    F, N, P, R, world = S.F, S.N, S.P, S.R, S.world
+    move_to(i, t, F, P, world)
+    e = min(P[i, E], world.restitution)
+    mu = max(P[i, MU], world.friction)
     x_side = side == SIDE_LEFT or side == SIDE_RIGHT
     if x_side:
         F[i, VX], F[i, VY] = wall_impact(F[i, VX], F[i, VY], e, mu)
@@ -161,7 +161,7 @@ def on_wall(i, side, t, F, N, world, jobs):
         F[i, VY], F[i, VX] = wall_impact(F[i, VY], F[i, VX], e, mu)
         F[i, Y] = 0.0 if side == SIDE_TOP else world.height - F[i, SH]
     if falls(world):
-        _settle(i, side, F, N, world)
+        _settle(i, side, F, P, R, world)
     N[i, CNT] += 1
     N[i, PARTNER] = -1
     set_job(jobs, 0, i, -1, JOB_EVENT)
@@ -169,15 +169,16 @@ def on_wall(i, side, t, F, N, world, jobs):
 
 
 @hot
-def on_stop(i, t, F, N, world, jobs):
+def on_stop(i, t, S, jobs):
     """Resting object i stops sliding: its speed along its wall is 0 from here, and static
     friction holds it or gravity starts it the other way. Returns the number of jobs (1)."""
-    move_to(i, t, F, world)
-    if N[i, REST] == SIDE_LEFT or N[i, REST] == SIDE_RIGHT:
+    F, N, P, R, world = S.F, S.N, S.P, S.R, S.world
+    move_to(i, t, F, P, world)
+    if R[i] == SIDE_LEFT or R[i] == SIDE_RIGHT:
         F[i, VY] = 0.0
     else:
         F[i, VX] = 0.0
-    slide(i, F, N, world)
+    slide(i, F, P, R, world)
     N[i, CNT] += 1
     N[i, PARTNER] = -1
     set_job(jobs, 0, i, -1, JOB_EVENT)
@@ -185,21 +186,21 @@ def on_stop(i, t, F, N, world, jobs):
 
 
 @hot
-def wake_or_slide(i, F, N, world):
+def wake_or_slide(i, F, P, R, world):
     """After a pair event, resting object i wakes (flies under gravity again) when it has a speed
     off its wall, into it or away; else it goes on sliding. Returns whether it woke."""
-    side = N[i, REST]
+    side = R[i]
     normal = F[i, VX] if side == SIDE_LEFT or side == SIDE_RIGHT else F[i, VY]
     if normal != 0.0:
-        N[i, REST] = -1
-        F[i, AX], F[i, AY] = world.gx, world.gy
+        R[i] = -1
+        P[i, AX], P[i, AY] = world.gx, world.gy
         return True
-    slide(i, F, N, world)
+    slide(i, F, P, R, world)
     return False
 
 
 @hot
-def on_pair(a, b, code, nx, ny, t, F, N, world, jobs):
+def on_pair(a, b, code, nx, ny, t, S, jobs):
     """a and b touch: the impact; then each moving one is predicted again, but not against the
     other (unless one falls and the other stands: on a curved relative path they may meet again),
     and a resting one wakes if knocked off its wall (wake_or_slide). Returns the number of jobs
@@ -212,18 +213,19 @@ def on_pair(a, b, code, nx, ny, t, F, N, world, jobs):
     one made before, and the local re-prediction then drift from the full one). For the same
     reason a static object never moves its clock: its counter does not change either, so the
     entries of its other pairs stay valid, and they must equal what asking again would give."""
-    vax, vay = velocity_at(a, t, F, world)
-    vbx, vby = velocity_at(b, t, F, world)
-    e = min(F[a, E], F[b, E])
-    mu = max(F[a, MU], F[b, MU])
+    F, N, P, R, world = S.F, S.N, S.P, S.R, S.world
+    vax, vay = velocity_at(a, t, F, P, world)
+    vbx, vby = velocity_at(b, t, F, P, world)
+    e = min(P[a, E], P[b, E])
+    mu = max(P[a, MU], P[b, MU])
     vax, vay, vbx, vby, changed = impact(
         vax, vay, vbx, vby, F[a, INV_MASS], F[b, INV_MASS], code, nx, ny, e, mu
     )
     # one falls, the other stands: their relative path is curved, and may meet again
     ax = ay = 0.0
     if falls(world):
-        ax = F[b, AX] - F[a, AX]
-        ay = F[b, AY] - F[a, AY]
+        ax = P[b, AX] - P[a, AX]
+        ay = P[b, AY] - P[a, AY]
     curved = ax != 0.0 or ay != 0.0
     if not changed:
         if curved and ax * nx + ay * ny < 0.0:
@@ -233,11 +235,11 @@ def on_pair(a, b, code, nx, ny, t, F, N, world, jobs):
         return -1  # a bounce that dies away on the other: it would rest on it (not yet)
     for i in (a, b):
         if N[i, STATIC] == 0:  # a static object's clock stays at 0: its entries never go stale
-            move_to(i, t, F, world)
+            move_to(i, t, F, P, world)
     F[a, VX], F[a, VY], F[b, VX], F[b, VY] = vax, vay, vbx, vby
     for i in (a, b):
-        if falls(world) and N[i, REST] >= 0:
-            wake_or_slide(i, F, N, world)
+        if falls(world) and R[i] >= 0:
+            wake_or_slide(i, F, P, R, world)
     n_jobs = 0
     for i, other in ((a, b), (b, a)):
         if N[i, STATIC] == 0:
@@ -248,7 +250,7 @@ def on_pair(a, b, code, nx, ny, t, F, N, world, jobs):
     return n_jobs
 
 
-def start_resting(F, N, world) -> None:
+def start_resting(F, N, P, R, world) -> None:
     """Moving objects that start still against a wall gravity pulls them into rest on it (sliding
     along it at their speed there): on the floor, or the ceiling, before on a side wall. Python,
     called once when the model is built."""
@@ -258,7 +260,7 @@ def start_resting(F, N, world) -> None:
         if g == 0.0:
             continue
         on = F[:, X + axis] >= span[:, axis] if g > 0 else F[:, X + axis] <= 0.0
-        still = (F[:, VX + axis] == 0.0) & (N[:, STATIC] == 0) & (N[:, REST] < 0)
+        still = (F[:, VX + axis] == 0.0) & (N[:, STATIC] == 0) & (R < 0)
         for i in np.flatnonzero(on & still):
-            N[i, REST] = high if g > 0 else low
-            slide(int(i), F, N, world)
+            R[i] = high if g > 0 else low
+            slide(int(i), F, P, R, world)

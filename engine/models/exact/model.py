@@ -14,7 +14,7 @@ velocities at the end of the last tick.
 
 Objects fly on straight lines between events, or under the world's gravity on parabolas (exact: `x +
 v·t + ½·g·t²`). Under gravity an object whose bounce on a wall would rise less than `rest_height`
-(px, an option) rests on that wall (N's REST): no speed nor gravity into it, sliding along it
+(px, an option) rests on that wall (R): no speed nor gravity into it, sliding along it
 against friction until it stops, an event due like a wall contact (its horizon); a pair event that
 leaves it a speed off the wall wakes it (apply.py). Each object keeps its own clock (TLOC: its
 position and velocity are valid at that time) and an invalidation counter. Two queues hold what
@@ -59,16 +59,15 @@ error is NoRoom naming them (the hot loop keeps no record for this).
 
 The kernel counts the wall and pair events as they happen, logged or not (`event_counts`).
 
-The parts live in their own modules beside this one: the state layout (floats F (n, 16), ints
-N (n, 16), scalar state; state.py), the horizon queue (horizonqueue.py), the event queue (a 4-ary
-heap; heap.py), the grid's per-cell lists (cells.py), the predictions (prediction.py) and a jam's
-objects (jam.py); from the shared engine, objects with no room to move (engine/noroom.py) and the
-event log (engine/events.py). The events themselves are applied in apply.py (`on_cross`,
+The parts live in their own modules beside this one: the state layout (floats F (n, 8), ints N (n,
+8), P (n, 4), R (n,), scalar state; state.py), the horizon queue (horizonqueue.py), the event queue
+(a 4-ary heap; heap.py), the grid's per-cell lists (cells.py), the predictions (prediction.py) and a
+jam's objects (jam.py); from the shared engine, objects with no room to move (engine/noroom.py) and
+the event log (engine/events.py). The events themselves are applied in apply.py (`on_cross`,
 `on_wall`, `on_pair`); this module runs the main loop, `_run`: take the next event, apply it,
 predict again for what it touched. The kernel `_run` (with `predict` inlined) allocates nothing:
 growing the heap or the event log is done in Python between calls (the kernel stops before an event
-it has no room for, and resumes).
-"""
+it has no room for, and resumes). """
 
 from __future__ import annotations
 
@@ -130,7 +129,6 @@ from collide2d.engine.models.exact.state import (
     AX,
     AY,
     CELL,
-    F_COLUMNS,
     INF,
     INV_MASS,
     J_EXTRA,
@@ -141,9 +139,7 @@ from collide2d.engine.models.exact.state import (
     JOB_FIRST,
     JOB_ROWS,
     MU,
-    N_COLUMNS,
     PARTNER,
-    REST,
     S_FIRST,
     S_HEAP_N,
     S_LOGGED,
@@ -308,16 +304,16 @@ def _run(state, jobs, stack, tick_to, log, cap, everyone, rows, times):
                         push(HT, HI, HN, st, e)
                     return STATUS_CAP
                 # what a (and b) rested on before: -1 nothing (nothing rests without gravity)
-                rest_a = N[a, REST] if falls(world) else -1
-                rest_b = N[b, REST] if falls(world) and rank == RANK_PAIR else -1
+                rest_a = S.R[a] if falls(world) else -1
+                rest_b = S.R[b] if falls(world) and rank == RANK_PAIR else -1
                 if rank == RANK_WALL and b == STOP:
-                    n_jobs = on_stop(a, t, F, N, world, jobs)
+                    n_jobs = on_stop(a, t, S, jobs)
                     kind, b, code = EV_STOP, -1, rest_a
                 elif rank == RANK_WALL:
-                    n_jobs = on_wall(a, b, t, F, N, world, jobs)
+                    n_jobs = on_wall(a, b, t, S, jobs)
                     kind, b = EV_WALL, -1
                 else:
-                    n_jobs = on_pair(a, b, code, e.nx, e.ny, t, F, N, world, jobs)
+                    n_jobs = on_pair(a, b, code, e.nx, e.ny, t, S, jobs)
                     kind = EV_PAIR
                     if n_jobs < 0:  # a body would rest on another: stopped, the pair named
                         set_job(jobs, 0, a, b, JOB_EVENT)
@@ -331,11 +327,11 @@ def _run(state, jobs, stack, tick_to, log, cap, everyone, rows, times):
                         put_event(rows, times, st[S_LOGGED], tick, t, kind, a, b, code)
                         st[S_LOGGED] += 1
                         # the modes the event changed: a rest it began, the rests it ended
-                        if kind == EV_WALL and rest_a < 0 and N[a, REST] >= 0:
+                        if kind == EV_WALL and rest_a < 0 and S.R[a] >= 0:
                             put_event(rows, times, st[S_LOGGED], tick, t, EV_REST, a, -1, code)
                             st[S_LOGGED] += 1
                         for i, was in ((a, rest_a), (b, rest_b)):
-                            if kind == EV_PAIR and was >= 0 and N[i, REST] < 0:
+                            if kind == EV_PAIR and was >= 0 and S.R[i] < 0:
                                 put_event(rows, times, st[S_LOGGED], tick, t, EV_WAKE, i, -1, was)
                                 st[S_LOGGED] += 1
         # predict again for what the step touched (and after an event with `everyone`, for
@@ -403,18 +399,19 @@ class Model:
         n = bodies.n
         static = np.asarray(bodies.static, bool)
         cores = build_cores(bodies, geometry)
-        self._F = np.zeros((n, F_COLUMNS))
+        self._F = np.zeros((n, 8))
         self._F[:, X : Y + 1] = bodies.pos
         self._F[:, VX : VY + 1] = np.where(static[:, None], 0.0, bodies.vel)
         self._F[:, SW : SH + 1] = bodies.size
         self._F[:, INV_MASS] = bodies.inv_mass
-        self._F[~static, AX : AY + 1] = world.gravity
-        self._F[:, E] = bodies.restitution
-        self._F[:, MU] = bodies.friction
+        self._P = np.zeros((n, 4))
+        self._P[~static, AX : AY + 1] = world.gravity
+        self._P[:, E] = bodies.restitution
+        self._P[:, MU] = bodies.friction
+        self._R = np.full(n, -1, np.int64)
         self.gravity = world.has_gravity
-        self._N = np.zeros((n, N_COLUMNS), np.int64)
+        self._N = np.zeros((n, 8), np.int64)
         self._N[:, PARTNER] = -1
-        self._N[:, REST] = -1
         self._N[:, STATIC] = static
         self._N[:, SHAPE] = cores.shape
         self._C = Cores(cores.radius, cores.start, cores.verts, cores.normals)
@@ -441,7 +438,7 @@ class Model:
             float(world.gravity[1]),
             float(rest_height),
         )
-        start_resting(self._F, self._N, self._world)
+        start_resting(self._F, self._N, self._P, self._R, self._world)
         self._G = build_grid(self._F, self._N, self.cell_size, gnx, gny)
         cap = max(64, HEAP_PER_OBJECT * n)
         self._heap = [np.empty(cap), np.empty((cap, 3), np.int64), np.empty((cap, 2))]
@@ -461,6 +458,8 @@ class Model:
         return State(
             self._F,
             self._N,
+            self._P,
+            self._R,
             self._C,
             cells,
             s_start,
@@ -584,7 +583,7 @@ class Model:
         dt = t - F[:, TLOC : TLOC + 1]
         pos = F[:, X : Y + 1] + F[:, VX : VY + 1] * dt
         if self.gravity:
-            pos += 0.5 * F[:, AX : AY + 1] * dt * dt
+            pos += 0.5 * self._P[:, AX : AY + 1] * dt * dt
         limit = np.array([self._world.width, self._world.height]) - F[:, SW : SH + 1]
         return np.minimum(np.maximum(pos, 0.0), limit)
 
@@ -594,4 +593,4 @@ class Model:
         if not self.gravity:
             return F[:, VX : VY + 1].copy()
         t = self.tick / self._world.fps
-        return F[:, VX : VY + 1] + F[:, AX : AY + 1] * (t - F[:, TLOC : TLOC + 1])
+        return F[:, VX : VY + 1] + self._P[:, AX : AY + 1] * (t - F[:, TLOC : TLOC + 1])

@@ -34,7 +34,6 @@ from collide2d.engine.models.exact.state import (
     JOB_CROSS,
     JOB_FIRST,
     NEXT,
-    REST,
     S_STAMP,
     SH,
     SHAPE,
@@ -55,25 +54,25 @@ from collide2d.engine.world import KIND_BOX
 
 
 @hot
-def velocity_at(i, t, F, world):
+def velocity_at(i, t, F, P, world):
     """Object i's velocity at time t (its own, unchanged without acceleration)."""
-    if not falls(world) or (F[i, AX] == 0.0 and F[i, AY] == 0.0):
+    if not falls(world) or (P[i, AX] == 0.0 and P[i, AY] == 0.0):
         return F[i, VX], F[i, VY]
     dt = t - F[i, TLOC]
-    return F[i, VX] + F[i, AX] * dt, F[i, VY] + F[i, AY] * dt
+    return F[i, VX] + P[i, AX] * dt, F[i, VY] + P[i, AY] * dt
 
 
 @hot
-def _state_at(i, t, F):
+def _state_at(i, t, F, P):
     """Object i's position and velocity at time t (x, y, vx, vy), not stored."""
     dt = t - F[i, TLOC]
-    if F[i, AX] == 0.0 and F[i, AY] == 0.0:
+    if P[i, AX] == 0.0 and P[i, AY] == 0.0:
         return F[i, X] + F[i, VX] * dt, F[i, Y] + F[i, VY] * dt, F[i, VX], F[i, VY]
     return (
-        F[i, X] + F[i, VX] * dt + 0.5 * F[i, AX] * dt * dt,
-        F[i, Y] + F[i, VY] * dt + 0.5 * F[i, AY] * dt * dt,
-        F[i, VX] + F[i, AX] * dt,
-        F[i, VY] + F[i, AY] * dt,
+        F[i, X] + F[i, VX] * dt + 0.5 * P[i, AX] * dt * dt,
+        F[i, Y] + F[i, VY] * dt + 0.5 * P[i, AY] * dt * dt,
+        F[i, VX] + P[i, AX] * dt,
+        F[i, VY] + P[i, AY] * dt,
     )
 
 
@@ -88,21 +87,21 @@ def _first_of_two(t_lo, t_hi, lo, hi):
 
 
 @hot
-def _wall_time_falling(i, t_now, F, world):
+def _wall_time_falling(i, t_now, F, P, world):
     """_wall_time under an acceleration: on each axis the first of its two walls the parabola meets
     (parabola.meet), from i's state at t_now."""
-    x, y, vx, vy = _state_at(i, t_now, F)
+    x, y, vx, vy = _state_at(i, t_now, F, P)
     sx = world.width - F[i, SW]
     sy = world.height - F[i, SH]
     tx, side_x = _first_of_two(
-        meet(max(x, 0.0), vx, F[i, AX]),
-        meet(max(sx - x, 0.0), -vx, -F[i, AX]),
+        meet(max(x, 0.0), vx, P[i, AX]),
+        meet(max(sx - x, 0.0), -vx, -P[i, AX]),
         SIDE_LEFT,
         SIDE_RIGHT,
     )
     ty, side_y = _first_of_two(
-        meet(max(y, 0.0), vy, F[i, AY]),
-        meet(max(sy - y, 0.0), -vy, -F[i, AY]),
+        meet(max(y, 0.0), vy, P[i, AY]),
+        meet(max(sy - y, 0.0), -vy, -P[i, AY]),
         SIDE_TOP,
         SIDE_BOTTOM,
     )
@@ -114,21 +113,21 @@ def _wall_time_falling(i, t_now, F, world):
 
 
 @hot
-def _stop_time(i, t_now, F, N):
+def _stop_time(i, t_now, F, P, R):
     """When resting object i, sliding against friction, stops (inf: never)."""
-    x, y, vx, vy = _state_at(i, t_now, F)
-    side = N[i, REST]
-    v, a = (vy, F[i, AY]) if side == SIDE_LEFT or side == SIDE_RIGHT else (vx, F[i, AX])
+    x, y, vx, vy = _state_at(i, t_now, F, P)
+    side = R[i]
+    v, a = (vy, P[i, AY]) if side == SIDE_LEFT or side == SIDE_RIGHT else (vx, P[i, AX])
     if v * a < 0.0:
         return t_now + -v / a
     return INF
 
 
 @hot
-def _wall_time(i, t_now, F, world):
+def _wall_time(i, t_now, F, P, world):
     """(t, side) of i's next wall contact (its box touching a wall line), (inf, -1) if none."""
-    if falls(world) and (F[i, AX] != 0.0 or F[i, AY] != 0.0):
-        return _wall_time_falling(i, t_now, F, world)
+    if falls(world) and (P[i, AX] != 0.0 or P[i, AY] != 0.0):
+        return _wall_time_falling(i, t_now, F, P, world)
     t_best = INF
     side = -1
     if F[i, VX] > 0.0:
@@ -147,16 +146,16 @@ def _wall_time(i, t_now, F, world):
 
 
 @hot
-def _cross_time_falling(i, t_now, F, N, world):
+def _cross_time_falling(i, t_now, F, P, N, world):
     """_cross_time under an acceleration: on each axis the first of the cell's two sides the
     centre's parabola meets (parabola.meet; none on the grid's edge), from i's state at t_now."""
     cell, gnx, gny = world.cell, world.gnx, world.gny
     gx = N[i, CELL] % gnx
     gy = N[i, CELL] // gnx
-    x, y, vx, vy = _state_at(i, t_now, F)
+    x, y, vx, vy = _state_at(i, t_now, F, P)
     cx = x + 0.5 * F[i, SW] - gx * cell  # the centre within its cell
     cy = y + 0.5 * F[i, SH] - gy * cell
-    ax, ay = F[i, AX], F[i, AY]
+    ax, ay = P[i, AX], P[i, AY]
     t_left = meet(max(cx, 0.0), vx, ax) if gx > 0 else INF
     t_right = meet(max(cell - cx, 0.0), -vx, -ax) if gx < gnx - 1 else INF
     t_up = meet(max(cy, 0.0), vy, ay) if gy > 0 else INF
@@ -171,10 +170,10 @@ def _cross_time_falling(i, t_now, F, N, world):
 
 
 @hot
-def _cross_time(i, t_now, F, N, world):
+def _cross_time(i, t_now, F, P, N, world):
     """(t, direction) when i's box centre next leaves its grid cell, (inf, -1) if never."""
-    if falls(world) and (F[i, AX] != 0.0 or F[i, AY] != 0.0):
-        return _cross_time_falling(i, t_now, F, N, world)
+    if falls(world) and (P[i, AX] != 0.0 or P[i, AY] != 0.0):
+        return _cross_time_falling(i, t_now, F, P, N, world)
     cell, gnx, gny = world.cell, world.gnx, world.gny
     gx = N[i, CELL] % gnx
     gy = N[i, CELL] // gnx
@@ -248,11 +247,12 @@ def _predict_pair(i, j, t_now, limit, S):
     b = max(i, j)
     t0 = max(F[a, TLOC], F[b, TLOC])
     if falls(S.world):
-        xa, ya, vax, vay = _state_at(a, t0, F)
-        xb, yb, vbx, vby = _state_at(b, t0, F)
+        P = S.P
+        xa, ya, vax, vay = _state_at(a, t0, F, P)
+        xb, yb, vbx, vby = _state_at(b, t0, F, P)
         qx, qy, ux, uy = xb - xa, yb - ya, vbx - vax, vby - vay
-        ax = F[b, AX] - F[a, AX]
-        ay = F[b, AY] - F[a, AY]
+        ax = P[b, AX] - P[a, AX]
+        ay = P[b, AY] - P[a, AY]
         if ax != 0.0 or ay != 0.0:  # one falls, the other stands: a curved relative path
             path = Arc(qx, qy, ux, uy, ax, ay)
             t, code, nx, ny = _arc_contact(a, b, path, t_now - t0, N, S.C)
@@ -291,13 +291,14 @@ def predict(jobs, k, t_now, S):
     s_start, s_items = S.s_start, S.s_items
     i, skip, mode = jobs[k, J_OBJ], jobs[k, J_SKIP], jobs[k, J_HIGHER]
     higher = mode == JOB_FIRST
-    t_wall, side = _wall_time(i, t_now, F, world)
-    if falls(world) and N[i, REST] >= 0:  # resting: its stop, if first, changes it next
-        t_stop = _stop_time(i, t_now, F, N)
+    P, R = S.P, S.R
+    t_wall, side = _wall_time(i, t_now, F, P, world)
+    if falls(world) and R[i] >= 0:  # resting: its stop, if first, changes it next
+        t_stop = _stop_time(i, t_now, F, P, R)
         if t_stop < t_wall:
             t_wall, side = t_stop, STOP
     if mode != JOB_CONTACTS:
-        t_cross, d = _cross_time(i, t_now, F, N, world)
+        t_cross, d = _cross_time(i, t_now, F, P, N, world)
         if t_cross <= t_wall and t_cross < INF:
             t_h, rank, what = max(t_cross, t_now), RANK_CROSS, d
         elif t_wall < INF:

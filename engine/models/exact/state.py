@@ -1,9 +1,10 @@
 """The exact model's state layout: its records, the columns of its arrays, its scalar state, its
 statuses.
 
-The exact model (model.py) keeps its objects in two arrays, floats F (n, 16) and ints
-N (n, 16), and its counters in `st` (int64) and `stf` (float64); the event queue (heap.py),
-the grid lists (cells.py) and the predictions (prediction.py) all read them by the names below.
+The exact model (model.py) keeps its objects in two arrays, floats F (n, 8) and ints N (n, 8),
+what only gravity and impacts read in P (n, 4) and R (n,), and its counters in `st` (int64) and
+`stf` (float64); the event queue (heap.py), the grid lists (cells.py) and the predictions
+(prediction.py) all read them by the names below.
 Its kernels share one record, `State`, read by field, which holds the others: `World` (the
 world's sides, fps and grid), `Cores` (the exact shapes) and `Horizons` (the horizon queue,
 horizonqueue.py); a heap entry travels as an `Entry`.
@@ -76,8 +77,10 @@ class Entry(NamedTuple):
 class State(NamedTuple):
     """The arrays the exact model's kernels share, handed to them as one argument."""
 
-    F: np.ndarray  # (n, 16) float64, columns below
-    N: np.ndarray  # (n, 16) int64, columns below
+    F: np.ndarray  # (n, 8) float64, columns below
+    N: np.ndarray  # (n, 8) int64, columns below
+    P: np.ndarray  # (n, 4) float64, columns below: acceleration, restitution, friction
+    R: np.ndarray  # (n,) int64: the wall side each object rests on (-1: none)
     C: Cores  # exact shapes
     cells: np.ndarray  # the grid's per-cell lists of movers (cells.py)
     s_start: np.ndarray  # each cell's first entry in s_items (static objects)
@@ -96,23 +99,19 @@ def plain(S: State) -> tuple:
     return tuple(S._replace(C=tuple(S.C), Q=tuple(S.Q), world=tuple(S.world)))
 
 
-# A row of F or N is 16 columns, two cache lines (128 bytes): the first 8, one line, hold what
-# every event and prediction reads, the rest what only gravity and impacts read, so that a scene
-# without gravity touches one line per object as it did before those columns came (a row of 12
-# or 9 would straddle two lines for every other object: 11 % fewer steps/s on the bench's 1,000).
-ROW_COLUMNS = 16
-# Columns of F (n, 16) float64: position (top-left, px) and velocity (px/s) valid at the object's
-# own clock TLOC (s), box size (px), inverse mass (0 for static objects); then acceleration
-# (px/s²: the world's gravity for a moving object, 0 for a static one and without gravity),
-# restitution and friction.
-X, Y, VX, VY, TLOC, SW, SH, INV_MASS, AX, AY, E, MU = range(12)
-F_COLUMNS = ROW_COLUMNS
-# Columns of N (n, 16) int64: invalidation counter, static flag, contact shape kind, grid cell,
+# Columns of F (n, 8) float64: position (top-left, px) and velocity (px/s) valid at the object's
+# own clock TLOC (s), box size (px), inverse mass (0 for static objects).
+X, Y, VX, VY, TLOC, SW, SH, INV_MASS = range(8)
+# Columns of N (n, 8) int64: invalidation counter, static flag, contact shape kind, grid cell,
 # next / previous object in that cell's list (-1 for none), last query stamp (static objects),
-# the partner of its last event if that was a pair (-1 otherwise); then the wall side it rests on
-# (-1: it does not rest).
-CNT, STATIC, SHAPE, CELL, NEXT, PREV, STAMP, PARTNER, REST = range(9)
-N_COLUMNS = ROW_COLUMNS
+# the partner of its last event if that was a pair (-1 otherwise).
+CNT, STATIC, SHAPE, CELL, NEXT, PREV, STAMP, PARTNER = range(8)
+# Columns of P (n, 4) float64, what only gravity and impacts read (apart from F and N, whose rows
+# of 8 are one cache line each, as every event and prediction reads them: wider rows cost a
+# scene without gravity up to 12 % of its steps/s): acceleration (px/s²: the world's gravity for
+# a moving object, 0 for a static one, and along its wall only for a resting one), restitution
+# and friction. R (n,) int64: the wall side each object rests on (-1: it does not rest).
+AX, AY, E, MU = range(4)
 # A horizon's `what` (besides wall sides 0-3 and directions 0-3): a resting object stops sliding.
 STOP = 4
 
@@ -168,6 +167,8 @@ def named(state):
     return State(
         S.F,
         S.N,
+        S.P,
+        S.R,
         Cores(*S.C),
         S.cells,
         S.s_start,
