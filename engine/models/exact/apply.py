@@ -151,8 +151,10 @@ def on_wall(i, side, t, S, jobs):
     on another and sliding into this one, stops against it. Returns the number of jobs (1)."""
     F, N, P, R, world = S.F, S.N, S.P, S.R, S.world
     move_to(i, t, F, P, world)
-    e = min(P[i, E], world.restitution)
-    mu = max(P[i, MU], world.friction)
+    e, mu = 1.0, 0.0  # a world without physics keys: no need to read them
+    if not world.elastic:
+        e = min(P[i, E], world.restitution)
+        mu = max(P[i, MU], world.friction)
     x_side = side == SIDE_LEFT or side == SIDE_RIGHT
     if x_side:
         F[i, VX], F[i, VY] = wall_impact(F[i, VX], F[i, VY], e, mu)
@@ -216,8 +218,10 @@ def on_pair(a, b, code, nx, ny, t, S, jobs):
     F, N, P, R, world = S.F, S.N, S.P, S.R, S.world
     vax, vay = velocity_at(a, t, F, P, world)
     vbx, vby = velocity_at(b, t, F, P, world)
-    e = min(P[a, E], P[b, E])
-    mu = max(P[a, MU], P[b, MU])
+    e, mu = 1.0, 0.0
+    if not world.elastic:
+        e = min(P[a, E], P[b, E])
+        mu = max(P[a, MU], P[b, MU])
     vax, vay, vbx, vby, changed = impact(
         vax, vay, vbx, vby, F[a, INV_MASS], F[b, INV_MASS], code, nx, ny, e, mu
     )

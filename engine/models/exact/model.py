@@ -437,6 +437,13 @@ class Model:
             float(world.gravity[0]),
             float(world.gravity[1]),
             float(rest_height),
+            bool(
+                not world.has_gravity
+                and world.restitution == 1.0
+                and world.friction == 0.0
+                and np.all(self._P[:, E] == 1.0)
+                and np.all(self._P[:, MU] == 0.0)
+            ),
         )
         start_resting(self._F, self._N, self._P, self._R, self._world)
         self._G = build_grid(self._F, self._N, self.cell_size, gnx, gny)

@@ -39,6 +39,7 @@ class World(NamedTuple):
     gx: float  # gravity, px/s²
     gy: float
     rest_height: float  # px: a bounce on a wall that would rise less comes to rest on it
+    elastic: bool  # no gravity, and every restitution 1 and friction 0: P is never read
 
 
 class Cores(NamedTuple):
