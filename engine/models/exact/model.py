@@ -425,6 +425,7 @@ class Model:
                 cell_size = float(max(world.width, world.height))
         self.cell_size = float(cell_size)
         gnx, gny = grid_dims(world.width, world.height, self.cell_size)
+        plain = world.restitution == 1.0 and world.friction == 0.0  # the walls'
         self._world = World(
             float(world.width),
             float(world.height),
@@ -437,13 +438,7 @@ class Model:
             float(world.gravity[0]),
             float(world.gravity[1]),
             float(rest_height),
-            bool(
-                not world.has_gravity
-                and world.restitution == 1.0
-                and world.friction == 0.0
-                and np.all(self._P[:, E] == 1.0)
-                and np.all(self._P[:, MU] == 0.0)
-            ),
+            bool(plain and not self.gravity and np.all(self._P[:, E : MU + 1] == (1.0, 0.0))),
         )
         start_resting(self._F, self._N, self._P, self._R, self._world)
         self._G = build_grid(self._F, self._N, self.cell_size, gnx, gny)
