@@ -54,7 +54,7 @@ def test_the_first_contact_is_where_sampling_first_sees_an_overlap():
     step = 2e-4
     ts = np.arange(0.0, 2.0, step)
     met = 0
-    for _ in range(300):
+    for _ in range(200):
         ka, kb = rng.choice(KINDS, 2)
         wa, wb = (float(x) for x in rng.integers(4, 20, 2))
         A = shape(ka, wa, wa if ka == KIND_CIRCLE else float(rng.integers(4, 20)))
@@ -78,7 +78,7 @@ def test_the_first_contact_is_where_sampling_first_sees_an_overlap():
             assert abs(depth(A, B, p)) <= 1e-7  # touching, not inside
             v = u + a * t
             assert v[0] * nx + v[1] * ny <= 1e-9  # coming in along the normal
-    assert met >= 60  # the cases met a contact, not only misses
+    assert met >= 40  # the cases met a contact, not only misses
 
 
 @pytest.mark.parametrize("kind", KINDS)
