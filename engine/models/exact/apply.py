@@ -42,6 +42,7 @@ from collide2d.engine.models.exact.state import (
     E,
     X,
     Y,
+    cold,
     falls,
     hot,
 )
@@ -119,7 +120,7 @@ def _settles(v, a, world):
     return a < 0.0 and v * v <= -2.0 * a * world.rest_height
 
 
-@hot
+@cold
 def _settle(i, side, F, P, R, world):
     """After i's bounce on wall `side` under gravity: a bounce that would rise less than
     `rest_height` ends there, i coming to rest on that wall, or, resting on another and sliding
@@ -170,7 +171,7 @@ def on_wall(i, side, t, S, jobs):
     return 1
 
 
-@hot
+@cold
 def on_stop(i, t, S, jobs):
     """Resting object i stops sliding: its speed along its wall is 0 from here, and static
     friction holds it or gravity starts it the other way. Returns the number of jobs (1)."""
@@ -187,7 +188,7 @@ def on_stop(i, t, S, jobs):
     return 1
 
 
-@hot
+@cold
 def wake_or_slide(i, F, P, R, world):
     """After a pair event, resting object i wakes (flies under gravity again) when it has a speed
     off its wall, into it or away; else it goes on sliding. Returns whether it woke."""

@@ -46,6 +46,7 @@ from collide2d.engine.models.exact.state import (
     Entry,
     X,
     Y,
+    cold,
     falls,
     hot,
 )
@@ -86,7 +87,7 @@ def _first_of_two(t_lo, t_hi, lo, hi):
     return INF, -1
 
 
-@hot
+@cold
 def _wall_time_falling(i, t_now, F, P, world):
     """_wall_time under an acceleration: on each axis the first of its two walls the parabola meets
     (parabola.meet), from i's state at t_now."""
@@ -112,7 +113,7 @@ def _wall_time_falling(i, t_now, F, P, world):
     return INF, -1
 
 
-@hot
+@cold
 def _stop_time(i, t_now, F, P, R):
     """When resting object i, sliding against friction, stops (inf: never)."""
     x, y, vx, vy = _state_at(i, t_now, F, P)
@@ -145,7 +146,7 @@ def _wall_time(i, t_now, F, P, world):
     return t_best, side
 
 
-@hot
+@cold
 def _cross_time_falling(i, t_now, F, P, N, world):
     """_cross_time under an acceleration: on each axis the first of the cell's two sides the
     centre's parabola meets (parabola.meet; none on the grid's edge), from i's state at t_now."""
@@ -235,6 +236,27 @@ def _arc_contact(a, b, path, now, N, C):
     return arc_contact(path, core_a, core_b, now)
 
 
+@cold
+def _falling_pair(a, b, t0, t_now, limit, S):
+    """_predict_pair's start under gravity: the pair's relative position and velocity at t0,
+    (False, qx, qy, ux, uy); or, when one falls and the other stands, their curved relative path's
+    contact pushed if it comes no later than `limit`, (True, ...)."""
+    F, N, P = S.F, S.N, S.P
+    xa, ya, vax, vay = _state_at(a, t0, F, P)
+    xb, yb, vbx, vby = _state_at(b, t0, F, P)
+    qx, qy, ux, uy = xb - xa, yb - ya, vbx - vax, vby - vay
+    ax = P[b, AX] - P[a, AX]
+    ay = P[b, AY] - P[a, AY]
+    if ax == 0.0 and ay == 0.0:
+        return False, qx, qy, ux, uy
+    t, code, nx, ny = _arc_contact(a, b, Arc(qx, qy, ux, uy, ax, ay), t_now - t0, N, S.C)
+    t = max(t0 + t, t_now)
+    if t <= limit:
+        e = Entry(t, make_key(RANK_PAIR, a, b, code), N[a, CNT], N[b, CNT], nx, ny)
+        push(S.HT, S.HI, S.HN, S.st, e)
+    return True, qx, qy, ux, uy
+
+
 @hot
 def _predict_pair(i, j, t_now, limit, S):
     """Push the next contact of i and j if it comes no later than `limit` (s).
@@ -247,19 +269,8 @@ def _predict_pair(i, j, t_now, limit, S):
     b = max(i, j)
     t0 = max(F[a, TLOC], F[b, TLOC])
     if falls(S.world):
-        P = S.P
-        xa, ya, vax, vay = _state_at(a, t0, F, P)
-        xb, yb, vbx, vby = _state_at(b, t0, F, P)
-        qx, qy, ux, uy = xb - xa, yb - ya, vbx - vax, vby - vay
-        ax = P[b, AX] - P[a, AX]
-        ay = P[b, AY] - P[a, AY]
-        if ax != 0.0 or ay != 0.0:  # one falls, the other stands: a curved relative path
-            path = Arc(qx, qy, ux, uy, ax, ay)
-            t, code, nx, ny = _arc_contact(a, b, path, t_now - t0, N, S.C)
-            t = max(t0 + t, t_now)
-            if t <= limit:
-                e = Entry(t, make_key(RANK_PAIR, a, b, code), N[a, CNT], N[b, CNT], nx, ny)
-                push(S.HT, S.HI, S.HN, S.st, e)
+        curved, qx, qy, ux, uy = _falling_pair(a, b, t0, t_now, limit, S)
+        if curved:
             return
     else:
         qx = (F[b, X] + F[b, VX] * (t0 - F[b, TLOC])) - (F[a, X] + F[a, VX] * (t0 - F[a, TLOC]))

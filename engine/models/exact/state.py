@@ -152,6 +152,10 @@ INF = np.inf
 # inlined helper took ~85 % of the run time on event-heavy scenes.
 hot = njit(cache=True, inline="always")
 kernel = njit(cache=True, _nrt=False)
+# What only gravity runs (a parabola's next wall, a slide, a rest) is compiled once on its own and
+# called, not inlined (`cold`): inlined, it doubled the event loop's compile time (a cold kernel
+# cache's minute) and its code, slowing the scenes without gravity that never run it.
+cold = njit(cache=True)
 
 
 @hot
