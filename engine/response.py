@@ -13,8 +13,11 @@ gives v1' = v1 - J w1 n and v2' = v2 + J w2 n, so u' = u + J (w1 + w2). Momentum
 
 Written with the ratios r1 + r2 = 1 it stays finite and exact in the limits: a static partner
 (w2 = 0) gives r1 = 1, a mirror reflection; masses 1 : 10^10 give r = 1 - 1e-10 and 1e-10 and no
-cancellation. With AXIS_XY (corner to corner) the exchange acts on x and on y apart, each with its
-own sign, and only on an axis along which the pair approaches.
+cancellation. Only the heavier body's change is computed from its ratio; the lighter one's is
+what leaves the pair at -u (times e) along n: a ratio rounded alike at every impact would
+otherwise bias the energy alike (docs/models.md#the-elastic-exchange). With AXIS_XY (corner
+to corner) the exchange acts on x and on y apart, each with its own sign, and only on an axis
+along which the pair approaches.
 """
 
 from __future__ import annotations
@@ -52,10 +55,18 @@ def impact_along(vax, vay, vbx, vby, wa, wb, nx, ny, e, mu):
         return vax, vay, vbx, vby, False
     ra = wa / (wa + wb)
     rb = wb / (wa + wb)
-    ja = (1.0 + e) * u * ra
-    jb = (1.0 + e) * u * rb
-    vax, vay = vax + ja * nx, vay + ja * ny
-    vbx, vby = vbx - jb * nx, vby - jb * ny
+    # the heavier one (a on a tie) takes its share of the impulse; the other then leaves at -e·u
+    # from it, so that a mass ratio rounded the same way at every impact never biases the energy
+    if wa <= wb:
+        ja = (1.0 + e) * u * ra
+        vax, vay = vax + ja * nx, vay + ja * ny
+        jb = (vax - vbx) * nx + (vay - vby) * ny - e * u
+        vbx, vby = vbx + jb * nx, vby + jb * ny
+    else:
+        jb = (1.0 + e) * u * rb
+        vbx, vby = vbx - jb * nx, vby - jb * ny
+        ja = (vbx - vax) * nx + (vby - vay) * ny + e * u
+        vax, vay = vax + ja * nx, vay + ja * ny
     if mu > 0.0:
         # the sliding of b along a before the impact, and what friction takes of it
         tx = (vbx - vax) - ((vbx - vax) * nx + (vby - vay) * ny) * nx
