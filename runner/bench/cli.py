@@ -179,7 +179,8 @@ def register(subparsers) -> None:
         "skip saves, and the section IV targets; with --peers, pymunk on the same scene; with "
         "--part, also the paper model three ways, the exact model's events/s, the drawing and "
         "writing of frames, (jit) each --jit mode's wall time from an empty kernel cache, and "
-        "(gravity) a settling pile against pymunk and both against the closed forms. "
+        "(gravity) a settling pile against pymunk, the stepped and exact models and pymunk "
+        "against the closed forms, and the exact model's events/s under gravity. "
         "Writes OUT/bench/bench.csv, bench.md and, with matplotlib, "
         "scaling.png, runtime_vs_error.png and gravity_runtime_vs_error.png.",
     )

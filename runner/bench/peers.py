@@ -12,7 +12,8 @@ both sides of the ratio alike (timed apart, minutes after the stepped model, the
 drift in); `peers` then divides the stepped model's steps/s by pymunk's.
 
 The gravity part (`--part gravity`, `gravity`): the stepped model's settling path against pymunk
-under gravity, and both against the closed forms (PHYSICS.md).
+under gravity, the stepped and exact models and pymunk against the closed forms (PHYSICS.md), and
+the exact model's events per second under gravity (fall.py).
 
 A settling pile (`pile`): n boxes of 8 px, e 0.3 and mu 0.3, on a grid ASPECT times as wide as it
 is tall (8 rows at 1,000, 25 at 10,000), dropped into a box just wider, at 60 fps with 2
@@ -27,13 +28,14 @@ Closed forms: a box dropped 100 px with e 0.5, its first three bounce instants
 against `t_n = t1·(1 + 2e(1 - e^(n-1)) / (1 - e))` (each found from the state after the step that
 held it: exact between contacts, the bounce lies `τ = 2h / (v + √(v² + 2g·h))` before it, h the
 height above the floor and v the speed up); a box sliding at 200 px/s with mu 0.5 against
-`v0² / (2·mu·g)`; each at CHART_FPS steps a second (one step a frame) by both, with the run time
+`v0² / (2·mu·g)`; each at CHART_FPS steps a second (one step a frame) by each, with the run time
 of its CLOSED_S simulated seconds, for gravity_runtime_vs_error.png (runner/bench/plots.py). Rows
 are one figure each (`value`, described by `note`).
 """
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 
@@ -213,7 +215,7 @@ def _ms_per_step(run, steps: int) -> float:
     return (time.perf_counter() - began) / steps * 1e3
 
 
-def _row(scene, model, n, value, note) -> dict:
+def row(scene, model, n, value, note) -> dict:
     """One figure of the gravity part, its note led by the model's name."""
     return {
         "part": "gravity",
@@ -233,7 +235,7 @@ def timings(n: int, echo) -> list[dict]:
     model = make("stepped", world, bodies, substeps=SUBSTEPS)
     model.advance(1)  # compiled (or loaded) before the clock starts
     ours = _ms_per_step(lambda k: model.advance(k // SUBSTEPS, log=False), steps)
-    rows = [_row(f"pile-{n}", "stepped", n, ours, "ms per step (1/120 s), the first second")]
+    rows = [row(f"pile-{n}", "stepped", n, ours, "ms per step (1/120 s), the first second")]
     slept = 1.0 + 1.0 / FPS
     while not model._settle.asleep().all() and slept < SETTLE_LIMIT_S:
         model.advance(FPS // 2, log=False)
@@ -241,7 +243,7 @@ def timings(n: int, echo) -> list[dict]:
     settled = _ms_per_step(lambda k: model.advance(k // SUBSTEPS, log=False), steps)
     asleep = int(model._settle.asleep().sum())
     rows.append(
-        _row(
+        row(
             f"pile-{n}",
             "stepped",
             n,
@@ -250,7 +252,7 @@ def timings(n: int, echo) -> list[dict]:
         )  # fmt: skip
     )
     rows.append(
-        _row(f"pile-{n}", "stepped", n, settled / ours, "settled / moving per step (target <= 0.1)")
+        row(f"pile-{n}", "stepped", n, settled / ours, "settled / moving per step (target <= 0.1)")
     )
     echo(f"gravity  stepped  n={n:<6d} moving {ours:8.3f} ms/step, settled {settled:8.4f} ms/step")
     try:
@@ -265,10 +267,10 @@ def timings(n: int, echo) -> list[dict]:
             space.step(dt)
 
     peer = _ms_per_step(stepping, steps)
-    rows.append(_row(f"pile-{n}", "pymunk", n, peer, "ms per step (1/120 s), the first second"))
+    rows.append(row(f"pile-{n}", "pymunk", n, peer, "ms per step (1/120 s), the first second"))
     target = 5 if n < 5000 else 10
     rows.append(
-        _row(
+        row(
             f"pile-{n}",
             "stepped",
             n,
@@ -328,11 +330,11 @@ def _bounce_error(states, dt) -> float:
     return max(abs(a - b) for a, b in zip(found, _bounce_expected(), strict=True))
 
 
-def _stepped_closed(fps: int) -> tuple[float, float, float, float]:
-    """(bounce error s, its run time s, slide relative error, its run time s) of the stepped
-    model stepping at `fps`."""
+def _ours_closed(name: str, fps: int) -> tuple[float, float, float, float]:
+    """(bounce error s, its run time s, slide relative error, its run time s) of the model `name`
+    (stepped, or exact) at `fps`."""
     world, bodies = _drop(fps)
-    model = make("stepped", world, bodies, sleep=False)
+    model = make(name, world, bodies, **({"sleep": False} if name == "stepped" else {}))
     states = [(0.0, FLOOR_PX - DROP_PX, 0.0)]
     began = time.perf_counter()
     for k in range(1, int(CLOSED_S * fps)):
@@ -340,7 +342,7 @@ def _stepped_closed(fps: int) -> tuple[float, float, float, float]:
         states.append((k / fps, model.positions()[0, 1], model.velocities()[0, 1]))
     bounce_s = time.perf_counter() - began
     world, block = _block(fps)
-    model = make("stepped", world, block)
+    model = make(name, world, block)
     began = time.perf_counter()
     model.advance(int(CLOSED_S * fps), log=False)
     slide_s = time.perf_counter() - began
@@ -350,7 +352,7 @@ def _stepped_closed(fps: int) -> tuple[float, float, float, float]:
 
 
 def _pymunk_closed(fps: int) -> tuple[float, float, float, float]:
-    """As `_stepped_closed`, pymunk stepping at 1/fps s."""
+    """As `_ours_closed`, pymunk stepping at 1/fps s."""
     dt = 1.0 / fps
     world, bodies = _drop(fps)
     space = _space(world, bodies, DROP_E, 0.0)
@@ -375,15 +377,16 @@ def _pymunk_closed(fps: int) -> tuple[float, float, float, float]:
 
 def closed_forms(echo, rates=CHART_FPS) -> list[dict]:
     """Errors against the closed forms (module docstring), and the run time of each, for the
-    stepped model and pymunk (when installed) stepping at each of `rates` fps."""
-    runs = {"stepped": _stepped_closed}
+    stepped model, the exact model and pymunk (when installed) at each of `rates` fps."""
+    runs = {name: functools.partial(_ours_closed, name) for name in ("stepped", "exact")}
     try:
         import pymunk  # noqa: F401
 
         runs["pymunk"] = _pymunk_closed
     except ImportError:
         pass
-    _stepped_closed(rates[0])  # compiled (or loaded) before any clock starts
+    for name in ("stepped", "exact"):
+        _ours_closed(name, rates[0])  # compiled (or loaded) before any clock starts
     rows = []
     for name, run in runs.items():
         for fps in rates:
@@ -393,9 +396,9 @@ def closed_forms(echo, rates=CHART_FPS) -> list[dict]:
                 ("slide", slide, slide_s, "relative error of the slide distance"),
             )
             for scene, value, seconds, note in notes:
-                row = _row(scene, name, 1, value, f"{note}, at {fps} fps")
-                row.update(fps=fps, run_time_s=seconds)
-                rows.append(row)
+                one = row(scene, name, 1, value, f"{note}, at {fps} fps")
+                one.update(fps=fps, run_time_s=seconds)
+                rows.append(one)
             echo(
                 f"gravity  {name:<8s} fps={fps:<4d} bounce {bounce:.2e} s "
                 f"({bounce_s * 1e3:.1f} ms), slide {slide:.2e} ({slide_s * 1e3:.1f} ms)"
@@ -404,8 +407,11 @@ def closed_forms(echo, rates=CHART_FPS) -> list[dict]:
 
 
 def gravity(quick: bool, echo) -> list[dict]:
-    """The part's rows: the piles (1,000; and 10,000 unless quick), then the closed forms."""
+    """The part's rows: the piles (1,000; and 10,000 unless quick), the closed forms, then the
+    exact model's events per second under gravity (fall.py)."""
+    from collide2d.runner.bench import fall
+
     rows: list[dict] = []
     for n in (1000,) if quick else (1000, 10_000):
         rows += timings(n, echo)
-    return rows + closed_forms(echo)
+    return rows + closed_forms(echo) + fall.rows(quick, echo)

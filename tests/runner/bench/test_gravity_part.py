@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
+from collide2d.engine import events as ev
 from collide2d.runner.bench import peers
 
 
@@ -40,3 +41,44 @@ def test_the_chart_of_the_closed_forms_is_written(tmp_path):
     assert "gravity_runtime_vs_error.png" in plots.plots(rows, tmp_path)
     with Image.open(tmp_path / "gravity_runtime_vs_error.png") as chart:
         assert chart.width > chart.height > 300
+
+
+def test_the_exact_model_meets_the_closed_forms_to_round_off_at_every_rate():
+    found = peers.closed_forms(lambda *a: None, rates=(30, 240))
+    rows = {(r["scene"], r["model"], r["fps"]): r for r in found}
+    for fps in (30, 240):
+        # every bounce at its closed-form instant, the slide's stop where v0²/(2 mu g) puts it
+        assert rows[("bounce", "exact", fps)]["value"] < 1e-12
+        assert rows[("slide", "exact", fps)]["value"] < 1e-12
+    # the stepped model's slide error shrinks with its step; the exact model's does not need to
+    assert rows[("slide", "stepped", 240)]["value"] < rows[("slide", "stepped", 30)]["value"]
+
+
+def test_the_exact_model_s_events_per_second_under_gravity_are_reported(monkeypatch):
+    from collide2d.runner.bench import fall
+
+    monkeypatch.setitem(fall.GAS, True, (300, 60))
+    monkeypatch.setitem(fall.BALLS, True, (200, 120))
+    said = []
+    found = {(r["scene"], r["note"].split(",")[0]): r for r in fall.rows(True, said.append)}
+    flat = found[("gas-300", "exact: events/s without gravity")]["value"]
+    falling = found[("gas-300", "exact: events/s under gravity 400 px/s²")]["value"]
+    ratio = found[("gas-300", "exact: under gravity / without (target >= 0.5)")]["value"]
+    assert flat > 0 and falling > 0 and ratio == falling / flat
+    assert found[("balls-200", "exact: events/s")]["value"] > 0  # they reach the floor
+    assert len(said) == 2 and "balls e 0.9" in said[1]
+
+
+def test_the_falling_balls_bounce_on_the_floor_and_each_other_and_stay_inside():
+    from collide2d.engine.models import make
+    from collide2d.engine.world import WorldSpec
+    from collide2d.runner.bench import fall
+
+    bodies = fall.balls(200)
+    world = WorldSpec(fall.SIDE, fall.SIDE, 60, gravity=(0.0, fall.BALLS_G))
+    model = make("exact", world, bodies)
+    found = model.advance(240)
+    floor = found[found["type"] == ev.EV_WALL]
+    assert (floor["code"] == ev.SIDE_BOTTOM).sum() > 200  # each ball's first bounces
+    assert (found["type"] == ev.EV_PAIR).sum() > 0
+    assert (model.positions() <= fall.SIDE - fall.SIZE).all() and (model.positions() >= 0).all()
