@@ -157,6 +157,7 @@ def _run_parts(args, parts, ns, models_, quick, in_process, folder, echo) -> tup
     if "gravity" in parts:
         echo.part("gravity")
         rows += peers.gravity(quick, echo)
+        rows += exact.gravity(quick, echo)
     return rows, time.perf_counter() - began
 
 

@@ -13,7 +13,7 @@ drift in); `peers` then divides the stepped model's steps/s by pymunk's.
 
 The gravity part (`--part gravity`, `gravity`): the stepped model's settling path against pymunk
 under gravity, the stepped and exact models and pymunk against the closed forms (PHYSICS.md), and
-the exact model's events per second under gravity (fall.py).
+the exact model's events per second under gravity (exact.py's `gravity`, run by the part).
 
 A settling pile (`pile`): n boxes of 8 px, e 0.3 and mu 0.3, on a grid ASPECT times as wide as it
 is tall (8 rows at 1,000, 25 at 10,000), dropped into a box just wider, at 60 fps with 2
@@ -407,11 +407,9 @@ def closed_forms(echo, rates=CHART_FPS) -> list[dict]:
 
 
 def gravity(quick: bool, echo) -> list[dict]:
-    """The part's rows: the piles (1,000; and 10,000 unless quick), the closed forms, then the
-    exact model's events per second under gravity (fall.py)."""
-    from collide2d.runner.bench import fall
-
+    """The part's rows of the stepped model and pymunk: the piles (1,000; and 10,000 unless
+    quick), then the closed forms."""
     rows: list[dict] = []
     for n in (1000,) if quick else (1000, 10_000):
         rows += timings(n, echo)
-    return rows + closed_forms(echo) + fall.rows(quick, echo)
+    return rows + closed_forms(echo)

@@ -55,12 +55,12 @@ def test_the_exact_model_meets_the_closed_forms_to_round_off_at_every_rate():
 
 
 def test_the_exact_model_s_events_per_second_under_gravity_are_reported(monkeypatch):
-    from collide2d.runner.bench import fall
+    from collide2d.runner.bench import exact
 
-    monkeypatch.setitem(fall.GAS, True, (300, 60))
-    monkeypatch.setitem(fall.BALLS, True, (200, 120))
+    monkeypatch.setitem(exact.GAS, True, (300, 60))
+    monkeypatch.setitem(exact.BALLS, True, (200, 120))
     said = []
-    found = {(r["scene"], r["note"].split(",")[0]): r for r in fall.rows(True, said.append)}
+    found = {(r["scene"], r["note"].split(",")[0]): r for r in exact.gravity(True, said.append)}
     flat = found[("gas-300", "exact: events/s without gravity")]["value"]
     falling = found[("gas-300", "exact: events/s under gravity 400 px/s²")]["value"]
     ratio = found[("gas-300", "exact: under gravity / without (target >= 0.5)")]["value"]
@@ -72,13 +72,13 @@ def test_the_exact_model_s_events_per_second_under_gravity_are_reported(monkeypa
 def test_the_falling_balls_bounce_on_the_floor_and_each_other_and_stay_inside():
     from collide2d.engine.models import make
     from collide2d.engine.world import WorldSpec
-    from collide2d.runner.bench import fall
+    from collide2d.runner.bench import exact
 
-    bodies = fall.balls(200)
-    world = WorldSpec(fall.SIDE, fall.SIDE, 60, gravity=(0.0, fall.BALLS_G))
+    bodies = exact.balls(200)
+    world = WorldSpec(exact.SIDE, exact.SIDE, 60, gravity=(0.0, exact.BALLS_G))
     model = make("exact", world, bodies)
     found = model.advance(240)
     floor = found[found["type"] == ev.EV_WALL]
     assert (floor["code"] == ev.SIDE_BOTTOM).sum() > 200  # each ball's first bounces
     assert (found["type"] == ev.EV_PAIR).sum() > 0
-    assert (model.positions() <= fall.SIDE - fall.SIZE).all() and (model.positions() >= 0).all()
+    assert (model.positions() <= exact.SIDE - exact.SIZE).all() and (model.positions() >= 0).all()
