@@ -176,7 +176,8 @@ def run(
 
     Raises:
         ScenarioError: the scenario is refused (or, with `out`, the output would pass a limit).
-        RunStopped: the model stopped the run (a runaway); `str(err)` says why.
+        RunStopped: the model stopped the run (a runaway); `str(err)` says why. With `out`, the
+            run folder then holds the run so far (`err.folder`; docs/limits.md#runaways).
         ModelError: a plugin model raised or broke the model protocol; `str(err)` names it.
     """
     from collide2d.runner import run as runner

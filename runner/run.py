@@ -20,7 +20,9 @@ cached them) are timed apart (`runner.compiling`): the summary's `compile_time_s
 `run_time_s` leaves them out. Ctrl-C during `run_to_dir` stops the run at the end of the current
 chunk of ticks: what was written so far (events, PNG frames, the final state at that tick, a
 summary with `interrupted_at_tick`) becomes OUT/NAME, without the GIF, which would be an animation
-of part of the run.
+of part of the run. A runaway during `run_to_dir` does the same at the end of the last whole chunk
+before it (its summary holds `stopped_at_tick` and the error), and then raises RunStopped naming
+that folder.
 """
 
 from __future__ import annotations
@@ -65,8 +67,14 @@ FIRST_CHUNK_TICKS = 16
 
 class RunStopped(Exception):
     """A model stopped the run with a clear error (a runaway: the exact model's event cap or an
-    object with no room to move, or an object crossing the world too many times in one stepped
-    step). str(err) is the message."""
+    object with no room to move, or what it cannot carry on exactly yet, or an object crossing the
+    world too many times in one stepped step). str(err) is the message; `folder`, for a run that
+    writes its files, is OUT/NAME holding the run up to the last whole chunk of ticks before the
+    stop (None otherwise)."""
+
+    def __init__(self, message: str, folder: Path | None = None):
+        super().__init__(message)
+        self.folder = folder
 
 
 @dataclass
@@ -102,7 +110,9 @@ def drive(
     advances one tick per call. overlay: a `runner.output.overlay.Overlay`; it may wrap the model,
     takes the events and draws over each frame before `on_frame` sees it. interruptible: Ctrl-C
     (SIGINT, in the main thread) ends the run after the current chunk of ticks; the summary then
-    holds `interrupted_at_tick`.
+    holds `interrupted_at_tick`. And a runaway ends it where the last whole chunk ended, instead of
+    raising RunStopped: the returned model is then that state (its positions, velocities and
+    event counts), and the summary holds `stopped_at_tick` and `stopped` (RunStopped's message).
     """
     if not isinstance(frames, FrameRule):
         frames = FrameRule.of(frames, scenario.ticks)
@@ -137,6 +147,8 @@ def _drive(
     began = time.perf_counter()
     compiled_before = compiling.seconds()
     interrupted = _Interrupt() if interruptible else None
+    kept = _Kept(model) if interruptible else None  # the state at the last whole chunk's end
+    stopped = None
     pace = _Pace()
 
     if on_tick is not None:
@@ -160,10 +172,13 @@ def _drive(
                 when = (
                     f"tick {stop}" if stop == model.tick + 1 else f"ticks {model.tick + 1}-{stop}"
                 )
-                raise RunStopped(
+                stopped = (
                     f"{scenario.path or scenario.name}: error: the {scenario.model} model stopped "
                     f"the run in {when}: {exc}{_names_of(exc, scenario.names)}"
-                ) from None
+                )
+                if kept is None:
+                    raise RunStopped(stopped) from None
+                break
             if log_events and len(events) and on_events is not None:
                 on_events(events)
             if overlay is not None and logging:
@@ -176,7 +191,11 @@ def _drive(
                 next_frame = frames.next_from(model.tick + 1)
             if progress is not None:
                 progress.update(model.tick)
+            if kept is not None:
+                kept.take(model)
     run_time = time.perf_counter() - began - (compiling.seconds() - compiled_before)
+    if stopped is not None:
+        model = kept  # the broken model's state is past the outputs written: the kept one is not
     if progress is not None:
         progress.close()
 
@@ -197,9 +216,35 @@ def _drive(
         "run_time_s": round(max(run_time, 0.0), 6),
         "compile_time_s": round(compiling.seconds(), 6),
     }
-    if model.tick < scenario.ticks:
+    if stopped is not None:
+        summary["stopped_at_tick"] = model.tick
+        summary["stopped"] = stopped
+    elif model.tick < scenario.ticks:
         summary["interrupted_at_tick"] = model.tick
     return model, summary
+
+
+class _Kept:
+    """A model's state as the outputs last saw it (taken after each chunk of ticks): what a run
+    stopped by a runaway writes as its final state, its summary's counts and energies. It answers
+    as a model does for those (tick, positions, velocities, event_counts)."""
+
+    def __init__(self, model):
+        self.take(model)
+
+    def take(self, model) -> None:
+        self.tick = model.tick
+        self._pos, self._vel = model.positions(), model.velocities()
+        self._counts = model.event_counts()
+
+    def positions(self) -> np.ndarray:
+        return self._pos
+
+    def velocities(self) -> np.ndarray:
+        return self._vel
+
+    def event_counts(self) -> tuple[int, int]:
+        return self._counts
 
 
 def make_model(scenario: Scenario):
@@ -383,6 +428,13 @@ def write_run(
                 raise
     except rundir.OutputBusy as exc:
         raise ScenarioError(scenario.path or "<scenario>", 1, 1, str(exc)) from None
+    summary = result.summary
+    if "stopped_at_tick" in summary:  # a runaway: the run so far is written, then the error
+        raise RunStopped(
+            f"{summary['stopped']}\n{target} holds the run up to tick "
+            f"{summary['stopped_at_tick']:,} (no GIF)",
+            target,
+        )
     return target, result
 
 
@@ -451,7 +503,8 @@ def _write_files(scenario: Scenario, folder: Path, options: RunOptions, plan) ->
             overlay=layer,
             interruptible=True,
         )
-        if "interrupted_at_tick" in summary and gif is not None:
+        part = "interrupted_at_tick" in summary or "stopped_at_tick" in summary
+        if part and gif is not None:
             writers.remove(gif)  # an animation of part of the run: not kept
             gif.abort()
         for writer in writers:
@@ -465,7 +518,7 @@ def _write_files(scenario: Scenario, folder: Path, options: RunOptions, plan) ->
     outputs.write_final_csv(
         folder / "final.csv", model.positions(), model.velocities(), scenario.names
     )
-    if recorder is not None and "interrupted_at_tick" not in summary:
+    if recorder is not None and not part:
         outputs.atomic_write_bytes(folder / viewer.VIEWER_FILE, recorder.page())
     outputs.write_json(folder / "summary.json", summary)
     return RunResult(scenario, empty_events(), model.positions(), model.velocities(), {}, summary)

@@ -279,6 +279,36 @@ def test_the_cap_comes_from_the_command_line_over_the_scenario(tmp_path, capsys)
     assert "tick 9 needed more than 1500 events" in capsys.readouterr().err
 
 
+def test_a_run_stopped_by_the_cap_keeps_its_outputs_so_far_as_ctrl_c_does(tmp_path, capsys):
+    """The run stops in tick 9 (1,571 collisions past a cap of 1,000): exit 2 with the error, and
+    OUT/NAME holds the run up to the last whole chunk of ticks before it: every frame and event
+    of those ticks, the state at its end, a summary saying where and why it stopped; no GIF (an
+    animation of part of the run), nothing of the tick that stopped it."""
+    capped = galperin_small(tmp_path, "model: {kind: exact, max_events_per_tick: 1000}")
+    text = capped.read_text().replace("output: {frames: none, gif: false, events: false}", "")
+    capped.write_text(text + "output: {frames: all, gif: true, events: true}\n")
+    assert run([capped, "--out", tmp_path, "--quiet"]) == 2
+    folder = tmp_path / "galperin-pi"
+    err = capsys.readouterr().err
+    assert "tick 9 needed more than 1000 events" in err
+    summary = json.loads((folder / "summary.json").read_text())
+    k = summary["stopped_at_tick"]
+    assert f"{folder} holds the run up to tick {k:,} (no GIF)" in err
+    assert k == 8 and "tick 9 needed more than 1000 events" in summary["stopped"]  # a chunk a frame
+    assert "interrupted_at_tick" not in summary and not (folder / "animation.gif").exists()
+    frames = sorted(p.name for p in (folder / "frames").iterdir())
+    assert frames == [f"frame_{i:06d}.png" for i in range(k + 1)]
+    events = [json.loads(line) for line in (folder / "events.jsonl").read_text().splitlines()]
+    assert all(e["tick"] <= k for e in events)
+    assert len(events) == summary["events"]["wall"] + summary["events"]["pair"]
+    # the final state is the one at tick k: what an uncapped run shows there
+    whole = galperin_small(tmp_path, "model: exact")
+    whole.write_text(whole.read_text().replace("ticks: 30", f"ticks: {k}"))
+    assert run([whole, "--out", tmp_path / "whole", "--quiet"]) == 0
+    final = (folder / "final.csv").read_text()
+    assert final == (tmp_path / "whole" / "galperin-pi" / "final.csv").read_text()
+
+
 def test_the_cap_is_refused_under_another_model_at_its_place(tmp_path, capsys):
     path = galperin_small(tmp_path, "model: {kind: stepped, max_events_per_tick: 1000}")
     assert run([path, "--out", tmp_path, "--quiet"]) == 2
