@@ -27,7 +27,7 @@ import numpy as np
 
 from collide2d.engine import models
 from collide2d.engine.models import make
-from collide2d.engine.world import KIND_CIRCLE, Bodies, Looks, WorldSpec
+from collide2d.engine.world import KIND_CIRCLE, Bodies, WorldSpec
 from collide2d.runner.bench import goals
 from collide2d.runner.bench.peers import row
 from collide2d.runner.bench.scenes import chain_scene, standard_scene
@@ -119,18 +119,9 @@ def balls(n: int, seed: int = 2) -> Bodies:
     pitch = SIDE / k
     idx = np.arange(n)
     pos = np.stack([idx % k, idx // k], axis=1) * pitch + rng.uniform(0, pitch - SIZE, (n, 2))
-    return Bodies(
-        kind=np.full(n, KIND_CIRCLE, np.int8),
-        pos=pos,
-        size=np.full((n, 2), SIZE),
-        vel=np.zeros((n, 2)),
-        mass=np.ones(n),
-        static=np.zeros(n, bool),
-        vert_start=np.zeros(n + 1, np.int64),
-        verts=np.zeros((0, 2), np.int64),
-        looks=Looks(color=np.ones(n, np.uint8), fill=np.zeros(n, bool)),
-        restitution=np.full(n, BALLS_E),
-    )
+    boxes = Bodies.boxes(pos, SIZE, [0.0, 0.0])
+    kind, restitution = np.full(n, KIND_CIRCLE, np.int8), np.full(n, BALLS_E)
+    return Bodies(**{**boxes.__dict__, "kind": kind, "restitution": restitution})
 
 
 def gravity_rate(bodies: Bodies, gravity: float, ticks: int) -> tuple[float, int, float]:
