@@ -28,7 +28,8 @@ Closed forms: a box dropped 100 px with e 0.5, its first three bounce instants
 against `t_n = t1·(1 + 2e(1 - e^(n-1)) / (1 - e))` (each found from the state after the step that
 held it: exact between contacts, the bounce lies `τ = 2h / (v + √(v² + 2g·h))` before it, h the
 height above the floor and v the speed up); a box sliding at 200 px/s with mu 0.5 against
-`v0² / (2·mu·g)`; each at CHART_FPS steps a second (one step a frame) by each, with the run time
+`v0² / (2·mu·g)`; each at CHART_FPS steps a second (one step a frame) by each, and the stepped
+model at LADDER_FPS with LADDER_SUBSTEPS substeps a frame, with the run time
 of its CLOSED_S simulated seconds, for gravity_runtime_vs_error.png (runner/bench/plots.py). Rows
 are one figure each (`value`, described by `note`).
 """
@@ -298,6 +299,8 @@ def _bounce_times(states, floor, dt) -> list[float]:
 DROP_E, DROP_PX, BOX_PX, FLOOR_PX = 0.5, 100.0, 10.0, 190.0
 SLIDE_V0, SLIDE_MU = 200.0, 0.5
 CHART_FPS = (30, 60, 120, 240)
+# The stepped model's ladder of substeps at one rate, for the same chart
+LADDER_FPS, LADDER_SUBSTEPS = 30, (2, 4, 8, 16, 32, 64)
 CLOSED_S = 2.0  # simulated seconds of each closed-form run
 
 
@@ -330,11 +333,12 @@ def _bounce_error(states, dt) -> float:
     return max(abs(a - b) for a, b in zip(found, _bounce_expected(), strict=True))
 
 
-def _ours_closed(name: str, fps: int) -> tuple[float, float, float, float]:
+def _ours_closed(name: str, fps: int, substeps: int = 1) -> tuple[float, float, float, float]:
     """(bounce error s, its run time s, slide relative error, its run time s) of the model `name`
-    (stepped, or exact) at `fps`."""
+    (stepped, with `substeps`; or exact) at `fps`."""
+    options = {"substeps": substeps} if name == "stepped" else {}
     world, bodies = _drop(fps)
-    model = make(name, world, bodies, **({"sleep": False} if name == "stepped" else {}))
+    model = make(name, world, bodies, **options, **({"sleep": False} if name == "stepped" else {}))
     states = [(0.0, FLOOR_PX - DROP_PX, 0.0)]
     began = time.perf_counter()
     for k in range(1, int(CLOSED_S * fps)):
@@ -342,7 +346,7 @@ def _ours_closed(name: str, fps: int) -> tuple[float, float, float, float]:
         states.append((k / fps, model.positions()[0, 1], model.velocities()[0, 1]))
     bounce_s = time.perf_counter() - began
     world, block = _block(fps)
-    model = make(name, world, block)
+    model = make(name, world, block, **options)
     began = time.perf_counter()
     model.advance(int(CLOSED_S * fps), log=False)
     slide_s = time.perf_counter() - began
@@ -375,9 +379,10 @@ def _pymunk_closed(fps: int) -> tuple[float, float, float, float]:
     return _bounce_error(states, dt), bounce_s, abs(sled.position.x - x0 - slide) / slide, slide_s
 
 
-def closed_forms(echo, rates=CHART_FPS) -> list[dict]:
+def closed_forms(echo, rates=CHART_FPS, ladder=LADDER_SUBSTEPS) -> list[dict]:
     """Errors against the closed forms (module docstring), and the run time of each, for the
-    stepped model, the exact model and pymunk (when installed) at each of `rates` fps."""
+    stepped model, the exact model and pymunk (when installed) at each of `rates` fps; then the
+    stepped model at LADDER_FPS with each of `ladder` substeps."""
     runs = {name: functools.partial(_ours_closed, name) for name in ("stepped", "exact")}
     try:
         import pymunk  # noqa: F401
@@ -403,6 +408,15 @@ def closed_forms(echo, rates=CHART_FPS) -> list[dict]:
                 f"gravity  {name:<8s} fps={fps:<4d} bounce {bounce:.2e} s "
                 f"({bounce_s * 1e3:.1f} ms), slide {slide:.2e} ({slide_s * 1e3:.1f} ms)"
             )
+    for k in ladder:
+        bounce, bounce_s, slide, slide_s = _ours_closed("stepped", LADDER_FPS, k)
+        for scene, value, seconds in (("bounce", bounce, bounce_s), ("slide", slide, slide_s)):
+            one = row(scene, "stepped", 1, value, f"at {LADDER_FPS} fps x {k} substeps")
+            one.update(fps=LADDER_FPS, substeps=k, run_time_s=seconds)
+            rows.append(one)
+        echo(
+            f"gravity  stepped  fps={LADDER_FPS}x{k:<3d} bounce {bounce:.2e} s, slide {slide:.2e}"
+        )
     return rows
 
 

@@ -62,26 +62,28 @@ GRAVITY_PANELS = {"bounce": "error of the first 3 bounce instants (s)",
 
 def _gravity_figure(plt, closed, folder, atomic_path) -> None:
     """gravity_runtime_vs_error.png: the gravity part's closed-form scenes, one panel each, run
-    time against error of each model at each rate (labelled with its fps)."""
+    time against error of each model at each rate (labelled with its fps, or fps x substeps)."""
     fig, axes = plt.subplots(1, len(GRAVITY_PANELS), figsize=(6 * len(GRAVITY_PANELS), 4.5))
     for ax, (scene, ylabel) in zip(axes, GRAVITY_PANELS.items(), strict=True):
         mine = [r for r in closed if r["scene"] == scene]
-        for name in dict.fromkeys(r["model"] for r in mine):
+        for name in dict.fromkeys(_gravity_series(r) for r in mine):
             pts = sorted(
-                (r["run_time_s"], max(r["value"], GRAVITY_ERROR_FLOOR), r["fps"])
+                (r["run_time_s"], max(r["value"], GRAVITY_ERROR_FLOOR), _gravity_label(r))
                 for r in mine
-                if r["model"] == name and math.isfinite(r["value"])  # inf: bounces not found
+                if _gravity_series(r) == name and math.isfinite(r["value"])  # inf: not found
             )
-            colour = MODEL_COLOURS.get(name, "tab:purple")
+            colour = MODEL_COLOURS.get(name, "tab:purple" if name == "pymunk" else "tab:cyan")
             ax.plot([p[0] for p in pts], [p[1] for p in pts], marker="o", ms=4, label=name,
                     color=colour)  # fmt: skip
-            for x, y, fps in pts:
-                ax.annotate(str(fps), (x, y), textcoords="offset points", xytext=(3, 3),
+            for x, y, text in pts:
+                ax.annotate(text, (x, y), textcoords="offset points", xytext=(3, 3),
                             fontsize=6, color=colour)  # fmt: skip
         ax.set(xscale="log", yscale="log", title=scene, ylabel=ylabel)
         ax.set_xlabel("run time of 2 simulated seconds (s)")
         ax.legend(fontsize="x-small", loc="best")
-    fig.suptitle("Under gravity: run time against error of the closed forms (labels: fps)")
+    fig.suptitle(
+        "Under gravity: run time against error of the closed forms (labels: fps, or fps x substeps)"
+    )
     fig.tight_layout()
     with atomic_path(folder / "gravity_runtime_vs_error.png") as tmp:
         fig.savefig(tmp, format="png", dpi=110)
@@ -89,6 +91,17 @@ def _gravity_figure(plt, closed, folder, atomic_path) -> None:
 
 
 MODEL_COLOURS = {"paper": "tab:orange", "stepped": "tab:blue", "exact": "tab:green"}
+
+
+def _gravity_series(r) -> str:
+    """A gravity row's line in the chart: its model, or the stepped model's ladder of substeps."""
+    return r["model"] if r.get("substeps", 1) == 1 else f"{r['model']}, substeps at {r['fps']} fps"
+
+
+def _gravity_label(r) -> str:
+    """A gravity row's point label: its fps, or fps x substeps."""
+    k = r.get("substeps", 1)
+    return f"{r['fps']}x{k}" if k > 1 else str(r["fps"])
 
 
 def _label(r) -> str:
