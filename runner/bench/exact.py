@@ -98,7 +98,6 @@ BALLS_G, BALLS_E = 980.0, 0.9
 GAS = {False: (10_000, 600), True: (1_000, 300)}
 BALLS = {False: (1_000, 300), True: (1_000, 120)}
 ROUNDS = {False: 3, True: 1}
-TARGET = 0.5  # under gravity / without, events per second
 
 
 def gas(n: int, seed: int = 1) -> Bodies:
@@ -151,12 +150,13 @@ def gravity(quick: bool, echo) -> list[dict]:
     and the falling balls."""
     gravity_rate(gas(100), GAS_G, 2)  # compiled (or loaded) before any clock starts
     n, ticks = GAS[quick]
+    target = goals.EXACT_GRAVITY_RATIO
     flat, falling = gas_rates(n, ticks, ROUNDS[quick])
     scene = f"gas-{n}"
     out = [
         row(scene, "exact", n, flat, f"events/s without gravity, {ticks} ticks"),
         row(scene, "exact", n, falling, f"events/s under gravity {GAS_G:g} px/s², {ticks} ticks"),
-        row(scene, "exact", n, falling / flat, f"under gravity / without (target >= {TARGET})"),
+        row(scene, "exact", n, falling / flat, f"under gravity / without (target >= {target})"),
     ]
     echo(
         f"gravity  exact    n={n:<6d} gas {flat:,.0f} events/s, falling {falling:,.0f} "
