@@ -259,6 +259,7 @@ def make_model(scenario: Scenario):
         rest_speed=scenario.rest_speed,
         sleep=scenario.sleep,
         sleep_after=scenario.sleep_after,
+        rest_height=scenario.rest_height,
     )
     return models.make(scenario.model, scenario.world, scenario.bodies, **options)
 

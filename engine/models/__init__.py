@@ -38,13 +38,14 @@ MODEL_NAMES = ("paper", "stepped", "exact")
 MAX_EVENTS_PER_TICK = 1_000_000
 # The settings a scenario gives each model (docs/scenario-format.md#model): the paper model takes
 # none; the stepped model's contacts and rest take iterations, slop, rest_speed, sleep and
-# sleep_after (docs/scenario-format.md#gravity-restitution-and-friction).
+# sleep_after (docs/scenario-format.md#gravity-restitution-and-friction); the exact model's rest
+# under gravity takes rest_height (docs/models.md#exact-under-gravity).
 SCENARIO_OPTIONS = {
     "paper": (),
     "stepped": (
         "substeps", "geometry", "iterations", "slop", "rest_speed", "sleep", "sleep_after",
     ),
-    "exact": ("geometry", "max_events_per_tick"),
+    "exact": ("geometry", "max_events_per_tick", "rest_height"),
 }  # fmt: skip
 
 

@@ -236,6 +236,8 @@ class Scenario:
     rest_speed: float | None = None  # px/s
     sleep: bool | None = None
     sleep_after: float | None = None  # s
+    # the exact model's rest under gravity (docs/models.md#exact-under-gravity); None: its default
+    rest_height: float | None = None  # px
 
 
 def load(
@@ -382,6 +384,7 @@ class _Reader(ModelReader):
             max_events_per_tick=settings.max_events_per_tick,
             generated=tuple(b.spec for b in blocks),
             **settings.stepped,
+            **settings.exact,
         )
 
     def description(self, top: dict) -> str:

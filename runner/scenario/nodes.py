@@ -56,7 +56,7 @@ NO_SUCH_PHYSICS = {
 }
 # Keys of another section: where they belong (a model's settings, the world's keys).
 _MODEL_SETTINGS = ("substeps", "geometry", "max_events_per_tick", "iterations", "slop",
-                   "rest_speed", "sleep", "sleep_after")  # fmt: skip
+                   "rest_speed", "sleep", "sleep_after", "rest_height")  # fmt: skip
 ELSEWHERE = {
     **{key: "world" for key in ("width", "height", "fps", "background", "gravity")},
     **{key: "model" for key in _MODEL_SETTINGS},

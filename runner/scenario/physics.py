@@ -5,9 +5,10 @@ docs/scenario-format.md#gravity-restitution-and-friction).
 `ModelReader` extends `runner.scenario.nodes.Nodes` for the scenario reader
 (`runner.scenario.load`): `model` reads the `model` section with the command line's `--model`
 and `--max-events-per-tick` and the project's defaults into a `ModelSettings` (kind, substeps,
-geometry, the exact model's event cap, and the stepped model's settings for contacts and rest:
-`iterations`, `slop`, `rest_speed`, `sleep`, `sleep_after`, None where the file gives none, so
-that the model's own default holds); `world_physics` reads `world.gravity` (`[gx, gy]` px/s², or
+geometry, the exact model's event cap, the stepped model's settings for contacts and rest:
+`iterations`, `slop`, `rest_speed`, `sleep`, `sleep_after`, and the exact model's rest under
+gravity: `rest_height` (docs/models.md#exact-under-gravity), each absent where the file gives none,
+so that the model's own default holds); `world_physics` reads `world.gravity` (`[gx, gy]` px/s², or
 one number g meaning `[0, g]`, y down), `world.restitution` and `world.friction` (the walls'), and
 `check_world_physics` holds them against the model once both are known: the paper model takes
 none of them (the paper has none), each refused at its line with a message naming `stepped`;
@@ -37,6 +38,7 @@ MAX_SUBSTEPS = 10_000  # substeps per tick of the stepped model
 MAX_ITERATIONS = 1_000  # velocity passes per step of the stepped model (peers use 4 to 10)
 MAX_SLOP = 1e9  # px, the largest overlap the stepped model may be told to leave (a bound only)
 MAX_SLEEP_AFTER = 1e9  # s, the longest a body must be slow before it sleeps (about 32 years)
+MAX_REST_HEIGHT = 1e9  # px, the highest rise the exact model may be told to end a bounce below
 MAX_GRAVITY = 1e12  # px/s², the largest gravity component
 # The exact model's `max_events_per_tick`: the default, and the largest a scenario or
 # --max-events-per-tick may ask for (counted exactly in the kernel's int64 and in float64).
@@ -52,12 +54,16 @@ MODEL_BOUNDS = {
     "slop": (0, MAX_SLOP),
     "rest_speed": (0, MAX_SPEED),
     "sleep_after": (0, MAX_SLEEP_AFTER),
+    "rest_height": (0, MAX_REST_HEIGHT),
 }
 # The stepped model's settings for contacts and rest (SCENARIO_OPTIONS of engine.models), with
 # their unit in messages; None for a true or false.
 STEPPED_KEYS = {"iterations": "", "slop": " px", "rest_speed": " px/s", "sleep": None,
                 "sleep_after": " s"}  # fmt: skip
-MODEL_KEYS = ("kind", "substeps", "geometry", "max_events_per_tick", *STEPPED_KEYS)
+# The exact model's settings besides its event cap (SCENARIO_OPTIONS of engine.models), with their
+# unit in messages: `rest_height`, a bounce under gravity that would rise less comes to rest.
+EXACT_KEYS = {"rest_height": " px"}
+MODEL_KEYS = ("kind", "substeps", "geometry", "max_events_per_tick", *STEPPED_KEYS, *EXACT_KEYS)
 # The world's physics keys and their defaults (the elastic, weightless world).
 WORLD_PHYSICS = {"gravity": 0.0, "restitution": 1.0, "friction": 0.0}
 
@@ -71,6 +77,7 @@ class ModelSettings:
     geometry: str = "box"
     max_events_per_tick: int = DEFAULT_MAX_EVENTS_PER_TICK
     stepped: dict = field(default_factory=dict)  # the stepped settings the file gives
+    exact: dict = field(default_factory=dict)  # the exact settings the file gives (EXACT_KEYS)
 
 
 @dataclass(frozen=True)
@@ -135,6 +142,7 @@ class ModelReader(Nodes):
         kind, substeps, geometry, cap = "paper", 1, None, DEFAULT_MAX_EVENTS_PER_TICK
         sub_node = cap_node = None
         stepped: dict = {}
+        exact: dict = {}
         if "model" not in top:
             kind = self.defaults.get("kind", kind)
         if "model" in top:
@@ -153,6 +161,9 @@ class ModelReader(Nodes):
                 for key in STEPPED_KEYS:
                     if key in m:
                         stepped[key] = self._setting(m, key, kind, "stepped")
+                for key in EXACT_KEYS:
+                    if key in m:
+                        exact[key] = self._setting(m, key, kind, "exact")
                 if "geometry" in m:
                     geo_node = m["geometry"][1]
                     geometry = self.choice(geo_node, "geometry", GEOMETRIES)
@@ -175,7 +186,7 @@ class ModelReader(Nodes):
                 raise self.error(None, f"{origin}: unknown model {v!r}; {hint}")
             if v != kind:
                 self.model_from = origin
-                kind, substeps, geometry, stepped = v, 1, None, {}
+                kind, substeps, geometry, stepped, exact = v, 1, None, {}, {}
                 cap = DEFAULT_MAX_EVENTS_PER_TICK
         if "max_events_per_tick" in self.overrides:  # any model: only the exact one uses it
             v = self.overrides["max_events_per_tick"]
@@ -192,7 +203,7 @@ class ModelReader(Nodes):
         )
         if geometry is None:
             geometry = "exact" if kind == "exact" else "box"
-        return ModelSettings(kind, substeps, geometry, cap, stepped)
+        return ModelSettings(kind, substeps, geometry, cap, stepped, exact)
 
     def _setting(self, m: dict, key: str, kind: str, model: str):
         """The value of the model setting `key` (of the `model` mapping `m`), which only `model`
@@ -206,7 +217,8 @@ class ModelReader(Nodes):
             value = self.integer(node, what, lo=lo, hi=hi)
         else:
             lo, hi = MODEL_BOUNDS[key]
-            value = float(self.number(node, what, lo=lo, hi=hi, unit=STEPPED_KEYS[key])) + 0.0
+            unit = {**STEPPED_KEYS, **EXACT_KEYS}[key]
+            value = float(self.number(node, what, lo=lo, hi=hi, unit=unit)) + 0.0
         if kind != model:
             raise self.error(node, f"{key} applies to the {model} model only, not to {kind}")
         return value

@@ -95,6 +95,15 @@ def json_schema() -> dict:
             "sleeps, default 0.5",
         },
     }
+    exact = {
+        "rest_height": {
+            "type": "number",
+            "minimum": 0,
+            "maximum": MODEL_BOUNDS["rest_height"][1],
+            "description": "exact model only, under gravity: a bounce on a wall that would rise "
+            "less (px) comes to rest; default 0.01",
+        },
+    }
     gravity_component = {"type": "number", "minimum": -MAX_GRAVITY, "maximum": MAX_GRAVITY}
     whole_px = {"type": "integer", "minimum": 1, "description": "whole pixels"}
     xy = {"type": "array", "items": number, "minItems": 2, "maxItems": 2}
@@ -260,6 +269,7 @@ def json_schema() -> dict:
                                 f"one tick may take, default {DEFAULT_MAX_EVENTS_PER_TICK:,}",
                             },
                             **stepped,
+                            **exact,
                         },
                         "required": ["kind"],
                         "additionalProperties": False,
@@ -272,10 +282,6 @@ def json_schema() -> dict:
                                     },
                                     "required": ["kind", "geometry"],
                                 },
-                                {
-                                    "properties": {"kind": {"enum": ["paper", "stepped"]}},
-                                    "required": ["kind", "max_events_per_tick"],
-                                },
                                 *(
                                     {
                                         "properties": {"kind": {"enum": ["paper", "exact"]}},
@@ -283,12 +289,20 @@ def json_schema() -> dict:
                                     }
                                     for key in ("substeps", *stepped)
                                 ),
+                                *(
+                                    {
+                                        "properties": {"kind": {"enum": ["paper", "stepped"]}},
+                                        "required": ["kind", key],
+                                    }
+                                    for key in ("max_events_per_tick", *exact)
+                                ),
                             ]
                         },
                     },
                 ],
                 "description": "paper (default) | stepped | exact, or {kind, substeps, geometry, "
-                "max_events_per_tick, iterations, slop, rest_speed, sleep, sleep_after}",
+                "max_events_per_tick, iterations, slop, rest_speed, sleep, sleep_after, "
+                "rest_height}",
             },
             "ticks": {"type": "integer", "minimum": 0},
             "duration": {

@@ -3,7 +3,8 @@ restitution-and-friction): what a file gives becomes the WorldSpec, the Bodies a
 model's settings, written in any of the ways objects are written (listed, generate, a CSV or .npy
 table, the fast lane); bad values are refused at their place, the paper model refuses every key at
 its line, the exact model takes only the defaults (naming `stepped`), and settings of another model
-are refused."""
+are refused; the exact model's `rest_height` (docs/models.md#exact-under-gravity) reaches it and
+ends a ball's bouncing sooner."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ import pytest
 from scenario_text import check_refused, refused
 
 from collide2d.engine import models
+from collide2d.engine.events import EV_REST, EV_WALL
 from collide2d.runner.run import make_model
 from collide2d.runner.scenario import fastlane as yamlfast
 from collide2d.runner.scenario.load import load, loads
@@ -218,6 +220,19 @@ def test_a_bad_stepped_setting_is_refused_at_its_place(setting, needle, fragment
     check_refused(scene(model=f"{{kind: stepped, {setting}}}"), needle, fragment)
 
 
+@pytest.mark.parametrize(
+    "setting, needle, fragment",
+    [
+        ("rest_height: -0.5", "-0.5", "model.rest_height must be at least 0 px, not -0.5"),
+        ("rest_height: 2e9", "2e9", "model.rest_height must be at most 1000000000 px"),
+        ("rest_height: .nan", ".nan", "model.rest_height must be a finite number"),
+        ("rest_height: low", "low", "model.rest_height must be a number"),
+    ],
+)
+def test_a_bad_rest_height_is_refused_at_its_place(setting, needle, fragment):
+    check_refused(scene(model=f"{{kind: exact, {setting}}}"), needle, fragment)
+
+
 def test_a_bad_table_cell_is_refused_at_its_row_and_column(tmp_path):
     rows = ["id,shape,w,h,x,y,restitution", "0,box,5,5,1,1,1", "1,box,5,5,10,1,1.25"]
     (tmp_path / "t.csv").write_text("\n".join(rows) + "\n")
@@ -304,6 +319,42 @@ def test_a_model_given_on_the_command_line_drops_the_files_stepped_settings():
     s = loads(scene(model="{kind: stepped, iterations: 3}", world="gravity: 0"),
               overrides={"model": "exact"})  # fmt: skip
     assert s.model == "exact" and s.iterations is None
+
+
+@pytest.mark.parametrize("kind", ["paper", "stepped"])
+def test_rest_height_under_another_model_is_refused_at_its_line(kind):
+    text = scene(world="background: black", model=f"{{kind: {kind}, rest_height: 0.5}}")
+    check_refused(text, "0.5}", f"rest_height applies to the exact model only, not to {kind}")
+
+
+def test_a_model_given_on_the_command_line_drops_the_files_rest_height():
+    text = scene(model="{kind: exact, rest_height: 0.5}", world="gravity: 0")
+    assert loads(text, overrides={"model": "stepped"}).rest_height is None
+    assert loads(text, overrides={"model": "exact"}).rest_height == 0.5  # the same kind keeps it
+
+
+# a ball of restitution 0.5 dropped from 1 px above the floor: its first impact leaves it
+# 1 px · 0.5² = 0.25 px to rise, its fourth the first under the default 0.01 px
+DROP = "  - {shape: circle, diameter: 10, position: [20, 89], restitution: 0.5}\n"
+
+
+def dropped(model: str):
+    """The events of the ball dropped under `model`, over 1 s (10 ticks)."""
+    s = loads(scene(DROP, world="gravity: 980", model=model))
+    found = make_model(s).advance(10)
+    return s, found[(found["type"] == EV_WALL) | (found["type"] == EV_REST)]
+
+
+def test_rest_height_reaches_the_exact_model_and_ends_the_bouncing_sooner():
+    s, found = dropped("{kind: exact, rest_height: 0.5}")
+    assert s.rest_height == 0.5
+    assert models.scenario_options("exact", rest_height=0.5, slop=0.1) == {"rest_height": 0.5}
+    assert found["type"].tolist() == [EV_WALL, EV_REST]  # at rest at its first impact
+    plain, found = dropped("exact")
+    assert plain.rest_height is None  # not given: the model's default holds
+    assert found["type"].tolist() == [EV_WALL] * 4 + [EV_REST]
+    _, found = dropped("{kind: exact, rest_height: 0.01}")  # the default written out
+    assert found["type"].tolist() == [EV_WALL] * 4 + [EV_REST]
 
 
 @pytest.mark.parametrize("gravity", ["980", "[1, 0]", "[0, -3]"])

@@ -91,6 +91,7 @@ GOOD_DOCS = [
     (DATA / "spec_example.yaml").read_text(),
     BASE + "model: {kind: stepped, substeps: 4}\nduration: 2.5\noutput: {frames: {every: 3}}\n",
     BASE + "model: {kind: exact, max_events_per_tick: 5000000}\n",
+    "version: 1\nworld: {gravity: 980}\nmodel: {kind: exact, rest_height: 0.5}\n",
     objects(
         "{shape: polygon, points: [[0, 0], [4, 0], [0, 4]], position: [1, 1], color: '#aabbcc',"
         " fill: true, name: tri}"
@@ -139,6 +140,10 @@ def test_schema_accepts_good_documents(text):
         BASE + "model: {kind: stepped, iterations: 0}\n",
         BASE + "model: {kind: stepped, sleep: 3}\n",
         BASE + "model: {kind: stepped, slop: -1}\n",
+        BASE + "model: {kind: exact, rest_height: -1}\n",
+        BASE + "model: {kind: exact, rest_height: 2e9}\n",
+        BASE + "model: {kind: stepped, rest_height: 0.5}\n",
+        BASE + "model: {kind: paper, rest_height: 0.5}\n",
         BASE + "generate:\n  - {count: 3, shape: box, size: 3, speed: 1, velocity: {min: [0, 0], "
         "max: [0, 0]}}\n",
     ],
