@@ -25,12 +25,14 @@ from collide2d.engine.jit import njit
 
 EV_WALL = 0
 EV_PAIR = 1
-# the exact model under gravity: an object comes to rest on a wall, stops sliding on it, or is
-# knocked off it (`code` is that wall's side)
+# the exact model under gravity: an object comes to rest on a wall or a static box's face, stops
+# sliding on it, is knocked off it, or slides past the static box's edge (`code` is the side it
+# presses into, `b` the static box, -1 for a wall)
 EV_REST = 2
 EV_STOP = 3
 EV_WAKE = 4
-TYPE_NAMES = ("wall", "pair", "rest", "stop", "wake")
+EV_LEAVE = 5
+TYPE_NAMES = ("wall", "pair", "rest", "stop", "wake", "leave")
 
 AXIS_X = 0
 AXIS_Y = 1
@@ -45,9 +47,10 @@ SIDE_BOTTOM = 3
 SIDE_NAMES = ("left", "right", "top", "bottom")
 
 # tick: the tick (1-based) the event belongs to; t: seconds (tick end in paper/stepped, the exact
-# contact time in exact); type: EV_WALL, EV_PAIR, EV_REST, EV_STOP or EV_WAKE; a: the object (a
-# wall, rest, stop or wake) or the lower id (pair); b: the higher id, -1 for the others; code: a
-# SIDE_* (the wall; of a rest, stop or wake the wall it rests on), an AXIS_* for pairs;
+# contact time in exact); type: EV_WALL ... EV_LEAVE; a: the object (a wall, rest, stop, wake or
+# leave) or the lower id (pair); b: the higher id (pair), the static box rested on (rest, stop,
+# wake, leave), else -1; code: a SIDE_* (the wall; of a rest, stop, wake or leave the side it
+# presses into), an AXIS_* for pairs;
 # xdiff/ydiff: the overlap's width and height (paper model only, else -1).
 EVENT_DTYPE = np.dtype(
     [
@@ -80,9 +83,11 @@ def format_number(x: float) -> str:
 def event_dict(rec) -> dict:
     """The JSON object of one event record, keys in their fixed order."""
     d = {"tick": int(rec["tick"]), "t": float(rec["t"]), "type": TYPE_NAMES[rec["type"]]}
-    if rec["type"] != EV_PAIR:  # an object's own event: its id and the wall's side
+    if rec["type"] != EV_PAIR:  # an object's own event: its id, the side, the static box (`on`)
         d["id"] = int(rec["a"])
         d["side"] = SIDE_NAMES[rec["code"]]
+        if rec["b"] >= 0:
+            d["on"] = int(rec["b"])
     else:
         d["a"] = int(rec["a"])
         d["b"] = int(rec["b"])

@@ -117,8 +117,10 @@ class Recorder:
         room = MAX_EVENTS - len(self.event_rows)
         for rec in events[: max(room, 0)]:
             d = event_dict(rec)
-            kind = int(rec["type"])  # engine.events: wall, pair, rest, stop, wake
+            kind = int(rec["type"])  # engine.events: wall, pair, rest, stop, wake, leave
             detail = d.get("side") or d.get("axis") or ""
+            if "on" in d:  # rests on (stops, wakes from, leaves) a static box
+                detail += f" on {d['on']}"
             if "xdiff" in d:
                 detail += f" xdiff {d['xdiff']} ydiff {d['ydiff']}"
             b = int(rec["b"]) if kind == EV_PAIR else -1

@@ -346,7 +346,7 @@ _JS = r"""
   }
   function setZoom(z) { zoom = z; zoomSel.value = String(z); draw(); }
 
-  var KINDS = ["wall", "pair", "rest", "stop", "wake"];  // engine/events.py TYPE_NAMES
+  var KINDS = ["wall", "pair", "rest", "stop", "wake", "leave"];  // engine/events.py TYPE_NAMES
 
   function buildEvents() {
     document.getElementById("event-count").textContent = D.eventCount > D.events.length

@@ -1,8 +1,8 @@
 """The exact model under gravity (docs/models.md#exact-under-gravity), held to the closed forms: a
 free fall at every frame, the bounce times of an elastic ball, a projectile's flight, the
 stacked-ball drop, bounces on a static box and a static circle (a curved relative path), and the
-energy of an elastic gas under gravity over 10,000 ticks; and what it does not carry on yet (a
-body coming to rest on another), stopped by name."""
+energy of an elastic gas under gravity over 10,000 ticks; rest, slides and stops on the walls.
+(Rest on static boxes, and the supports it does not follow: test_exact_rest_on_static.py.)"""
 
 from __future__ import annotations
 
@@ -12,7 +12,6 @@ import numpy as np
 import pytest
 from engine_refs import pile_bodies
 
-from collide2d.engine.errors import NotYetExact
 from collide2d.engine.events import EV_PAIR, EV_WALL, SIDE_BOTTOM, TYPE_NAMES
 from collide2d.engine.models import make
 from collide2d.engine.world import KIND_CIRCLE, Bodies, Looks, WorldSpec
@@ -172,18 +171,6 @@ def test_a_projectile_meets_a_static_wall_where_its_parabola_does():
     m2.advance(int(t * 30))
     y = 100 - 200 * (m2.tick / 30) + 0.5 * G * (m2.tick / 30) ** 2
     assert m2.positions()[0, 1] == pytest.approx(y, rel=1e-13)
-
-
-def test_a_body_that_would_rest_on_a_static_one_stops_the_run_by_name():
-    world = WorldSpec(200, 1000, 60, gravity=(0.0, G))
-    bodies = Bodies.boxes([[50, 700], [40, 710]], [[10, 10], [40, 20]], [[5, 0], [0, 0]],
-                          static=[False, True])  # fmt: skip
-    m = make("exact", world, bodies)
-    with pytest.raises(NotYetExact, match="objects 0 and 1 .* tick 1 .* model: stepped") as info:
-        m.advance(10)
-    assert info.value.objects == (0, 1)
-    with pytest.raises(NotYetExact):  # and stays stopped
-        m.advance(1)
 
 
 def with_(bodies: Bodies, **columns) -> Bodies:

@@ -8,8 +8,10 @@ taken at that instant. Both act with the contact's restitution (the smaller of i
 and friction (the larger): elastic and frictionless at the defaults, to the bit. Each writes its
 prediction jobs (state.py) and returns how many; a pair that does not approach is no event (0
 jobs), and one pressed together with no speed while one of the two falls on the other (which
-would come to rest on it) returns -1: the model stops there. `move_to` carries an object's
-position, and under gravity its velocity, to a time.
+would come to rest on it) returns -1: `rest_on` then rests it on a static box's face, as on a
+wall, or the model stops there. A resting object's stop and leave (past the face's edge) are
+events of their own. `move_to` carries an object's position, and under gravity its velocity, to
+a time.
 """
 
 from __future__ import annotations
@@ -18,7 +20,7 @@ import numpy as np
 
 from collide2d.engine.events import SIDE_BOTTOM, SIDE_LEFT, SIDE_RIGHT, SIDE_TOP
 from collide2d.engine.models.exact.cells import cell_insert, cell_remove
-from collide2d.engine.models.exact.prediction import set_job, velocity_at
+from collide2d.engine.models.exact.prediction import leave_span, set_job, state_at, velocity_at
 from collide2d.engine.models.exact.state import (
     AX,
     AY,
@@ -34,6 +36,7 @@ from collide2d.engine.models.exact.state import (
     MU,
     PARTNER,
     SH,
+    SHAPE,
     STATIC,
     SW,
     TLOC,
@@ -45,9 +48,12 @@ from collide2d.engine.models.exact.state import (
     cold,
     falls,
     hot,
+    rest_side,
+    rest_support,
 )
 from collide2d.engine.parabola import slide_acceleration
 from collide2d.engine.response import impact, wall_impact
+from collide2d.engine.world import KIND_BOX, KIND_POLYGON
 
 
 @hot
@@ -94,9 +100,11 @@ def pull(side, world):
 def slide(i, F, P, R, world):
     """Set resting object i's acceleration: none into its wall, and along it gravity less friction
     against its sliding (parabola.slide_acceleration); none either against a wall it touches
-    along its slide with no speed (it sits in the corner)."""
-    side = R[i]
-    mu = max(P[i, MU], world.friction)
+    along its slide with no speed (it sits in the corner). On a static box's face, as on a wall
+    that side, with the larger of its friction and the box's."""
+    side = rest_side(R[i])
+    j = rest_support(R[i])
+    mu = max(P[i, MU], world.friction if j < 0 else P[j, MU])
     if side == SIDE_LEFT or side == SIDE_RIGHT:
         a = slide_acceleration(world.gy, F[i, VY], mu, pull(side, world))
         span, p, v = world.height - F[i, SH], F[i, Y], F[i, VY]
@@ -177,7 +185,8 @@ def on_stop(i, t, S, jobs):
     friction holds it or gravity starts it the other way. Returns the number of jobs (1)."""
     F, N, P, R, world = S.F, S.N, S.P, S.R, S.world
     move_to(i, t, F, P, world)
-    if R[i] == SIDE_LEFT or R[i] == SIDE_RIGHT:
+    side = rest_side(R[i])
+    if side == SIDE_LEFT or side == SIDE_RIGHT:
         F[i, VY] = 0.0
     else:
         F[i, VX] = 0.0
@@ -191,8 +200,9 @@ def on_stop(i, t, S, jobs):
 @cold
 def wake_or_slide(i, F, P, R, world):
     """After a pair event, resting object i wakes (flies under gravity again) when it has a speed
-    off its wall, into it or away; else it goes on sliding. Returns whether it woke."""
-    side = R[i]
+    off its wall (or static box), into it or away; else it goes on sliding. Returns whether it
+    woke."""
+    side = rest_side(R[i])
     normal = F[i, VX] if side == SIDE_LEFT or side == SIDE_RIGHT else F[i, VY]
     if normal != 0.0:
         R[i] = -1
@@ -253,6 +263,96 @@ def on_pair(a, b, code, nx, ny, t, S, jobs):
             set_job(jobs, n_jobs, i, -1 if curved else other, JOB_EVENT)
             n_jobs += 1
     return n_jobs
+
+
+@hot
+def _face_side(dx, dy):
+    """The side pressed into along the unit direction (dx, dy) when it is an axis (-1 if not)."""
+    if dx == 0.0 and dy == 1.0:
+        return SIDE_BOTTOM
+    if dx == 0.0 and dy == -1.0:
+        return SIDE_TOP
+    if dy == 0.0 and dx == 1.0:
+        return SIDE_RIGHT
+    if dy == 0.0 and dx == -1.0:
+        return SIDE_LEFT
+    return -1
+
+
+@cold
+def rest_on(a, b, nx, ny, t, S, jobs):
+    """Pair (a, b), of unit normal n from a to b, where on_pair found that one falls onto the
+    other to rest (-1): the falling one comes to rest on the other when that is a static box and
+    they touch on its face across gravity's pull, the falling one over that face (leave_span; a
+    box or a circle): its impact there with the pair's restitution and friction, then no speed
+    into the face, set exactly on it, sliding along it as on a wall. Returns the jobs (1); -1
+    where it cannot rest (a moving, curved or polygonal support, a corner): the model stops."""
+    F, N, P, R, world = S.F, S.N, S.P, S.R, S.world
+    if N[b, STATIC] != 0 and N[a, STATIC] == 0:
+        i, j, side = a, b, _face_side(nx, ny)
+    elif N[a, STATIC] != 0 and N[b, STATIC] == 0:
+        i, j, side = b, a, _face_side(-nx, -ny)
+    else:
+        return -1
+    if side < 0 or N[j, SHAPE] != KIND_BOX or N[i, SHAPE] == KIND_POLYGON or R[i] >= 0:
+        return -1
+    if not pull(side, world) > 0.0:
+        return -1
+    x_side = side == SIDE_LEFT or side == SIDE_RIGHT
+    axis = 1 if x_side else 0  # along the face
+    lo, hi = leave_span(i, j, axis, F, N)
+    x, y, _, _ = state_at(i, t, F, P)
+    p = y if x_side else x
+    if not (lo < p < hi):
+        return -1
+    move_to(i, t, F, P, world)
+    e = min(P[i, E], P[j, E])
+    mu = max(P[i, MU], P[j, MU])
+    if x_side:
+        F[i, VX], F[i, VY] = wall_impact(F[i, VX], F[i, VY], e, mu)
+        F[i, VX] = 0.0
+        F[i, X] = F[j, X] - F[i, SW] if side == SIDE_RIGHT else F[j, X] + F[j, SW]
+    else:
+        F[i, VY], F[i, VX] = wall_impact(F[i, VY], F[i, VX], e, mu)
+        F[i, VY] = 0.0
+        F[i, Y] = F[j, Y] - F[i, SH] if side == SIDE_BOTTOM else F[j, Y] + F[j, SH]
+    R[i] = side + 4 * (j + 1)
+    slide(i, F, P, R, world)
+    N[i, CNT] += 1
+    N[i, PARTNER] = -1
+    set_job(jobs, 0, i, -1, JOB_EVENT)
+    return 1
+
+
+@cold
+def on_leave(i, t, S, jobs):
+    """Resting object i slides past the edge of the static box j it rests on (leave_span): set
+    exactly at that edge, it falls from there at its velocity. A box leaves the corner at once
+    (they only touch there); a circle, whose centre is then over the corner, flies clear of it
+    when its speed v along the face holds v² >= r·g (g gravity's pull into the face) and gravity
+    along the face does not pull it back: predicting i again leaves j out this once (they touch
+    at that instant, parting). Else it would slide round the corner: -1, the model stops. Returns
+    the jobs (1)."""
+    F, N, P, R, world = S.F, S.N, S.P, S.R, S.world
+    side = rest_side(R[i])
+    j = rest_support(R[i])
+    axis = 1 if side == SIDE_LEFT or side == SIDE_RIGHT else 0
+    v = velocity_at(i, t, F, P, world)[axis]
+    skip = -1
+    if N[i, SHAPE] != KIND_BOX:  # a circle (rest_on takes no polygon)
+        along = world.gy if axis == 1 else world.gx
+        if v * v < 0.5 * F[i, SW] * pull(side, world) or v * along < 0.0:
+            return -1
+        skip = j
+    move_to(i, t, F, P, world)
+    lo, hi = leave_span(i, j, axis, F, N)
+    F[i, X + axis] = lo if v < 0.0 else hi
+    R[i] = -1
+    P[i, AX], P[i, AY] = world.gx, world.gy
+    N[i, CNT] += 1
+    N[i, PARTNER] = skip
+    set_job(jobs, 0, i, skip, JOB_EVENT)
+    return 1
 
 
 def start_resting(F, N, P, R, world) -> None:

@@ -13,10 +13,11 @@ wall and pair events in the order they happened, `t` = the exact contact time; p
 velocities at the end of the last tick.
 
 Objects fly on straight lines between events, or under the world's gravity on parabolas (exact: `x +
-v·t + ½·g·t²`). Under gravity an object whose bounce on a wall would rise less than `rest_height`
-(px, an option) rests on that wall (R): no speed nor gravity into it, sliding along it
-against friction until it stops, an event due like a wall contact (its horizon); a pair event that
-leaves it a speed off the wall wakes it (apply.py). Each object keeps its own clock (TLOC: its
+v·t + ½·g·t²`). Under gravity an object whose bounce on a wall, or on a static box's face, would
+rise less than `rest_height` (px, an option) rests on it (R): no speed nor gravity into it,
+sliding along it against friction until it stops, or past the face's edge (`leave`), each an event
+due like a wall contact (its horizon); a pair event that leaves it a speed off its support wakes
+it (apply.py). Each object keeps its own clock (TLOC: its
 position and velocity are valid at that time) and an invalidation counter. Two queues hold what
 comes next, keyed by (time, rank, a, b) so that ties go cell crossings first (bookkeeping, never
 logged), then walls by (id, side), then pairs in (a, b) order: each moving object's *horizon*, the
@@ -79,6 +80,7 @@ from collide2d.engine.events import (
     AXIS_NAMES,
     AXIS_X,
     AXIS_Y,
+    EV_LEAVE,
     EV_PAIR,
     EV_REST,
     EV_STOP,
@@ -88,7 +90,15 @@ from collide2d.engine.events import (
     SIDE_RIGHT,
     put_event,
 )
-from collide2d.engine.models.exact.apply import on_cross, on_pair, on_stop, on_wall, start_resting
+from collide2d.engine.models.exact.apply import (
+    on_cross,
+    on_leave,
+    on_pair,
+    on_stop,
+    on_wall,
+    rest_on,
+    start_resting,
+)
 from collide2d.engine.models.exact.cells import (
     build_grid,
     grid_cell,
@@ -138,6 +148,7 @@ from collide2d.engine.models.exact.state import (
     JOB_EVENT,
     JOB_FIRST,
     JOB_ROWS,
+    LEAVE,
     MU,
     PARTNER,
     S_FIRST,
@@ -171,6 +182,8 @@ from collide2d.engine.models.exact.state import (
     kernel,
     named,
     plain,
+    rest_side,
+    rest_support,
 )
 from collide2d.engine.noroom import no_room, no_room_message
 from collide2d.engine.shapes import GEOMETRIES, build_cores
@@ -308,16 +321,26 @@ def _run(state, jobs, stack, tick_to, log, cap, everyone, rows, times):
                 rest_b = S.R[b] if falls(world) and rank == RANK_PAIR else -1
                 if rank == RANK_WALL and b == STOP:
                     n_jobs = on_stop(a, t, S, jobs)
-                    kind, b, code = EV_STOP, -1, rest_a
+                    kind, b, code = EV_STOP, rest_support(rest_a), rest_side(rest_a)
+                elif rank == RANK_WALL and b == LEAVE:
+                    n_jobs = on_leave(a, t, S, jobs)
+                    kind, b, code = EV_LEAVE, rest_support(rest_a), rest_side(rest_a)
+                    if n_jobs < 0:  # a circle that would slide round the corner: stopped
+                        set_job(jobs, 0, a, b, JOB_EVENT)
+                        return STATUS_REST
                 elif rank == RANK_WALL:
                     n_jobs = on_wall(a, b, t, S, jobs)
                     kind, b = EV_WALL, -1
                 else:
                     n_jobs = on_pair(a, b, code, e.nx, e.ny, t, S, jobs)
                     kind = EV_PAIR
-                    if n_jobs < 0:  # a body would rest on another: stopped, the pair named
-                        set_job(jobs, 0, a, b, JOB_EVENT)
-                        return STATUS_REST
+                    if n_jobs < 0:  # a body would rest on the other: on a static box's face
+                        n_jobs = rest_on(a, b, e.nx, e.ny, t, S, jobs)
+                        if n_jobs < 0:  # on anything else it cannot: stopped, the pair named
+                            set_job(jobs, 0, a, b, JOB_EVENT)
+                            return STATUS_REST
+                        a = jobs[0, J_OBJ]
+                        kind, b, code = EV_REST, rest_support(S.R[a]), rest_side(S.R[a])
                 if n_jobs > 0:  # a pair that was not approaching is no event
                     if kind == EV_WALL:
                         st[S_WALLS] += 1
@@ -332,7 +355,17 @@ def _run(state, jobs, stack, tick_to, log, cap, everyone, rows, times):
                             st[S_LOGGED] += 1
                         for i, was in ((a, rest_a), (b, rest_b)):
                             if kind == EV_PAIR and was >= 0 and S.R[i] < 0:
-                                put_event(rows, times, st[S_LOGGED], tick, t, EV_WAKE, i, -1, was)
+                                put_event(
+                                    rows,
+                                    times,
+                                    st[S_LOGGED],
+                                    tick,
+                                    t,
+                                    EV_WAKE,
+                                    i,
+                                    rest_support(was),
+                                    rest_side(was),
+                                )
                                 st[S_LOGGED] += 1
         # predict again for what the step touched (and after an event with `everyone`, for
         # every other moving object: contacts only, not against the partner of its last pair)
@@ -542,7 +575,7 @@ class Model:
         same = np.abs(times[:n] - t) <= max(INSTANT_S, abs(t) * INSTANT_REL)
         last = rows[:n][same][:, 2:5]  # a, b, code
         involved = sorted({int(i) for i in last[:, :2].ravel() if i >= 0})
-        walls = last[:, 1] < 0
+        walls = rows[:n][same][:, 1] != EV_PAIR  # an object's own event: its side in code
         x_side = (last[:, 2] == SIDE_LEFT) | (last[:, 2] == SIDE_RIGHT)
         on = {
             AXIS_X: (walls & x_side) | (~walls & (last[:, 2] != AXIS_Y)),
@@ -566,14 +599,14 @@ class Model:
         return EventCapExceeded(said)
 
     def _resting(self) -> NotYetExact:
-        """The error of a run stopped where a falling body would come to rest on another (the
-        pair is in the first row of the jobs)."""
+        """The error of a run stopped where a falling body would come to rest on another, or a
+        circle slide round a static box's corner (the pair is in the first row of the jobs)."""
         a, b = int(self._jobs[0, J_OBJ]), int(self._jobs[0, J_SKIP])
         return NotYetExact(
             f"objects {a} and {b} meet with no speed between them while gravity presses them "
             f"together, in tick {int(self._st[S_TICK]) + 1} at t = {float(self._stf[SF_T_NOW])!r} "
-            "s: one would come to rest on the other, which the exact model does not do yet; "
-            "use model: stepped",
+            "s: one would rest on the other or slide round it, which the exact model does only on "
+            "the walls and the flat faces of static boxes; use model: stepped",
             (a, b),
         )
 

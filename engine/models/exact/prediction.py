@@ -33,6 +33,7 @@ from collide2d.engine.models.exact.state import (
     JOB_CONTACTS,
     JOB_CROSS,
     JOB_FIRST,
+    LEAVE,
     NEXT,
     S_STAMP,
     SH,
@@ -49,9 +50,11 @@ from collide2d.engine.models.exact.state import (
     cold,
     falls,
     hot,
+    rest_side,
+    rest_support,
 )
 from collide2d.engine.parabola import meet
-from collide2d.engine.world import KIND_BOX
+from collide2d.engine.world import KIND_BOX, KIND_CIRCLE
 
 
 @hot
@@ -64,7 +67,7 @@ def velocity_at(i, t, F, P, world):
 
 
 @hot
-def _state_at(i, t, F, P):
+def state_at(i, t, F, P):
     """Object i's position and velocity at time t (x, y, vx, vy), not stored."""
     dt = t - F[i, TLOC]
     if P[i, AX] == 0.0 and P[i, AY] == 0.0:
@@ -91,7 +94,7 @@ def _first_of_two(t_lo, t_hi, lo, hi):
 def _wall_time_falling(i, t_now, F, P, world):
     """_wall_time under an acceleration: on each axis the first of its two walls the parabola meets
     (parabola.meet), from i's state at t_now."""
-    x, y, vx, vy = _state_at(i, t_now, F, P)
+    x, y, vx, vy = state_at(i, t_now, F, P)
     sx = world.width - F[i, SW]
     sy = world.height - F[i, SH]
     tx, side_x = _first_of_two(
@@ -116,12 +119,38 @@ def _wall_time_falling(i, t_now, F, P, world):
 @cold
 def _stop_time(i, t_now, F, P, R):
     """When resting object i, sliding against friction, stops (inf: never)."""
-    x, y, vx, vy = _state_at(i, t_now, F, P)
-    side = R[i]
+    x, y, vx, vy = state_at(i, t_now, F, P)
+    side = rest_side(R[i])
     v, a = (vy, P[i, AY]) if side == SIDE_LEFT or side == SIDE_RIGHT else (vx, P[i, AX])
     if v * a < 0.0:
         return t_now + -v / a
     return INF
+
+
+@cold
+def leave_span(i, j, axis, F, N):
+    """The positions (lo, hi) along `axis` (0: x, 1: y) between which object i is over the face
+    of static box j it rests on: a box while it overlaps the face, a circle while its centre is
+    over it (past that it would hang on the corner)."""
+    lo = F[j, X + axis]
+    hi = lo + F[j, SW + axis]
+    size = F[i, SW + axis]
+    if N[i, SHAPE] == KIND_CIRCLE:
+        return lo - 0.5 * size, hi - 0.5 * size
+    return lo - size, hi
+
+
+@cold
+def _leave_time(i, t_now, F, N, P, R):
+    """When object i, resting on a static box's face, slides past its edge (leave_span; inf:
+    never)."""
+    side = rest_side(R[i])
+    axis = 1 if side == SIDE_LEFT or side == SIDE_RIGHT else 0
+    lo, hi = leave_span(i, rest_support(R[i]), axis, F, N)
+    x, y, vx, vy = state_at(i, t_now, F, P)
+    p, v, a = (y, vy, P[i, AY]) if axis == 1 else (x, vx, P[i, AX])
+    t, _ = _first_of_two(meet(max(p - lo, 0.0), v, a), meet(max(hi - p, 0.0), -v, -a), 0, 1)
+    return t_now + t
 
 
 @hot
@@ -153,7 +182,7 @@ def _cross_time_falling(i, t_now, F, P, N, world):
     cell, gnx, gny = world.cell, world.gnx, world.gny
     gx = N[i, CELL] % gnx
     gy = N[i, CELL] // gnx
-    x, y, vx, vy = _state_at(i, t_now, F, P)
+    x, y, vx, vy = state_at(i, t_now, F, P)
     cx = x + 0.5 * F[i, SW] - gx * cell  # the centre within its cell
     cy = y + 0.5 * F[i, SH] - gy * cell
     ax, ay = P[i, AX], P[i, AY]
@@ -242,8 +271,8 @@ def _falling_pair(a, b, t0, t_now, limit, S):
     (False, qx, qy, ux, uy); or, when one falls and the other stands, their curved relative path's
     contact pushed if it comes no later than `limit`, (True, ...)."""
     F, N, P = S.F, S.N, S.P
-    xa, ya, vax, vay = _state_at(a, t0, F, P)
-    xb, yb, vbx, vby = _state_at(b, t0, F, P)
+    xa, ya, vax, vay = state_at(a, t0, F, P)
+    xb, yb, vbx, vby = state_at(b, t0, F, P)
     qx, qy, ux, uy = xb - xa, yb - ya, vbx - vax, vby - vay
     ax = P[b, AX] - P[a, AX]
     ay = P[b, AY] - P[a, AY]
@@ -304,10 +333,16 @@ def predict(jobs, k, t_now, S):
     higher = mode == JOB_FIRST
     P, R = S.P, S.R
     t_wall, side = _wall_time(i, t_now, F, P, world)
-    if falls(world) and R[i] >= 0:  # resting: its stop, if first, changes it next
+    support = -1  # the static box i rests on: touching it, it is no contact
+    if falls(world) and R[i] >= 0:  # resting: its stop or its leaving, if first, changes it next
         t_stop = _stop_time(i, t_now, F, P, R)
         if t_stop < t_wall:
             t_wall, side = t_stop, STOP
+        support = rest_support(R[i])
+        if support >= 0:
+            t_leave = _leave_time(i, t_now, F, N, P, R)
+            if t_leave < t_wall:
+                t_wall, side = t_leave, LEAVE
     if mode != JOB_CONTACTS:
         t_cross, d = _cross_time(i, t_now, F, P, N, world)
         if t_cross <= t_wall and t_cross < INF:
@@ -347,7 +382,7 @@ def predict(jobs, k, t_now, S):
                 continue
             for m in range(s_start[c], s_start[c + 1]):
                 j = s_items[m]
-                if N[j, STAMP] != st[S_STAMP] and j != skip:
+                if N[j, STAMP] != st[S_STAMP] and j != skip and j != support:
                     N[j, STAMP] = st[S_STAMP]
                     _predict_pair(i, j, t_now, limit, S)
 

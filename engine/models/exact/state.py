@@ -111,10 +111,14 @@ CNT, STATIC, SHAPE, CELL, NEXT, PREV, STAMP, PARTNER = range(8)
 # of 8 are one cache line each, as every event and prediction reads them: wider rows cost a
 # scene without gravity up to 12 % of its steps/s): acceleration (px/s²: the world's gravity for
 # a moving object, 0 for a static one, and along its wall only for a resting one), restitution
-# and friction. R (n,) int64: the wall side each object rests on (-1: it does not rest).
+# and friction. R (n,) int64: what each object rests on: -1 nothing; a wall, its side (0-3); the
+# face of a static box j, side + 4·(j + 1), the side being the one it presses into as it would a
+# wall's (rest_side, rest_support).
 AX, AY, E, MU = range(4)
-# A horizon's `what` (besides wall sides 0-3 and directions 0-3): a resting object stops sliding.
+# A horizon's `what` (besides wall sides 0-3 and directions 0-3): a resting object stops sliding,
+# or slides past the edge of the static box it rests on.
 STOP = 4
+LEAVE = 5
 
 # A prediction job (one row of `jobs`): the object, the partner to leave out (-1: none; for
 # JOB_CROSS, the direction it crossed in), and its mode: JOB_EVENT (after an event of the object),
@@ -163,6 +167,18 @@ def falls(world):
     """Whether the world has gravity: without it no object has an acceleration or rests, and the
     kernels read neither (a branch on the world, the same at every call)."""
     return world.gx != 0.0 or world.gy != 0.0
+
+
+@hot
+def rest_side(r):
+    """The side a resting object presses into, of its R entry r (>= 0)."""
+    return r & 3
+
+
+@hot
+def rest_support(r):
+    """The static box a resting object rests on, of its R entry r (-1: a wall, or no rest)."""
+    return (r >> 2) - 1 if r >= 0 else -1
 
 
 @hot
