@@ -35,14 +35,17 @@ output: {frames: {every: 5}, gif: true, events: true}
 
 
 def files(folder: Path) -> dict[str, bytes]:
-    """Every file under folder by its bytes, summary.json without its run time."""
+    """Every file under folder by its bytes, summary.json without how this run ran (its run time,
+    and whether the kernels were compiled by then: under --jit auto that depends on the machine's
+    load)."""
     out = {}
     for p in sorted(folder.rglob("*")):
         if p.is_file():
             data = p.read_bytes()
             if p.name == "summary.json":
                 summary = json.loads(data)
-                summary.pop("run_time_s")
+                for key in ("run_time_s", "compile_time_s", "kernels"):
+                    summary.pop(key, None)
                 data = json.dumps(summary, sort_keys=True).encode()
             out[str(p.relative_to(folder))] = data
     return out

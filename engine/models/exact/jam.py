@@ -1,17 +1,21 @@
-"""A jam that stops the exact model: the moving objects held on an axis, named in words.
+"""Why the exact model stops, named in words: a jam, a runaway, a rest it cannot follow.
 
-After a tick stopped at the event cap, `jammed` finds the moving objects held from both sides by
-a touching chain from wall or static object to wall or static object (they cannot move on that
-axis, so the model would collide them again and again with no time passing); `listing` names
-them for the message. Objects with no room already when a scene is built are found by
-engine/noroom.py.
+After a tick stopped at the event cap, `jam_error` looks at the events that would come next at the
+instant it stopped: `jammed` finds the moving objects held from both sides by a touching chain
+from wall or static object to wall or static object (they cannot move on that axis, so the model
+would collide them again and again with no time passing), and the error names them (NoRoom), else
+it is a runaway (EventCapExceeded). `rest_error` names a pair where one would rest on the other,
+or slide round it, which the model does not follow (NotYetExact). `listing` names objects for the
+messages. Objects with no room already when a scene is built are found by engine/noroom.py.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from collide2d.engine.events import AXIS_X
+from collide2d.engine.errors import EventCapExceeded, NoRoom, NotYetExact
+from collide2d.engine.events import AXIS_NAMES, AXIS_X, AXIS_Y, EV_PAIR, SIDE_LEFT, SIDE_RIGHT
+from collide2d.engine.models.exact.heap import INSTANT_REL, INSTANT_S
 from collide2d.engine.models.exact.state import SH, STATIC, SW, TLOC, VX, VY, X, Y
 
 
@@ -51,3 +55,44 @@ def jammed(F, N, world, ids: list[int], axis: int, t: float) -> list[int]:
             reached = more
         held.append(reached)
     return [int(i) for i in ids[held[0] & held[1] & ~fixed]]
+
+
+def jam_error(rows, times, t: float, F, N, world, said: str) -> EventCapExceeded | NoRoom:
+    """The error of a tick stopped at the cap, from the events logged after it (rows, times of
+    the event log) and the state: NoRoom when the objects of the events at the instant t are
+    jammed on an axis, naming them; else EventCapExceeded (`said`: what stopped)."""
+    same = np.abs(times - t) <= max(INSTANT_S, abs(t) * INSTANT_REL)
+    last = rows[same][:, 2:5]  # a, b, code
+    involved = sorted({int(i) for i in last[:, :2].ravel() if i >= 0})
+    walls = rows[same][:, 1] != EV_PAIR  # an object's own event: its side in code
+    x_side = (last[:, 2] == SIDE_LEFT) | (last[:, 2] == SIDE_RIGHT)
+    on = {
+        AXIS_X: (walls & x_side) | (~walls & (last[:, 2] != AXIS_Y)),
+        AXIS_Y: (walls & ~x_side) | (~walls & (last[:, 2] != AXIS_X)),
+    }
+    for axis in (AXIS_X, AXIS_Y):
+        objects = jammed(F, N, world, involved, axis, t) if on[axis].any() else []
+        if objects:
+            one = len(objects) == 1
+            against = " and the walls" if walls.any() else ""
+            return NoRoom(
+                f"{listing('object', objects)} {'has' if one else 'have'} no room to move on "
+                f"{AXIS_NAMES[axis]}: {'it collides' if one else 'they collide'} with "
+                f"{'its neighbours' if one else 'each other'}{against} again and again at "
+                f"t = {t!r} s with no time passing ({said})",
+                tuple(objects),
+                AXIS_NAMES[axis],
+            )
+    return EventCapExceeded(said)
+
+
+def rest_error(a: int, b: int, tick: int, t: float) -> NotYetExact:
+    """The error of a run stopped in `tick` at time t where, of objects a and b pressed together
+    by gravity with no speed between them, one would rest on the other or slide round it."""
+    return NotYetExact(
+        f"objects {a} and {b} meet with no speed between them while gravity presses them "
+        f"together, in tick {tick} at t = {t!r} s: one would rest on the other or slide round "
+        "it, which the exact model does only on the walls and the flat faces of static boxes; "
+        "use model: stepped",
+        (a, b),
+    )

@@ -78,16 +78,12 @@ from collide2d.engine import events, models
 from collide2d.engine.errors import EventCapExceeded, NoRoom, NotYetExact
 from collide2d.engine.events import (
     AXIS_NAMES,
-    AXIS_X,
-    AXIS_Y,
     EV_LEAVE,
     EV_PAIR,
     EV_REST,
     EV_STOP,
     EV_WAKE,
     EV_WALL,
-    SIDE_LEFT,
-    SIDE_RIGHT,
     put_event,
 )
 from collide2d.engine.models.exact.apply import (
@@ -108,8 +104,6 @@ from collide2d.engine.models.exact.cells import (
 )
 from collide2d.engine.models.exact.heap import (
     HKEY,
-    INSTANT_REL,
-    INSTANT_S,
     INSTANT_STACK,
     MAX_OBJECTS,
     RANK_CROSS,
@@ -133,7 +127,7 @@ from collide2d.engine.models.exact.horizonqueue import (
     new_horizons,
     next_top,
 )
-from collide2d.engine.models.exact.jam import jammed, listing
+from collide2d.engine.models.exact.jam import jam_error, rest_error
 from collide2d.engine.models.exact.prediction import predict, set_job
 from collide2d.engine.models.exact.state import (
     AX,
@@ -570,45 +564,15 @@ class Model:
         while self._call(int(st[S_TICK]) + 1, True, cap, rows, times) == STATUS_HEAP_FULL:
             self._grow_heap()
         st[S_WALLS : S_PAIRS + 1] = counts  # the counts stay those of the events before the stop
-        t = float(self._stf[SF_T_NOW])
         n = int(st[S_LOGGED])
-        same = np.abs(times[:n] - t) <= max(INSTANT_S, abs(t) * INSTANT_REL)
-        last = rows[:n][same][:, 2:5]  # a, b, code
-        involved = sorted({int(i) for i in last[:, :2].ravel() if i >= 0})
-        walls = rows[:n][same][:, 1] != EV_PAIR  # an object's own event: its side in code
-        x_side = (last[:, 2] == SIDE_LEFT) | (last[:, 2] == SIDE_RIGHT)
-        on = {
-            AXIS_X: (walls & x_side) | (~walls & (last[:, 2] != AXIS_Y)),
-            AXIS_Y: (walls & ~x_side) | (~walls & (last[:, 2] != AXIS_X)),
-        }
-        for axis in (AXIS_X, AXIS_Y):
-            objects = (
-                jammed(self._F, self._N, self._world, involved, axis, t) if on[axis].any() else []
-            )
-            if objects:
-                one = len(objects) == 1
-                against = " and the walls" if walls.any() else ""
-                return NoRoom(
-                    f"{listing('object', objects)} {'has' if one else 'have'} no room to move on "
-                    f"{AXIS_NAMES[axis]}: {'it collides' if one else 'they collide'} with "
-                    f"{'its neighbours' if one else 'each other'}{against} again and again at "
-                    f"t = {t!r} s with no time passing ({said})",
-                    tuple(objects),
-                    AXIS_NAMES[axis],
-                )
-        return EventCapExceeded(said)
+        return jam_error(rows[:n], times[:n], float(self._stf[SF_T_NOW]), self._F, self._N,
+                         self._world, said)  # fmt: skip
 
     def _resting(self) -> NotYetExact:
         """The error of a run stopped where a falling body would come to rest on another, or a
         circle slide round a static box's corner (the pair is in the first row of the jobs)."""
         a, b = int(self._jobs[0, J_OBJ]), int(self._jobs[0, J_SKIP])
-        return NotYetExact(
-            f"objects {a} and {b} meet with no speed between them while gravity presses them "
-            f"together, in tick {int(self._st[S_TICK]) + 1} at t = {float(self._stf[SF_T_NOW])!r} "
-            "s: one would rest on the other or slide round it, which the exact model does only on "
-            "the walls and the flat faces of static boxes; use model: stepped",
-            (a, b),
-        )
+        return rest_error(a, b, int(self._st[S_TICK]) + 1, float(self._stf[SF_T_NOW]))
 
     def positions(self) -> np.ndarray:
         """(n, 2) float64 top-left corners at the last tick's end, px (each object carried from
