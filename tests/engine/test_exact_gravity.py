@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 from engine_refs import pile_bodies
 
-from collide2d.engine.events import EV_PAIR, EV_WALL, SIDE_BOTTOM, TYPE_NAMES
+from collide2d.engine.events import AXIS_Y, EV_PAIR, EV_WALL, SIDE_BOTTOM, TYPE_NAMES
 from collide2d.engine.models import make
-from collide2d.engine.world import KIND_CIRCLE, Bodies, Looks, WorldSpec
+from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, Bodies, Looks, WorldSpec
 
 G = 980.0
 
@@ -223,24 +223,32 @@ def test_a_block_on_the_floor_holds_while_friction_can_hold_it(gx, moves):
     assert m.positions()[0, 1] == 90.0
 
 
-def test_a_resting_box_knocked_off_the_floor_wakes_and_energy_never_rises():
+@pytest.mark.parametrize("x0, held", [(60, True), (46, False)])
+def test_a_resting_box_is_held_by_the_floor_or_knocked_off_it_and_energy_never_rises(x0, held):
+    # a ball thrown sideways lands on the resting box's top (x0 = 60): pressed straight into the
+    # floor, the box is held by it and the ball bounces off as off the floor; on its corner
+    # (x0 = 46), the oblique impact knocks the box off the floor: it wakes and bounces
     world = WorldSpec(200, 400, 60, gravity=(0.0, G))
-    # thrown sideways onto the box, the ball bounces off it and lands on the floor beyond
-    bodies = Bodies.boxes([[60, 100], [90, 380]], [[10, 10], [20, 20]], [[50, 0], [0, 0]],
+    bodies = Bodies.boxes([[x0, 100], [90, 380]], [[10, 10], [20, 20]], [[50, 0], [0, 0]],
                           mass=[1.0, 2.0])  # fmt: skip
-    bodies = with_(bodies, restitution=np.array([0.9, 0.5]))
+    bodies = with_(bodies, restitution=np.array([0.9, 0.5]),
+                   kind=np.array([KIND_CIRCLE, KIND_BOX], np.int8))  # fmt: skip
     m = make("exact", world, bodies)
     before = energy(m, bodies, world)
-    kinds = []
+    found = []
     for _ in range(120):
-        found = m.advance(1)
-        kinds += [TYPE_NAMES[k] for k in found["type"]]
+        found.append(m.advance(1))
         now = energy(m, bodies, world)
         assert now <= before + 1e-9 * abs(before)
         before = now
-    # the ball meets the resting box, which is pressed into the floor: it wakes and bounces
-    assert kinds[:3] == ["pair", "wake", "wall"]
-    assert "rest" in kinds
+    found = np.concatenate(found)
+    kinds = [TYPE_NAMES[k] for k in found["type"]]
+    box = found["a"] == 1
+    if held:
+        assert kinds[0] == "pair" and found["code"][0] == AXIS_Y
+        assert not box.any() and m.positions()[1].tolist() == [90.0, 380.0]
+    else:
+        assert kinds[:3] == ["pair", "wake", "wall"] and "rest" in kinds
 
 
 def test_a_cradle_resting_on_a_frictionless_floor_is_the_zero_g_cradle():

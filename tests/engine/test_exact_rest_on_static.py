@@ -2,8 +2,8 @@
 closed forms: bounces on a platform at their times, then lying exactly on it; a slide with
 friction stopping where the formulas say; sliding off the edge (`leave`) and landing as a
 projectile from there; a circle that flies clear of the corner or would slide round it; across
-the seam of two platforms; and the supports it does not follow (curved, moving), stopped by
-name."""
+the seam of two platforms; stacks, each box resting on one resting still; and the supports it
+does not follow (curved, knocked into motion), stopped by name."""
 
 from __future__ import annotations
 
@@ -157,7 +157,67 @@ def test_a_box_on_a_static_circle_s_crown_stops_the_run_by_name():
         m.advance(1)
 
 
-def test_a_box_on_a_body_resting_on_the_floor_stops_the_run_by_name():
-    bodies = Bodies.boxes([[50, 970], [40, 980]], [[10, 10], [40, 20]], [[0, 0], [0, 0]])
-    with pytest.raises(NotYetExact, match="objects 0 and 1 .* tick 1"):
-        make("exact", WORLD, bodies).advance(10)
+# --- stacks: bodies resting still are supports too ------------------------------------------
+
+
+def column(n: int, gap: float, e: float = 0.0, top_down: bool = False) -> Bodies:
+    """n boxes 10 px a side in a column over the floor of WORLD, `gap` px between each and the one
+    below (the lowest `gap` over the floor), restitution e; ids from the bottom up (or top down)."""
+    ys = [1000 - (k + 1) * (10 + gap) for k in range(n)]
+    if top_down:
+        ys = ys[::-1]
+    bodies = Bodies.boxes([[50, y] for y in ys], 10, [[0, 0]] * n)
+    return with_(bodies, restitution=np.full(n, e))
+
+
+def test_a_column_of_ten_boxes_lands_into_a_stack_at_the_closed_form_times_and_stays():
+    # at e = 0 each box rests where it lands; box k (from the bottom) falls (k + 1)·gap in all,
+    # the ones below having stopped under it: it lands at √(2(k + 1)·gap/g)
+    gap = 5.0
+    m = make("exact", WORLD, column(10, gap))
+    found = m.advance(60)
+    rests = found[found["type"] == TYPE_NAMES.index("rest")]
+    assert len(rests) == 10 and rests["a"].tolist() == list(range(10))
+    assert rests["b"].tolist() == [-1, *range(9)]  # the floor, then each on the one below
+    for k, t in enumerate(rests["t"]):
+        assert abs(t - math.sqrt(2 * (k + 1) * gap / G)) <= 1e-9
+    still = m.positions().copy()
+    assert still[:, 1].tolist() == [1000 - 10 * (k + 1) for k in range(10)]
+    assert len(m.advance(120)) == 0 and (m.positions() == still).all()
+    assert (m.velocities() == 0).all()
+
+
+@pytest.mark.parametrize("top_down", [False, True])
+def test_a_stack_placed_still_rests_from_the_start_in_any_id_order(top_down):
+    m = make("exact", WORLD, column(5, 0.0, top_down=top_down))
+    found = m.advance(60)
+    assert names(found) == ["rest"] * 4 and (found["t"] == 0.0).all()
+    assert (m.velocities() == 0).all() and sorted(m.positions()[:, 1].tolist()) == [
+        950.0, 960.0, 970.0, 980.0, 990.0]  # fmt: skip
+
+
+def test_a_box_dropped_on_a_stack_bounces_off_it_as_off_the_floor_then_rests_on_it():
+    # the stack is held by the floor: a box of e = 0.5 dropped h onto it bounces at the floor's
+    # closed-form times, the stack unmoved, and comes to rest on its top
+    h, e = 200.0, 0.5
+    stack = column(3, 0.0)
+    drop = Bodies.boxes([[50, 970 - 10 - h]], 10, [[0, 0]])
+    bodies = Bodies.boxes(np.vstack([stack.pos, drop.pos]), 10, [[0, 0]] * 4)
+    m = make("exact", WORLD, with_(bodies, restitution=np.array([1.0, 1.0, 1.0, e])))
+    t1 = math.sqrt(2 * h / G)
+    found = m.advance(int(t1 * (1 + e) / (1 - e) * 60) + 2)
+    impacts = found[found["type"] == EV_PAIR]
+    for n, t in enumerate(impacts["t"], start=1):
+        assert abs(t - t1 * (1 + 2 * e * (1 - e ** (n - 1)) / (1 - e))) <= 1e-9
+    assert (found["type"][-1], found["a"][-1], found["b"][-1]) == (
+        TYPE_NAMES.index("rest"), 3, 2)
+    assert m.positions()[:, 1].tolist() == [990.0, 980.0, 970.0, 960.0]
+    assert (m.velocities() == 0).all()
+
+
+def test_knocking_a_box_that_another_rests_on_stops_the_run_by_name():
+    stack = column(2, 0.0)
+    bodies = Bodies.boxes(np.vstack([stack.pos, [[150, 990]]]), 10, [[0, 0], [0, 0], [-100, 0]])
+    m = make("exact", WORLD, bodies)
+    with pytest.raises(NotYetExact, match=r"object 0, which object 1 rests on, is knocked"):
+        m.advance(120)

@@ -35,6 +35,7 @@ from collide2d.engine.models.exact.state import (
     JOB_EVENT,
     MU,
     PARTNER,
+    S_STACKED,
     SH,
     SHAPE,
     STATIC,
@@ -230,12 +231,15 @@ def on_pair(a, b, code, nx, ny, t, S, jobs):
     vax, vay = velocity_at(a, t, F, P, world)
     vbx, vby = velocity_at(b, t, F, P, world)
     e, mu = 1.0, 0.0
+    wa, wb = F[a, INV_MASS], F[b, INV_MASS]
     if not world.elastic:
         e = min(P[a, E], P[b, E])
         mu = max(P[a, MU], P[b, MU])
-    vax, vay, vbx, vby, changed = impact(
-        vax, vay, vbx, vby, F[a, INV_MASS], F[b, INV_MASS], code, nx, ny, e, mu
-    )
+        if falls(world):  # a body resting still, pressed into its support, is held by it
+            wa, wb = _held(a, b, nx, ny, wa, wb, S)
+    vax, vay, vbx, vby, changed = impact(vax, vay, vbx, vby, wa, wb, code, nx, ny, e, mu)
+    if changed and S.st[S_STACKED] > 0 and _knocks_carrier(a, b, vax, vay, vbx, vby, t, S, jobs):
+        return -2  # a body another rests on is knocked into motion: its support would move
     # one falls, the other stands: their relative path is curved, and may meet again
     ax = ay = 0.0
     if falls(world):
@@ -265,6 +269,48 @@ def on_pair(a, b, code, nx, ny, t, S, jobs):
     return n_jobs
 
 
+@cold
+def still_on_support(i, S):
+    """Whether object i rests, still (no speed, no acceleration), on a wall or a static box or a
+    body resting still in turn: a support for what falls on it."""
+    F, P, R = S.F, S.P, S.R
+    return (
+        R[i] >= 0
+        and F[i, VX] == 0.0
+        and F[i, VY] == 0.0
+        and P[i, AX] == 0.0
+        and P[i, AY] == 0.0
+    )
+
+
+@cold
+def _held(a, b, nx, ny, wa, wb, S):
+    """The inverse masses of pair (a, b), of unit normal n from a to b, for their impact: one
+    resting still that the impact presses straight into its support (its side, along n for b,
+    -n for a) is held by it, as if static (0), the support taking the impulse."""
+    if wb > 0.0 and still_on_support(b, S) and _face_side(nx, ny) == rest_side(S.R[b]):
+        return wa, 0.0
+    if wa > 0.0 and still_on_support(a, S) and _face_side(-nx, -ny) == rest_side(S.R[a]):
+        return 0.0, wb
+    return wa, wb
+
+
+@cold
+def _knocks_carrier(a, b, vax, vay, vbx, vby, t, S, jobs):
+    """Whether the impact of a and b, leaving them at (vax, vay) and (vbx, vby), sets moving a
+    body that another rests on (a stack): that one and the carried one in jobs' row 0."""
+    F, N, P, R, world = S.F, S.N, S.P, S.R, S.world
+    for i, vx, vy in ((a, vax, vay), (b, vbx, vby)):
+        ux, uy = velocity_at(i, t, F, P, world)
+        if N[i, STATIC] != 0 or (ux == vx and uy == vy):
+            continue
+        for k in range(R.shape[0]):
+            if rest_support(R[k]) == i:
+                set_job(jobs, 0, i, k, JOB_EVENT)
+                return True
+    return False
+
+
 @hot
 def _face_side(dx, dy):
     """The side pressed into along the unit direction (dx, dy) when it is an axis (-1 if not)."""
@@ -282,19 +328,22 @@ def _face_side(dx, dy):
 @cold
 def rest_on(a, b, nx, ny, t, S, jobs):
     """Pair (a, b), of unit normal n from a to b, where on_pair found that one falls onto the
-    other to rest (-1): the falling one comes to rest on the other when that is a static box and
-    they touch on its face across gravity's pull, the falling one over that face (leave_span; a
-    box or a circle): its impact there with the pair's restitution and friction, then no speed
-    into the face, set exactly on it, sliding along it as on a wall. Returns the jobs (1); -1
-    where it cannot rest (a moving, curved or polygonal support, a corner): the model stops."""
+    other to rest (-1): the falling one comes to rest on the other when that is a static box, or
+    a box resting still pressed the same way (a stack; still_on_support), and they touch on its
+    face across gravity's pull, the falling one over that face (leave_span; a box or a circle):
+    its impact there with the pair's restitution and friction, then no speed into the face, set
+    exactly on it, sliding along it as on a wall. Returns the jobs (1); -1 where it cannot rest
+    (a moving, curved or polygonal support, a corner): the model stops."""
     F, N, P, R, world = S.F, S.N, S.P, S.R, S.world
-    if N[b, STATIC] != 0 and N[a, STATIC] == 0:
+    if R[a] < 0 and N[a, STATIC] == 0 and (N[b, STATIC] != 0 or still_on_support(b, S)):
         i, j, side = a, b, _face_side(nx, ny)
-    elif N[a, STATIC] != 0 and N[b, STATIC] == 0:
+    elif R[b] < 0 and N[b, STATIC] == 0 and (N[a, STATIC] != 0 or still_on_support(a, S)):
         i, j, side = b, a, _face_side(-nx, -ny)
     else:
         return -1
-    if side < 0 or N[j, SHAPE] != KIND_BOX or N[i, SHAPE] == KIND_POLYGON or R[i] >= 0:
+    if side < 0 or N[j, SHAPE] != KIND_BOX or N[i, SHAPE] == KIND_POLYGON:
+        return -1
+    if N[j, STATIC] == 0 and rest_side(R[j]) != side:  # a stack: pressed the way j is
         return -1
     if not pull(side, world) > 0.0:
         return -1
@@ -317,6 +366,8 @@ def rest_on(a, b, nx, ny, t, S, jobs):
         F[i, VY] = 0.0
         F[i, Y] = F[j, Y] - F[i, SH] if side == SIDE_BOTTOM else F[j, Y] + F[j, SH]
     R[i] = side + 4 * (j + 1)
+    if N[j, STATIC] == 0:
+        S.st[S_STACKED] += 1
     slide(i, F, P, R, world)
     N[i, CNT] += 1
     N[i, PARTNER] = -1

@@ -5,7 +5,8 @@ instant it stopped: `jammed` finds the moving objects held from both sides by a 
 from wall or static object to wall or static object (they cannot move on that axis, so the model
 would collide them again and again with no time passing), and the error names them (NoRoom), else
 it is a runaway (EventCapExceeded). `rest_error` names a pair where one would rest on the other,
-or slide round it, which the model does not follow (NotYetExact). `listing` names objects for the
+or slide round it, and `carried_error` a body knocked into motion while another rests on it,
+which the model does not follow (NotYetExact). `listing` names objects for the
 messages. Objects with no room already when a scene is built are found by engine/noroom.py.
 """
 
@@ -86,13 +87,24 @@ def jam_error(rows, times, t: float, F, N, world, said: str) -> EventCapExceeded
     return EventCapExceeded(said)
 
 
+def carried_error(a: int, b: int, tick: int, t: float) -> NotYetExact:
+    """The error of a run stopped in `tick` at time t where object a, which object b rests on,
+    is knocked into motion: b's support would move under it."""
+    return NotYetExact(
+        f"object {a}, which object {b} rests on, is knocked into motion in tick {tick} at t = "
+        f"{t!r} s: the exact model rests bodies on supports that stay still (the walls, static "
+        "boxes, and bodies resting still on them); use model: stepped",
+        (a, b),
+    )
+
+
 def rest_error(a: int, b: int, tick: int, t: float) -> NotYetExact:
     """The error of a run stopped in `tick` at time t where, of objects a and b pressed together
     by gravity with no speed between them, one would rest on the other or slide round it."""
     return NotYetExact(
         f"objects {a} and {b} meet with no speed between them while gravity presses them "
         f"together, in tick {tick} at t = {t!r} s: one would rest on the other or slide round "
-        "it, which the exact model does only on the walls and the flat faces of static boxes; "
-        "use model: stepped",
+        "it, which the exact model does only on the walls, the flat faces of static boxes and "
+        "the tops of boxes resting still; use model: stepped",
         (a, b),
     )

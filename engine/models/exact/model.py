@@ -127,7 +127,7 @@ from collide2d.engine.models.exact.horizonqueue import (
     new_horizons,
     next_top,
 )
-from collide2d.engine.models.exact.jam import jam_error, rest_error
+from collide2d.engine.models.exact.jam import carried_error, jam_error, rest_error
 from collide2d.engine.models.exact.prediction import predict, set_job
 from collide2d.engine.models.exact.state import (
     AX,
@@ -157,6 +157,7 @@ from collide2d.engine.models.exact.state import (
     SHAPE,
     STATIC,
     STATUS_CAP,
+    STATUS_CARRIED,
     STATUS_DONE,
     STATUS_HEAP_FULL,
     STATUS_LOG_FULL,
@@ -328,6 +329,8 @@ def _run(state, jobs, stack, tick_to, log, cap, everyone, rows, times):
                 else:
                     n_jobs = on_pair(a, b, code, e.nx, e.ny, t, S, jobs)
                     kind = EV_PAIR
+                    if n_jobs == -2:  # it knocks a body that carries another: stopped, named
+                        return STATUS_CARRIED
                     if n_jobs < 0:  # a body would rest on the other: on a static box's face
                         n_jobs = rest_on(a, b, e.nx, e.ny, t, S, jobs)
                         if n_jobs < 0:  # on anything else it cannot: stopped, the pair named
@@ -475,7 +478,7 @@ class Model:
         self._horizons = new_horizons(
             static, bucket_width(self._F, static, self.cell_size, world.width, world.height)
         )
-        self._st = np.zeros(8, np.int64)
+        self._st = np.zeros(9, np.int64)
         self._stf = np.zeros(1)
         self._jobs = np.zeros((JOB_ROWS, 3), np.int64)  # scratch: the prediction jobs of one event
         self._stack = np.zeros(INSTANT_STACK, np.int64)  # scratch: walking one instant's entries
@@ -520,6 +523,11 @@ class Model:
                 raise self._broken
             elif status == STATUS_REST:
                 self._broken = self._resting()
+                raise self._broken
+            elif status == STATUS_CARRIED:
+                a, b = int(self._jobs[0, J_OBJ]), int(self._jobs[0, J_SKIP])
+                self._broken = carried_error(a, b, int(self._st[S_TICK]) + 1,
+                                             float(self._stf[SF_T_NOW]))  # fmt: skip
                 raise self._broken
             else:
                 break

@@ -333,7 +333,7 @@ def predict(jobs, k, t_now, S):
     higher = mode == JOB_FIRST
     P, R = S.P, S.R
     t_wall, side = _wall_time(i, t_now, F, P, world)
-    support = -1  # the static box i rests on: touching it, it is no contact
+    support = -1  # the box i rests on: touching it, it is no contact
     if falls(world) and R[i] >= 0:  # resting: its stop or its leaving, if first, changes it next
         t_stop = _stop_time(i, t_now, F, P, R)
         if t_stop < t_wall:
@@ -375,7 +375,7 @@ def predict(jobs, k, t_now, S):
             c = cy * gnx + cx
             j = cells[c, C_HEAD]
             while j >= 0:
-                if j != i and j != skip and not (higher and j < i):
+                if j != i and j != skip and j != support and not (higher and j < i):
                     _predict_pair(i, j, t_now, limit, S)
                 j = N[j, NEXT]
             if not statics:  # (spares reading the static objects' lists of a scene without any)

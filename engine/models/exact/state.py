@@ -137,8 +137,9 @@ DIR_LEFT, DIR_RIGHT, DIR_UP, DIR_DOWN = range(4)
 
 # Scalar state st (int64): heap size, ticks done, events in the current tick, query stamp, event
 # rows written in this `advance`, objects given their first prediction, wall events and pair
-# events so far (logged or not). stf (float64): the current time, s.
-S_HEAP_N, S_TICK, S_TICK_EVENTS, S_STAMP, S_LOGGED, S_FIRST, S_WALLS, S_PAIRS = range(8)
+# events so far (logged or not), rests begun on a body that is not static (stacks). stf (float64):
+# the current time, s.
+S_HEAP_N, S_TICK, S_TICK_EVENTS, S_STAMP, S_LOGGED, S_FIRST, S_WALLS, S_PAIRS, S_STACKED = range(9)
 SF_T_NOW = 0
 
 
@@ -147,6 +148,7 @@ STATUS_CAP = 1
 STATUS_HEAP_FULL = 2
 STATUS_LOG_FULL = 3
 STATUS_REST = 4  # a falling body would rest on another (the pair in jobs' first row)
+STATUS_CARRIED = 5  # a body that carries another is knocked (it and the carried one, jobs' row 0)
 
 INF = np.inf
 # Small helpers are inlined into the kernels (`hot`). The kernels (`kernel`) allocate nothing and
