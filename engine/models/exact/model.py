@@ -521,13 +521,8 @@ class Model:
             elif status == STATUS_CAP:
                 self._broken = self._runaway()
                 raise self._broken
-            elif status == STATUS_REST:
-                self._broken = self._resting()
-                raise self._broken
-            elif status == STATUS_CARRIED:
-                a, b = int(self._jobs[0, J_OBJ]), int(self._jobs[0, J_SKIP])
-                self._broken = carried_error(a, b, int(self._st[S_TICK]) + 1,
-                                             float(self._stf[SF_T_NOW]))  # fmt: skip
+            elif status == STATUS_REST or status == STATUS_CARRIED:
+                self._broken = self._resting(status)
                 raise self._broken
             else:
                 break
@@ -576,11 +571,13 @@ class Model:
         return jam_error(rows[:n], times[:n], float(self._stf[SF_T_NOW]), self._F, self._N,
                          self._world, said)  # fmt: skip
 
-    def _resting(self) -> NotYetExact:
+    def _resting(self, status: int) -> NotYetExact:
         """The error of a run stopped where a falling body would come to rest on another, or a
-        circle slide round a static box's corner (the pair is in the first row of the jobs)."""
+        circle slide round a static box's corner (STATUS_REST), or a body another rests on is
+        knocked into motion (STATUS_CARRIED): the pair is in the first row of the jobs."""
         a, b = int(self._jobs[0, J_OBJ]), int(self._jobs[0, J_SKIP])
-        return rest_error(a, b, int(self._st[S_TICK]) + 1, float(self._stf[SF_T_NOW]))
+        said = rest_error if status == STATUS_REST else carried_error
+        return said(a, b, int(self._st[S_TICK]) + 1, float(self._stf[SF_T_NOW]))
 
     def positions(self) -> np.ndarray:
         """(n, 2) float64 top-left corners at the last tick's end, px (each object carried from
