@@ -73,6 +73,16 @@ def move_to(i, t, F, P, world):
 
 
 @hot
+def again(i, skip, N, jobs):
+    """Object i changed at an event of its own: its queued entries go stale (its counter) and it
+    is predicted again, leaving out `skip` (-1: none). Returns the number of jobs (1)."""
+    N[i, CNT] += 1
+    N[i, PARTNER] = skip
+    set_job(jobs, 0, i, skip, JOB_EVENT)
+    return 1
+
+
+@hot
 def on_cross(i, d, N, cells, world, jobs):
     """i's centre enters the next cell: refile it. Returns the number of jobs (1)."""
     gnx = world.gnx
@@ -174,10 +184,7 @@ def on_wall(i, side, t, S, jobs):
         F[i, Y] = 0.0 if side == SIDE_TOP else world.height - F[i, SH]
     if falls(world):
         _settle(i, side, F, P, R, world)
-    N[i, CNT] += 1
-    N[i, PARTNER] = -1
-    set_job(jobs, 0, i, -1, JOB_EVENT)
-    return 1
+    return again(i, -1, N, jobs)
 
 
 @cold
@@ -192,10 +199,7 @@ def on_stop(i, t, S, jobs):
     else:
         F[i, VX] = 0.0
     slide(i, F, P, R, world)
-    N[i, CNT] += 1
-    N[i, PARTNER] = -1
-    set_job(jobs, 0, i, -1, JOB_EVENT)
-    return 1
+    return again(i, -1, N, jobs)
 
 
 @cold
@@ -369,10 +373,7 @@ def rest_on(a, b, nx, ny, t, S, jobs):
     if N[j, STATIC] == 0:
         S.st[S_STACKED] += 1
     slide(i, F, P, R, world)
-    N[i, CNT] += 1
-    N[i, PARTNER] = -1
-    set_job(jobs, 0, i, -1, JOB_EVENT)
-    return 1
+    return again(i, -1, N, jobs)
 
 
 @cold
@@ -400,10 +401,7 @@ def on_leave(i, t, S, jobs):
     F[i, X + axis] = lo if v < 0.0 else hi
     R[i] = -1
     P[i, AX], P[i, AY] = world.gx, world.gy
-    N[i, CNT] += 1
-    N[i, PARTNER] = skip
-    set_job(jobs, 0, i, skip, JOB_EVENT)
-    return 1
+    return again(i, skip, N, jobs)
 
 
 def start_resting(F, N, P, R, world) -> None:
