@@ -215,9 +215,11 @@ def test_a_box_dropped_on_a_stack_bounces_off_it_as_off_the_floor_then_rests_on_
     assert (m.velocities() == 0).all()
 
 
-def test_knocking_a_box_that_another_rests_on_stops_the_run_by_name():
-    stack = column(2, 0.0)
-    bodies = Bodies.boxes(np.vstack([stack.pos, [[150, 990]]]), 10, [[0, 0], [0, 0], [-100, 0]])
-    m = make("exact", WORLD, bodies)
+@pytest.mark.parametrize("crowd", [0, 30])
+def test_knocking_a_box_that_another_rests_on_stops_the_run_by_name(crowd):
+    # (with a crowd resting further along the floor the model files its objects in a grid)
+    pos = [[50, 990], [50, 980], [150, 990]] + [[600 + 40 * k, 990] for k in range(crowd)]
+    vel = [[0, 0], [0, 0], [-100, 0]] + [[0, 0]] * crowd
+    m = make("exact", WorldSpec(2000, 1000, 60, gravity=(0.0, G)), Bodies.boxes(pos, 10, vel))
     with pytest.raises(NotYetExact, match=r"object 0, which object 1 rests on, is knocked"):
         m.advance(120)

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from collide2d.engine.events import SIDE_BOTTOM, SIDE_LEFT, SIDE_RIGHT, SIDE_TOP
-from collide2d.engine.models.exact.cells import cell_insert, cell_remove
+from collide2d.engine.models.exact.cells import C_HEAD, cell_insert, cell_remove
 from collide2d.engine.models.exact.prediction import leave_span, set_job, state_at, velocity_at
 from collide2d.engine.models.exact.state import (
     AX,
@@ -34,6 +34,7 @@ from collide2d.engine.models.exact.state import (
     JOB_CROSS,
     JOB_EVENT,
     MU,
+    NEXT,
     PARTNER,
     S_STACKED,
     SH,
@@ -302,16 +303,24 @@ def _held(a, b, nx, ny, wa, wb, S):
 @cold
 def _knocks_carrier(a, b, vax, vay, vbx, vby, t, S, jobs):
     """Whether the impact of a and b, leaving them at (vax, vay) and (vbx, vby), sets moving a
-    body that another rests on (a stack): that one and the carried one in jobs' row 0."""
-    F, N, P, R, world = S.F, S.N, S.P, S.R, S.world
+    body that another rests on (a stack): that one and the carried one in jobs' row 0. What
+    rests on a body touches it, so it is filed in the 3×3 cells around it (as for predict)."""
+    F, N, P, R, world, cells = S.F, S.N, S.P, S.R, S.world, S.cells
+    gnx, gny = world.gnx, world.gny
     for i, vx, vy in ((a, vax, vay), (b, vbx, vby)):
         ux, uy = velocity_at(i, t, F, P, world)
         if N[i, STATIC] != 0 or (ux == vx and uy == vy):
             continue
-        for k in range(R.shape[0]):
-            if rest_support(R[k]) == i:
-                set_job(jobs, 0, i, k, JOB_EVENT)
-                return True
+        gx = N[i, CELL] % gnx
+        gy = N[i, CELL] // gnx
+        for cy in range(max(gy - 1, 0), min(gy + 1, gny - 1) + 1):
+            for cx in range(max(gx - 1, 0), min(gx + 1, gnx - 1) + 1):
+                k = cells[cy * gnx + cx, C_HEAD]
+                while k >= 0:
+                    if rest_support(R[k]) == i:
+                        set_job(jobs, 0, i, k, JOB_EVENT)
+                        return True
+                    k = N[k, NEXT]
     return False
 
 

@@ -331,7 +331,7 @@ def _run(state, jobs, stack, tick_to, log, cap, everyone, rows, times):
                     kind = EV_PAIR
                     if n_jobs == -2:  # it knocks a body that carries another: stopped, named
                         return STATUS_CARRIED
-                    if n_jobs < 0:  # a body would rest on the other: on a static box's face
+                    if n_jobs < 0:  # a body would rest on the other: on a box that stays
                         n_jobs = rest_on(a, b, e.nx, e.ny, t, S, jobs)
                         if n_jobs < 0:  # on anything else it cannot: stopped, the pair named
                             set_job(jobs, 0, a, b, JOB_EVENT)
