@@ -25,9 +25,9 @@ from collide2d.engine.jit import njit
 
 EV_WALL = 0
 EV_PAIR = 1
-# the exact model under gravity: an object comes to rest on a wall or a static box's face, stops
-# sliding on it, is knocked off it, or slides past the static box's edge (`code` is the side it
-# presses into, `b` the static box, -1 for a wall)
+# the exact model under gravity: an object comes to rest on a wall or a box's face (a static box,
+# or one resting still in a stack), stops sliding on it, is knocked off it, or slides past the
+# box's edge (`code` is the side it presses into, `b` the box, -1 for a wall)
 EV_REST = 2
 EV_STOP = 3
 EV_WAKE = 4

@@ -1,5 +1,6 @@
 """Debug overlays drawn into PNG and GIF frames: velocity arrows, boxes, contact flashes, labels,
-and for the `paper` model the overlap a pair had before the model took its step back.
+for the `paper` model the overlap a pair had before the model took its step back, and for the
+`exact` model under gravity what rests on what.
 
 Asked for by `output: {overlay: [...]}` in a scenario (then its goldens show them too: the scenario
 asked) or by `collide2d run --overlay a,b` (that run's files only; goldens never see them). The
@@ -8,7 +9,8 @@ names (`OVERLAYS`):
 - `velocity`: a line from each moving object's centre along half a second of its motion, with a
   two-stroke head;
 - `boxes`: each object's pixel extent, outlined;
-- `contacts`: a ring around each object of a wall or pair event at the frame's tick;
+- `contacts`: a ring around each object of an event at the frame's tick (wall and pair events,
+  and under gravity rest, stop, wake and leave);
 - `labels`: each object's name above it (Pillow's default font, without smoothing), on one line
   (control characters spelled out, `runner.output.escape.one_line`) and at most LABEL_MAX_PX wide: a
   longer name is cut and ends in an ellipsis;
@@ -18,7 +20,14 @@ names (`OVERLAYS`):
   overlap filled in red: a rectangle `xdiff` wide and `ydiff` tall, the picture of the paper's
   Figure 2 (the frame itself shows the boxes after the take-back). The rule sees later pairs of a
   tick after earlier ones took steps back; the rectangle is drawn from the positions before any
-  pair of the tick, exact for the first pair of each object.
+  pair of the tick, exact for the first pair of each object;
+- `rests` (`exact` under gravity; other models log no rests and draw nothing for it): for each
+  object resting at the frame's tick (`runner.output.rests`: from its `rest` event until its
+  `wake` or `leave`, and from tick 0 on a wall it starts still against), a line from its centre
+  to its edge on the side it presses into (straight below the centre for `bottom`), a mark
+  across the contact on the support's face (2 * MARK_PX + 1 px; for a wall, on the frame's edge)
+  and, when the support is an object, a line on to that object's centre, so a stack shows as a
+  chain down to what bears it.
 
 Overlays are drawn over the frame's palette indices in colours added after the scenario's palette
 (`Overlay.palette`), so the frames stay exact palette images and the GIF needs no quantising.
@@ -31,11 +40,12 @@ from __future__ import annotations
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
-from collide2d.engine.events import EV_PAIR
+from collide2d.engine.events import EV_PAIR, SIDE_BOTTOM, SIDE_LEFT, SIDE_RIGHT, SIDE_TOP
 from collide2d.engine.picture.pixels import dda_line, midpoint_circle
 from collide2d.engine.picture.raster import round_positions
 from collide2d.engine.picture.sprites import sprites
 from collide2d.runner.output import escape
+from collide2d.runner.output.rests import WALL, Rests
 from collide2d.runner.scenario.load import ScenarioError
 from collide2d.runner.scenario.sections import OVERLAY_NAMES
 
@@ -47,6 +57,7 @@ COLORS = {
     "contacts": (255, 96, 0),
     "labels": (255, 255, 255),
     "overlap": (255, 0, 0),
+    "rests": (0, 230, 0),
     "ghost": (200, 200, 200),
 }
 # An arrow shows this many seconds of motion; its head's strokes are HEAD_PX long.
@@ -57,6 +68,8 @@ RING_GAP_PX = 3
 # The widest a label is drawn (px; and never wider than the frame): a longer name is cut and ends
 # in an ellipsis (about 15 characters of the default font).
 LABEL_MAX_PX = 96
+# A rest's mark across the contact reaches this far (px) each side of it.
+MARK_PX = 3
 MAX_PALETTE = 256
 
 
@@ -147,21 +160,29 @@ class Overlay:
         self.staged: Staged | None = None
         self._pending: list = []
         self._labels: list[str] | None = None
+        self.rests = Rests() if "rests" in self.names else None
 
     @property
     def wants_events(self) -> bool:
-        return self.record or "contacts" in self.names
+        return self.record or "contacts" in self.names or self.rests is not None
 
     def wrap(self, model):
         """The model to run: a `Staged` paper model when overlaps are noted, else `model`."""
+        if self.rests is not None:
+            self.rests.start(model)
         if self.record:
             self.staged = Staged(model)
             return self.staged
         return model
 
     def events(self, events: np.ndarray) -> None:
-        """Take an event chunk (the chunks end at frame ticks)."""
+        """Take an event chunk (the chunks end at frame ticks; every tick's events come, those
+        of ticks no frame draws too)."""
+        if not self.wants_events:
+            return  # a run that logs events for its file: nothing here reads them
         self._pending.append(events)
+        if self.rests is not None:
+            self.rests.events(events)
 
     def at(self, tick: int) -> np.ndarray:
         """The events of `tick` among those taken (older ones are dropped)."""
@@ -181,6 +202,7 @@ class Overlay:
     def draw(self, k: int, idx: np.ndarray, model) -> np.ndarray:
         """A copy of the index frame `idx` of tick k with the overlays drawn over it."""
         events = self.at(k) if self.wants_events else np.zeros(0)
+        resting = self.rests.at(k) if self.rests is not None else {}
         if not self.names:
             return idx
         notes = self.pair_overlaps(k, events) if "overlap" in self.names else []
@@ -205,6 +227,8 @@ class Overlay:
                              self.index["ghost"], under=True)  # fmt: skip
                 if rect is not None:
                     pen.fill(rect[0], rect[1], rect[2] - 1, rect[3] - 1, self.index["overlap"])
+        for x0, y0, x1, y1 in rest_lines(resting, ipos, ext, out.shape[1], out.shape[0]):
+            pen.line(x0, y0, x1, y1, self.index["rests"])
         if "velocity" in self.names:
             for i in range(ipos.shape[0]):
                 if not (vel[i] != 0).any() or ext[i, 2] < ext[i, 0]:
@@ -232,6 +256,34 @@ class Overlay:
                 self._labels = labels(_names(self.scenario), min(LABEL_MAX_PX, idx.shape[1]))
             pen.labels(ipos, ext, self._labels, self.index["labels"])
         return out
+
+
+def rest_lines(resting: dict, ipos, ext, width: int, height: int) -> list:
+    """[(x0, y0, x1, y1)] pixel lines of the `rests` overlay, objects in id order: for each
+    resting object i, from its centre to its edge pixel on its side, the mark across the contact
+    on the support's face (the pixel past that edge, kept inside the frame: a wall's is the
+    frame's edge pixel) and, on an object, from there to that object's centre."""
+    lines = []
+    for i in sorted(resting):
+        side, support = resting[i]
+        if ext[i, 2] < ext[i, 0]:
+            continue  # draws nothing
+        cx, cy = _centre(ipos[i], ext[i])
+        x0, y0 = ipos[i, 0] + ext[i, 0], ipos[i, 1] + ext[i, 1]
+        x1, y1 = ipos[i, 0] + ext[i, 2], ipos[i, 1] + ext[i, 3]
+        ex, ey, dx, dy = {
+            SIDE_BOTTOM: (cx, y1, 0, 1),
+            SIDE_TOP: (cx, y0, 0, -1),
+            SIDE_LEFT: (x0, cy, -1, 0),
+            SIDE_RIGHT: (x1, cy, 1, 0),
+        }[side]
+        fx = int(min(max(ex + dx, 0), width - 1))
+        fy = int(min(max(ey + dy, 0), height - 1))
+        lines.append((cx, cy, int(ex), int(ey)))
+        lines.append((fx - MARK_PX * dy, fy - MARK_PX * dx, fx + MARK_PX * dy, fy + MARK_PX * dx))
+        if support != WALL and ext[support, 2] >= ext[support, 0]:
+            lines.append((fx, fy, *_centre(ipos[support], ext[support])))
+    return lines
 
 
 def _names(scenario) -> list[str]:

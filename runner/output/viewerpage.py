@@ -17,7 +17,8 @@ default; where a golden pixel differs from the run's, the mean of the two). Hove
 names it and shows its position (the rounded pixel position the frame draws it
 at) and velocity (px/s) at the frame shown, following the frame as it plays. Overlays: velocity
 arrows (half a second of motion), boxes (each object's pixel extent), contact flashes (a ring at
-each object of a pair or wall event, fading over `FLASH_FRAMES` frames) and labels.
+each object of a pair or wall event, fading over `FLASH_FRAMES` frames) and labels (not the frames'
+`rests`: a run drawing it opens with the others it draws checked).
 """
 
 from __future__ import annotations
@@ -136,7 +137,8 @@ _JS = r"""
       {checked: false, addEventListener: function () {}};
     ov[k].addEventListener("change", function () { draw(); });
   });
-  D.overlay.forEach(function (name) { ov[named[name]].checked = true; });
+  // the frames' overlays it draws too (`rests` it does not)
+  D.overlay.forEach(function (name) { if (named[name]) ov[named[name]].checked = true; });
   function rgba(c) { return ((255 << 24) | (c[2] << 16) | (c[1] << 8) | c[0]) >>> 0; }
   var bg = rgba(D.background);
   var col = D.colors.map(rgba);

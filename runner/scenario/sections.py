@@ -22,7 +22,7 @@ FRAME_WORDS = ("all", "none", "last")
 EVERY_KEYS = ("every",)
 OUTPUT_KEYS = ("frames", "gif", "events", "viewer", "overlay")
 # Debug overlays a scenario may ask to draw into its frames (runner.output.overlay draws them).
-OVERLAY_NAMES = ("velocity", "boxes", "contacts", "labels", "overlap")
+OVERLAY_NAMES = ("velocity", "boxes", "contacts", "labels", "overlap", "rests")
 GOLDEN_KEYS = ("frames", "time_tolerance", "max_diff_pixels", "color_threshold")
 
 

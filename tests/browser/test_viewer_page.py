@@ -190,3 +190,16 @@ def test_a_name_that_opens_a_comment_or_a_script_leaves_the_viewer_working(clean
         clean_page.evaluate("JSON.parse(document.getElementById('data').textContent).names")
         == names
     )
+
+
+def test_a_run_drawing_rests_opens_with_its_other_overlays_checked(clean_page, tmp_path):
+    """The viewer draws no `rests` (docs/outputs.md#viewer): a run whose frames draw it opens
+    with the overlays it does draw checked, without a script error."""
+    out = tmp_path / "out"
+    path = ROOT / "scenarios" / "exact_ledges.yaml"
+    argv = ["run", str(path), "--out", str(out), "--viewer", "--no-gif", "--quiet"]
+    assert cli.main([*argv, "--ticks", "20", "--overlay", "rests,boxes"]) == 0
+    _open(clean_page, (out / "exact_ledges" / "viewer.html").as_uri())
+    assert clean_page.locator("#ov-boxes").is_checked()
+    assert not clean_page.locator("#ov-velocity").is_checked()
+    assert clean_page.locator("#ov-rests").count() == 0

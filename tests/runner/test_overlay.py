@@ -121,6 +121,14 @@ def test_contacts_ring_the_objects_of_an_event_at_the_frame():
     assert not (seen[0] == ring).any() and (seen[1] == ring).any()
 
 
+def test_an_overlay_that_reads_no_events_keeps_none_of_a_logged_run():
+    """A run logging its events with only `velocity` drawn kept every chunk until the end."""
+    scn = _scn("wall_bounces", ticks=40)
+    layer = Overlay(scn, ("velocity",))
+    drive(scn, frames=(0, 40), on_frame=lambda k, idx: None, log_events=True, overlay=layer)
+    assert not layer.wants_events and layer._pending == []
+
+
 def test_overlay_names_are_checked(tmp_path, capsys):
     with pytest.raises(ScenarioError, match="did you mean 'overlap'"):
         loads("version: 1\noutput: {overlay: [overlapp]}\n")

@@ -487,23 +487,8 @@ class Model:
         """The arrays the kernels share."""
         cells, s_start, s_items = self._G
         HT, HI, HN = self._heap
-        return State(
-            self._F,
-            self._N,
-            self._P,
-            self._R,
-            self._C,
-            cells,
-            s_start,
-            s_items,
-            HT,
-            HI,
-            HN,
-            self._horizons,
-            self._st,
-            self._stf,
-            self._world,
-        )
+        return State(self._F, self._N, self._P, self._R, self._C, cells, s_start, s_items,
+                     HT, HI, HN, self._horizons, self._st, self._stf, self._world)  # fmt: skip
 
     def advance(self, ticks: int, log: bool = True) -> np.ndarray:
         """Run `ticks` ticks; the events in the order they happened (empty when log is False)."""
@@ -578,6 +563,11 @@ class Model:
         a, b = int(self._jobs[0, J_OBJ]), int(self._jobs[0, J_SKIP])
         said = rest_error if status == STATUS_REST else carried_error
         return said(a, b, int(self._st[S_TICK]) + 1, float(self._stf[SF_T_NOW]))
+
+    def rests(self) -> dict[int, tuple[int, int]]:
+        """{object: (side, support)} of the objects resting now: the side each presses into
+        (SIDE_*) and the object it rests on, -1 for a wall (docs/models.md#exact-under-gravity)."""
+        return {int(i): (int(r) & 3, (int(r) >> 2) - 1) for i, r in enumerate(self._R) if r >= 0}
 
     def positions(self) -> np.ndarray:
         """(n, 2) float64 top-left corners at the last tick's end, px (each object carried from

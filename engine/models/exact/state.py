@@ -112,8 +112,8 @@ CNT, STATIC, SHAPE, CELL, NEXT, PREV, STAMP, PARTNER = range(8)
 # scene without gravity up to 12 % of its steps/s): acceleration (px/s²: the world's gravity for
 # a moving object, 0 for a static one, and along its wall only for a resting one), restitution
 # and friction. R (n,) int64: what each object rests on: -1 nothing; a wall, its side (0-3); the
-# face of a static box j, side + 4·(j + 1), the side being the one it presses into as it would a
-# wall's (rest_side, rest_support).
+# face of a box j (static, or resting still), side + 4·(j + 1), the side being the one it presses
+# into as it would a wall's (rest_side, rest_support).
 AX, AY, E, MU = range(4)
 # A horizon's `what` (besides wall sides 0-3 and directions 0-3): a resting object stops sliding,
 # or slides past the edge of the static box it rests on.
@@ -179,7 +179,7 @@ def rest_side(r):
 
 @hot
 def rest_support(r):
-    """The static box a resting object rests on, of its R entry r (-1: a wall, or no rest)."""
+    """The box a resting object rests on, of its R entry r (-1: a wall, or no rest)."""
     return (r >> 2) - 1 if r >= 0 else -1
 
 
