@@ -567,7 +567,8 @@ class Model:
     def rests(self) -> dict[int, tuple[int, int]]:
         """{object: (side, support)} of the objects resting now: the side each presses into
         (SIDE_*) and the object it rests on, -1 for a wall (docs/models.md#exact-under-gravity)."""
-        return {int(i): (int(r) & 3, (int(r) >> 2) - 1) for i, r in enumerate(self._R) if r >= 0}
+        side, support = rest_side.py_func, rest_support.py_func  # (plain Python: nothing compiles)
+        return {int(i): (side(int(r)), support(int(r))) for i, r in enumerate(self._R) if r >= 0}
 
     def positions(self) -> np.ndarray:
         """(n, 2) float64 top-left corners at the last tick's end, px (each object carried from
