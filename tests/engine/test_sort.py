@@ -9,7 +9,14 @@ import pytest
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
-from collide2d.engine.sort import heap_argsort, median, sort_by_time, sort_keys, sort_order
+from collide2d.engine.sort import (
+    heap_argsort,
+    median,
+    sort_by_time,
+    sort_keys,
+    sort_order,
+    sort_pair_keys,
+)
 
 keys = st.lists(st.integers(-50, 50), max_size=200).map(lambda v: np.array(v, np.int64))
 
@@ -37,6 +44,27 @@ def test_sort_keys_sorts_the_first_n_in_place(key):
     got = key.copy()
     sort_keys(got, n)
     assert np.array_equal(got[:n], np.sort(key[:n])) and np.array_equal(got[n:], key[n:])
+
+
+# Pair keys as the candidate lists make them: the first object's id in the high bits.
+SHIFT = 32
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.integers(1, 40),
+    st.lists(st.tuples(st.integers(0, 39), st.integers(0, 2**31)), max_size=400, unique=True),
+    st.integers(0, 2**32 - 1),
+)
+def test_sort_pair_keys_sorts_the_first_k_by_bucket_then_key(n, pairs, seed):
+    rng = np.random.default_rng(seed)
+    key = np.unique(np.array([(a % n) << SHIFT | b for a, b in pairs], np.int64))
+    rng.shuffle(key)
+    tail = rng.integers(0, 2**62, 3)  # past k: left alone
+    got = np.concatenate([key, tail])
+    heads = np.full(2 * n + 1, 7, np.int64)  # scratch, whatever it held
+    sort_pair_keys(got, len(key), SHIFT, heads)
+    assert np.array_equal(got[: len(key)], np.sort(key)) and np.array_equal(got[len(key) :], tail)
 
 
 @settings(max_examples=60, deadline=None)

@@ -36,6 +36,8 @@ INF = np.inf
 # Below this speed (px/s) a bounce under gravity keeps nothing, whatever the rest speed: the
 # bounces of e < 1 would otherwise come without end within one step (Zeno).
 ZENO_SPEED = 1e-6
+# An object farther than this (px) beyond twice its reach in a step from every wall meets none.
+WALL_CLEAR_PX = 1e-6
 # An object may meet walls at most this many times in one step (a runaway past it).
 MAX_HITS_PER_STEP = 2 * MAX_FOLDS_PER_STEP
 
@@ -58,6 +60,14 @@ def _advance(p, v, a, t, span, resting):
     return p, v + a * t
 
 
+@njit(cache=True, inline="always")
+def _clear(p, v, a, span, dt):
+    """Whether an axis's walls, at 0 and span (> 0), lie beyond twice the farthest it can move in
+    dt: then the step meets neither (and the move is one `_advance`, as the loop below makes it)."""
+    reach = 2.0 * (abs(v) * dt + 0.5 * abs(a) * dt * dt) + WALL_CLEAR_PX
+    return span > 0.0 and p > reach and span - p > reach
+
+
 @njit(cache=True)
 def fall_one(body, i, e, mu, P, dt, sides, hits):
     """Move object i for dt s (module docstring); its bounces go to hits (side, code of each)
@@ -73,6 +83,11 @@ def fall_one(body, i, e, mu, P, dt, sides, hits):
         x, rest_x = 0.0, 2
     if not sy > 0.0:
         y, rest_y = 0.0, 2
+    if _clear(x, vx, gx, sx, dt) and _clear(y, vy, gy, sy, dt):  # no wall within reach
+        x, vx = _advance(x, vx, gx, dt, sx, 0)
+        y, vy = _advance(y, vy, gy, dt, sy, 0)
+        body[i, B_X], body[i, B_Y], body[i, B_VX], body[i, B_VY] = x, y, vx, vy
+        return 0
     under = gx != 0.0 or gy != 0.0
     left = dt
     counted = 0

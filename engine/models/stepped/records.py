@@ -151,4 +151,5 @@ class Touch(NamedTuple):
     exact: bool  # whether objects collide by their real shapes
     hits: np.ndarray  # int64 scratch: one object's bounces in a step (fall.fall_one)
     capped: np.ndarray  # (n,) bool scratch (touch.cap_goals)
+    heads: np.ndarray  # (2n + 1,) int64 scratch: the candidate list's sort (sort.sort_pair_keys)
     bank: np.ndarray  # (1,) float64 energy given up so far and not yet spent on pushes (solver)

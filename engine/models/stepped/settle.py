@@ -214,6 +214,7 @@ class Settle:
             exact=geometry == "exact",
             hits=np.zeros(MAX_HITS_PER_STEP + 1, np.int64),
             capped=np.zeros(n, bool),
+            heads=np.zeros(2 * n + 1, np.int64),
             bank=np.zeros(1),
         )
         self.tick = 0

@@ -26,14 +26,14 @@ contact then parts at exactly -e times its approach. Among many, one pass can ov
 is scaled back the same way.
 
 Positions (`correct`): overlap deeper than `slop` is removed in `iterations` passes (forward and
-backward in turn), each pair pushed apart along its normal by its depth past slop, shared by
-inverse mass, never out of the world (a side that a wall stops hands the rest to the other).
-Velocities are not touched. A push shared by inverse mass along gravity keeps the potential
-energy; one against a wall or a static or sleeping object raises it (the object had sunk into its
-support, the fall's energy given up by the contact's velocity). The pushes are scaled back, when
-needed, so that what they raise stays within the energy the velocity passes have given up so far
-and pushes have not spent (settle.py keeps that account): the energy never rises above what the
-scene began with, and a push never gives an object speed.
+backward in turn; done sooner once a pass finds nothing past slop), each pair pushed apart along its
+normal by its depth past slop, shared by inverse mass, never out of the world (a side that a wall
+stops hands the rest to the other). Velocities are not touched. A push shared by inverse mass along
+gravity keeps the potential energy; one against a wall or a static or sleeping object raises it (the
+object had sunk into its support, the fall's energy given up by the contact's velocity). The pushes
+are scaled back, when needed, so that what they raise stays within the energy the velocity passes
+have given up so far and pushes have not spent (settle.py keeps that account): the energy never
+rises above what the scene began with, and a push never gives an object speed.
 """
 
 from __future__ import annotations
@@ -215,12 +215,12 @@ def _shift(body, i, dx, dy, sides):
 @njit(cache=True, inline="always")
 def _push(body, mass, gx, gy, slop, a, b, floats, c, sides):
     """Push contact c's pair apart along its normal by its depth past slop (module docstring);
-    returns the potential energy that raised."""
+    returns (whether it pushed, the potential energy that raised)."""
     nx, ny, wa, wb = floats[c, C_NX], floats[c, C_NY], floats[c, C_WA], floats[c, C_WB]
     apart = (body[b, B_X] - body[a, B_X]) * nx + (body[b, B_Y] - body[a, B_Y]) * ny
     push = floats[c, C_GAP] - apart - slop
     if not push > 0.0:
-        return 0.0
+        return False, 0.0
     raised = 0.0
     made = 0.0
     if wa > 0.0:
@@ -236,7 +236,7 @@ def _push(body, mass, gx, gy, slop, a, b, floats, c, sides):
     if wa > 0.0 and left > 0.0:
         mx, my = _shift(body, a, -left * nx, -left * ny, sides)
         raised -= mass[a] * (gx * mx + gy * my)
-    return raised
+    return True, raised
 
 
 @njit(cache=True)
@@ -255,10 +255,15 @@ def correct(F, P, pairs, floats, m, budget, sides):
     raised = 0.0
     mass, gx, gy, slop = F.mass, P.gx, P.gy, P.slop
     for it in range(P.iterations):
+        pushed = False
         for k in range(first, m):
             c = m - 1 - (k - first) if it % 2 else k
             a, b = _sides(pairs[c])
-            raised += _push(body, mass, gx, gy, slop, a, b, floats, c, sides)
+            moved, up = _push(body, mass, gx, gy, slop, a, b, floats, c, sides)
+            raised += up
+            pushed |= moved
+        if not pushed:  # every overlap within slop: the passes left would push nothing either
+            break
     if raised > max(budget, 0.0):  # (so raised > 0: a budget below 0 with nothing raised is no 0/0)
         s = max(budget, 0.0) / raised
         for i in range(body.shape[0]):

@@ -39,7 +39,7 @@ from collide2d.engine.contact import box_sweep, penetration
 from collide2d.engine.events import AXIS_NORMAL, AXIS_X, AXIS_XY, AXIS_Y, EV_PAIR, log_event
 from collide2d.engine.jit import njit
 from collide2d.engine.models.stepped.move import B_H, B_VX, B_VY, B_W, B_X, B_Y
-from collide2d.engine.sort import sort_keys
+from collide2d.engine.sort import sort_pair_keys
 
 # The columns of a contact's row of floats: the normal, the depth plus the offset along it (px),
 # the two sides' inverse masses (0 for a static, sleeping or wall side), the contact's e and mu,
@@ -86,7 +86,7 @@ def relist(F, P, T, keys):
     while k > keys.shape[0]:
         keys = np.empty(2 * k, np.int64)
         k = find_split(T.finder, lo, hi, F.awake, T.cell, T.order, keys, T.ws, found)
-    sort_keys(keys, k)
+    sort_pair_keys(keys, k, KEY_SHIFT, T.heads)
     T.counts[N_KEYS] = k
     T.counts[N_RELIST] = 0
     return keys
