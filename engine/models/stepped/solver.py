@@ -213,14 +213,9 @@ def _shift(body, i, dx, dy, sides):
 
 
 @njit(cache=True, inline="always")
-def _push(body, mass, gx, gy, slop, a, b, floats, c, sides):
-    """Push contact c's pair apart along its normal by its depth past slop (module docstring);
-    returns (whether it pushed, the potential energy that raised)."""
-    nx, ny, wa, wb = floats[c, C_NX], floats[c, C_NY], floats[c, C_WA], floats[c, C_WB]
-    apart = (body[b, B_X] - body[a, B_X]) * nx + (body[b, B_Y] - body[a, B_Y]) * ny
-    push = floats[c, C_GAP] - apart - slop
-    if not push > 0.0:
-        return False, 0.0
+def _push(body, mass, gx, gy, a, b, nx, ny, wa, wb, push, sides):
+    """Push a contact's pair, a and b, apart along its normal n by `push` px (module docstring);
+    returns the potential energy that raised."""
     raised = 0.0
     made = 0.0
     if wa > 0.0:
@@ -236,7 +231,7 @@ def _push(body, mass, gx, gy, slop, a, b, floats, c, sides):
     if wa > 0.0 and left > 0.0:
         mx, my = _shift(body, a, -left * nx, -left * ny, sides)
         raised -= mass[a] * (gx * mx + gy * my)
-    return True, raised
+    return raised
 
 
 @njit(cache=True)
@@ -259,9 +254,13 @@ def correct(F, P, pairs, floats, m, budget, sides):
         for k in range(first, m):
             c = m - 1 - (k - first) if it % 2 else k
             a, b = _sides(pairs[c])
-            moved, up = _push(body, mass, gx, gy, slop, a, b, floats, c, sides)
-            raised += up
-            pushed |= moved
+            nx, ny, wa, wb = floats[c, C_NX], floats[c, C_NY], floats[c, C_WA], floats[c, C_WB]
+            apart = (body[b, B_X] - body[a, B_X]) * nx + (body[b, B_Y] - body[a, B_Y]) * ny
+            push = floats[c, C_GAP] - apart - slop  # the depth past slop
+            if not push > 0.0:
+                continue
+            pushed = True
+            raised += _push(body, mass, gx, gy, a, b, nx, ny, wa, wb, push, sides)
         if not pushed:  # every overlap within slop: the passes left would push nothing either
             break
     if raised > max(budget, 0.0):  # (so raised > 0: a budget below 0 with nothing raised is no 0/0)
