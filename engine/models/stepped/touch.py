@@ -264,6 +264,16 @@ def _held(body, a, b, nx, ny):
     return max(depth, TOUCHING)
 
 
+@njit(cache=True, inline="always")
+def _wake(F, T, s, o, rest2):
+    """Wake s if it sleeps and o, awake, moves at the rest speed or faster (module docstring)."""
+    if F.asleep[s] and F.awake[o] and _speed2(F.body, o) >= rest2 and rest2 > 0.0:
+        F.asleep[s] = False
+        F.awake[s] = True
+        F.quiet[s] = 0.0
+        T.counts[N_RELIST] = 1
+
+
 @njit(cache=True)
 def pair_contacts(F, P, T, keys, pairs, floats, m, at, log, held):
     """The listed pairs in contact after the step `at` (a Step), from row m on: wakes a sleeping
@@ -303,12 +313,9 @@ def pair_contacts(F, P, T, keys, pairs, floats, m, at, log, held):
                 depth, code, nx, ny = _normal(body, F.saved, a, b, at.dt, lean)
         if not depth > 0.0:
             continue
-        for s, o in ((a, b), (b, a)):  # a sleeping side woken by a moving one
-            if asleep[s] and awake[o] and _speed2(body, o) >= rest2 and rest2 > 0.0:
-                asleep[s] = False
-                awake[s] = True
-                F.quiet[s] = 0.0
-                T.counts[N_RELIST] = 1
+        if asleep[a] or asleep[b]:  # a sleeping side woken by a moving one
+            _wake(F, T, a, b, rest2)
+            _wake(F, T, b, a, rest2)
         wa = F.inv_mass[a] if awake[a] else 0.0
         wb = F.inv_mass[b] if awake[b] else 0.0
         if wa + wb == 0.0:
