@@ -102,6 +102,12 @@ def sort_keys(keys, n):
             keys[0], keys[end] = keys[end], keys[0]
             _sift_keys(keys, top, end)
         return
+    _insertion_sort(keys, n)
+
+
+@njit(cache=True)
+def _insertion_sort(keys, n):
+    """Sort keys[:n] in place by insertion: quick for a handful, or for keys each near its place."""
     for i in range(1, n):
         key = keys[i]
         j = i - 1
@@ -156,13 +162,7 @@ def sort_pair_keys(keys, k, shift, heads):
                 j = fill[h]
                 fill[h] += 1
                 keys[i], keys[j] = keys[j], keys[i]
-    for i in range(1, k):
-        key = keys[i]
-        j = i - 1
-        while j >= 0 and keys[j] > key:
-            keys[j + 1] = keys[j]
-            j -= 1
-        keys[j + 1] = key
+    _insertion_sort(keys, k)  # each key is in its bucket: it moves only within it
 
 
 @njit(cache=True, inline="always")
