@@ -146,7 +146,7 @@ def max_box_overlap(p: np.ndarray, bodies: Bodies) -> float:
 
 
 @pytest.mark.slow
-def test_a_pile_25_rows_tall_at_a_half_box_fall_a_step_sleeps_without_overlap():
+def test_a_pile_25_rows_tall_falling_under_half_a_box_a_step_sleeps_without_overlap():
     # docs/models.md: tall piles need a step's fall under half a box (at 2 substeps this pile
     # lands at 5 px a step, and after 8 s boxes still overlap by 2.8 px and 88 objects are awake)
     world = WorldSpec(400, 420, 60, gravity=(0.0, G))
