@@ -1,6 +1,6 @@
 """The exact model's events per second under gravity against the same scene without it.
 
-The scenes and timings of `collide2d bench --part gravity` (runner/bench/exact.py, `gravity`),
+The scenes and timings of `collide2d bench --part gravity` (runner/bench/gravity/exact.py),
 with the size, ticks and rounds chosen here: a gas of N boxes (default 10,000) run for the same
 ticks without gravity and with 400 px/s², in turns, each after a tick that loads the kernels; then
 1,000 balls of restitution 0.9 dropped onto the floor. Prints the median events per second of
@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import argparse
 
-from collide2d.runner.bench import exact
+from collide2d.runner.bench.gravity import exact
 
 
 def main() -> None:

@@ -37,10 +37,14 @@ The parts, each selectable with `--part`:
 - jit (only with `--part jit`): `collide2d run` under `--jit on`, `off` and `auto`, each in a fresh
   process from an empty kernel cache, on the bundled scenarios, the bench's scenes and scenes of
   10 to 5,000 bodies over 10 to 100,000 ticks: wall times and `auto` over the faster lane.
+- gravity (only with `--part gravity`): a settling pile under the stepped model against pymunk, the
+  closed forms of a bounce and a slide for the stepped and exact models and pymunk, and the exact
+  model's events/s under gravity (the package `gravity`).
 
 One module per concept: `scenes` (the standard scene and where the benchmark scenarios are),
 `timing` (how a run is timed), one module per part (`scaling`, `peers`, `error`, `skips`,
-`targets` (and jit), `paper`, `exact`, `raster`), `report` (bench.csv and bench.md),
+`targets` (and jit), `paper`, `exact`, `raster`, `stages`, `load`) and the package `gravity`,
+`goals` (the figures held to), `report` (bench.csv and bench.md),
 `plots` (the PNG plots) and `cli` (the subcommand; it loads the parts only when `collide2d bench`
 runs).
 

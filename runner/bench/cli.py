@@ -22,7 +22,7 @@ from collide2d.engine import models
 from collide2d.runner.command.exitcodes import EXIT_BAD_INPUT, EXIT_DIFFERENCE, EXIT_OK
 
 PARTS = ("scaling", "error", "peers", "skips", "targets", "paper", "exact", "raster")
-PARTS += ("stages", "load", "jit", "gravity")  # bench/stages.py, load.py, targets.py, peers.py
+PARTS += ("stages", "load", "jit", "gravity")  # bench/stages.py, load.py, targets.py, gravity/
 DEFAULT_PARTS = ("scaling", "error", "skips", "targets")
 FILE_PARTS = ("error", "skips", "targets", "paper", "raster", "jit")  # read scenarios/*.yaml
 REPORT_DIR = "bench"
@@ -89,6 +89,7 @@ def _run_parts(args, parts, ns, models_, quick, in_process, folder, echo) -> tup
     from collide2d.runner.bench import (
         error,
         exact,
+        gravity,
         paper,
         peers,
         raster,
@@ -156,8 +157,7 @@ def _run_parts(args, parts, ns, models_, quick, in_process, folder, echo) -> tup
         rows += targets.cold_start(quick, echo, folder)
     if "gravity" in parts:
         echo.part("gravity")
-        rows += peers.gravity(quick, echo)
-        rows += exact.gravity(quick, echo)
+        rows += gravity.part(quick, echo)
     return rows, time.perf_counter() - began
 
 

@@ -1,4 +1,4 @@
-"""The gravity part of `collide2d bench` (runner/bench/peers.py): the pile it times, and the
+"""The gravity part of `collide2d bench` (runner/bench/gravity): the pile it times, and the
 stepped model held to the closed forms it reports."""
 
 from __future__ import annotations
@@ -8,19 +8,19 @@ import pytest
 from PIL import Image
 
 from collide2d.engine import events as ev
-from collide2d.runner.bench import peers
+from collide2d.runner.bench.gravity import closed, pile
 
 
 def test_the_pile_is_n_boxes_inside_a_world_with_gravity_e_and_mu():
-    world, bodies = peers.pile(1000)
+    world, bodies = pile.pile(1000)
     assert bodies.n == 1000 and world.has_gravity
     corner = bodies.pos + bodies.size
     assert (bodies.pos >= 0).all() and (corner <= [world.width, world.height]).all()
-    assert (bodies.restitution == peers.E).all() and (bodies.friction == peers.MU).all()
+    assert (bodies.restitution == pile.E).all() and (bodies.friction == pile.MU).all()
 
 
 def test_the_closed_forms_hold_for_the_stepped_model_at_every_rate():
-    found = peers.closed_forms(lambda *a: None, rates=(60, 240))
+    found = closed.closed_forms(lambda *a: None, rates=(60, 240))
     rows = {(r["scene"], r["model"], r["fps"]): r for r in found if r.get("substeps", 1) == 1}
     for fps in (60, 240):
         # exact between contacts: the bounce instants
@@ -30,7 +30,7 @@ def test_the_closed_forms_hold_for_the_stepped_model_at_every_rate():
     # the ladder of substeps at 30 fps: bounces still to round-off, the slide's error down by a
     # thousand to the floor it has at 240 fps (30 x 8), where it stays
     ladder = [r for r in found if r.get("substeps", 1) > 1]
-    assert sorted({r["substeps"] for r in ladder}) == list(peers.LADDER_SUBSTEPS)
+    assert sorted({r["substeps"] for r in ladder}) == list(closed.LADDER_SUBSTEPS)
     assert all(r["value"] < 1e-9 for r in ladder if r["scene"] == "bounce")
     slides = {r["substeps"]: r["value"] for r in ladder if r["scene"] == "slide"}
     assert slides[64] < slides[2] / 1000
@@ -45,14 +45,14 @@ def test_the_chart_of_the_closed_forms_is_written(tmp_path):
     pytest.importorskip("matplotlib")
     from collide2d.runner.bench import plots
 
-    rows = peers.closed_forms(lambda *a: None, rates=(30, 60))
+    rows = closed.closed_forms(lambda *a: None, rates=(30, 60))
     assert "gravity_runtime_vs_error.png" in plots.plots(rows, tmp_path)
     with Image.open(tmp_path / "gravity_runtime_vs_error.png") as chart:
         assert chart.width > chart.height > 300
 
 
 def test_the_exact_model_meets_the_closed_forms_to_round_off_at_every_rate():
-    found = peers.closed_forms(lambda *a: None, rates=(30, 240))
+    found = closed.closed_forms(lambda *a: None, rates=(30, 240))
     rows = {(r["scene"], r["model"], r["fps"]): r for r in found if r.get("substeps", 1) == 1}
     for fps in (30, 240):
         # every bounce at its closed-form instant, the slide's stop where v0²/(2 mu g) puts it
@@ -63,7 +63,7 @@ def test_the_exact_model_meets_the_closed_forms_to_round_off_at_every_rate():
 
 
 def test_the_exact_model_s_events_per_second_under_gravity_are_reported(monkeypatch):
-    from collide2d.runner.bench import exact
+    from collide2d.runner.bench.gravity import exact
 
     monkeypatch.setitem(exact.GAS, True, (300, 60))
     monkeypatch.setitem(exact.BALLS, True, (200, 120))
@@ -80,7 +80,7 @@ def test_the_exact_model_s_events_per_second_under_gravity_are_reported(monkeypa
 def test_the_falling_balls_bounce_on_the_floor_and_each_other_and_stay_inside():
     from collide2d.engine.models import make
     from collide2d.engine.world import WorldSpec
-    from collide2d.runner.bench import exact
+    from collide2d.runner.bench.gravity import exact
 
     bodies = exact.balls(200)
     world = WorldSpec(exact.SIDE, exact.SIDE, 60, gravity=(0.0, exact.BALLS_G))
