@@ -317,14 +317,20 @@ def _shown(v) -> str:
 def _names(data, refuse) -> tuple:
     """Each row's name under the one rule for object names (runner.scenario.rules.object_names), a
     cell past TEXT_CHARS as written refused first (a CSV's is read one character longer, never cut
-    short unseen); a number in a .npy name column is its text."""
+    short unseen); a number in a .npy name column is its text, its bytes UTF-8 text (else refused,
+    never replaced unseen)."""
     n = data.shape[0]
     if "name" not in data.dtype.names:
         return (None,) * n
     column = data["name"]
     texts = column.tolist()
     if column.dtype.kind == "S":
-        texts = [v.decode("utf-8", "replace") for v in texts]
+        try:
+            texts = [v.decode("utf-8") for v in texts]
+        except UnicodeDecodeError:
+            bad = np.fromiter((not _utf8(v) for v in texts), bool, n)
+            refuse(bad, "name", lambda r: "the cell is not UTF-8 text")
+            return (None,) * n
     elif column.dtype.kind != "U":
         texts = [str(v) for v in texts]
     most = TEXT_CHARS["name"]
@@ -338,6 +344,14 @@ def _names(data, refuse) -> tuple:
         said = str(exc)
         refuse(np.arange(n) == exc.index, "name", lambda r: said)
         return (None,) * n
+
+
+def _utf8(raw: bytes) -> bool:
+    try:
+        raw.decode("utf-8")
+    except UnicodeDecodeError:
+        return False
+    return True
 
 
 def _flag(data, column: str, refuse) -> np.ndarray:

@@ -5,17 +5,22 @@ structured array whose field names are the columns, with a `Place` that turns (r
 cell's place for a message. Nothing is parsed before the header has been checked and the row count
 held against `--max-objects`.
 
-CSV: UTF-8 text (an initial byte-order mark dropped); lines end in LF, CRLF or CR alone (all read as
-LF first, so the row count and every line number mean what an editor shows). The header names the
-columns; the rows are read by `numpy.loadtxt` in one pass, numbers as float64 and each text column
-as text of its TEXT_CHARS width and one character more, so a longer cell is seen, never cut short in
+CSV: UTF-8 text (an initial byte-order mark dropped; a byte that is not UTF-8, or a NUL, which
+numpy's text would drop, refused at its line and column); lines end in LF, CRLF or CR alone (all
+read as LF first, so the row count and every line number mean what an editor shows). The header
+names the columns (read by Python's csv module, its field size limit raised to the line's length,
+so a long name is an unknown column like any other). A line of spaces or tabs alone is a blank
+line (docs/scenario-format.md) unless it lies inside a quoted field, and blank lines are skipped.
+The rows are read by `numpy.loadtxt` in one pass, numbers as float64 and each text column as text
+of its TEXT_CHARS width and one character more, so a longer cell is seen, never cut short in
 silence (`runner.scenario.table` refuses it). A header with no rows is a table of no objects. When
-numpy refuses a row, the cell is found again with Python's csv module (its field size limit raised
-to the text's length for that reading, so a long cell is read like any other): a row of the wrong
-length, or a number numpy does not read (`NUMBER_RE`: decimal, exponent, `inf`, `nan`; not `1_000`,
-not `0x10`, not full-width digits). A quote that opens a field and is never closed would take the
-rest of the file into that field, rows and all: it is refused where it opens (looked for only when
-fewer rows were read than the text has lines, or when numpy refused the text).
+numpy refuses a row, the cell is found again with the csv module (its field size limit raised to
+the text's length for that reading, so a long cell is read like any other): a row of the wrong
+length, or a number numpy does not read (`NUMBER_RE`: decimal, exponent, `inf`, `nan`; not
+`1_000`, not `0x10`, not full-width digits). A quote that opens a field and is never closed would
+take the rest of the file into that field, rows and all, and numpy reads that without a word: it
+is refused where it opens (the last quoted field, `QUOTED_RE`, looked at whenever the text holds a
+quote).
 
 `.npy`: the header is read from the bytes first; a one-dimensional structured array of numbers
 and text (no objects, so no pickles), whose rows at their item size must fill the rest of the file
@@ -25,6 +30,9 @@ header claims).
 
 from __future__ import annotations
 
+import bisect
+import codecs
+import collections
 import csv
 import difflib
 import io
@@ -58,6 +66,13 @@ NUMBER_RE = re.compile(
     r"[+-]?(?:(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|inf|infinity|nan)",
     re.IGNORECASE | re.ASCII,
 )
+# A quoted field as the csv module reads one: a quote where a field starts (at a line's start or
+# after a comma: the look-behind follows the quote, so that a search jumps from quote to quote),
+# then anything but a lone quote, then the closing quote, which group 1 lacks when the field runs
+# to the end of the text. Scanned left to right, a match takes in the commas, line ends and quotes
+# of its field, so the next match starts at a field of its own.
+QUOTED_RE = re.compile(r'"(?<![^,\n]")[^"]*(?:""[^"]*)*("?)')
+_SPACES_RE = re.compile(r"^[^\S\n]+$", re.MULTILINE)  # a line of spaces or tabs alone
 _CSV_LIMIT = threading.Lock()  # the csv module's field size limit is one for the whole process
 
 
@@ -82,19 +97,18 @@ class Place:
         return ScenarioError(self.shown, line, char, message)
 
 
-def header_error(shown: str, header: list[str]) -> None:
-    """Unknown, repeated and missing columns, at the header line."""
+def header_error(shown: str, header: list[str], column_of) -> None:
+    """Unknown, repeated and missing columns, at the header line; `column_of(i)` is the column
+    of field i (from 0) in messages."""
     seen = set()
-    at = 1
-    for name in header:
+    for i, name in enumerate(header):
         if name not in COLUMNS:
             near = difflib.get_close_matches(name, COLUMNS, n=1)
             hint = f"did you mean '{near[0]}'?" if near else "expected " + ", ".join(COLUMNS)
-            raise ScenarioError(shown, 1, at, f"unknown column {name!r}; {hint}")
+            raise ScenarioError(shown, 1, column_of(i), f"unknown column {_cut(name)!r}; {hint}")
         if name in seen:
-            raise ScenarioError(shown, 1, at, f"column {name!r} appears twice")
+            raise ScenarioError(shown, 1, column_of(i), f"column {_cut(name)!r} appears twice")
         seen.add(name)
-        at += len(name) + 1
     missing = [c for c in REQUIRED if c not in seen]
     if missing:
         raise ScenarioError(
@@ -123,20 +137,22 @@ def _too_many(shown: str, rows: int, limits: Limits) -> None:
 
 def read_csv(raw: bytes, shown: str, limits: Limits):
     """(structured array, Place) of the CSV table `raw`."""
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        line = raw.count(b"\n", 0, exc.start) + 1
-        raise ScenarioError(shown, line, 1, "the table is not UTF-8 text") from None
-    if "\r" in text:
-        text = text.replace("\r\n", "\n").replace("\r", "\n")
+    text = _decoded(raw, shown)
     rows = text.count("\n") + (0 if text.endswith("\n") else 1) - 1
     _too_many(shown, rows, limits)
     first, _, body = text.partition("\n")
     if not first.strip():
-        raise ScenarioError(shown, 1, 1, "the table is empty; its first line names the columns")
-    header = [h.strip() for h in next(csv.reader([first]), [])]
-    header_error(shown, header)
+        said = "the table is empty; its first line names the columns"
+        if body.strip():
+            said = "the table's first line is blank; it must name the columns"
+        raise ScenarioError(shown, 1, 1, said)
+    if '"' in text:
+        _refuse_unclosed(first, shown)  # the header is one line
+        _refuse_unclosed(text, shown)
+    header = [h.strip() for h in _fields(first)]
+    header_error(shown, header, lambda i: _field_start(first, i))
+    if _SPACES_RE.search(body):  # lines of spaces are blank lines, skipped as numpy skips ""
+        text = _blank_spaces(text)
     place = Place(shown, header, text)
     dtype = [(c, "f8") if c in NUMBERS else (c, f"U{TEXT_CHARS[c] + 1}") for c in header]
     if not body.strip():  # a header alone: no objects (numpy would warn of no data)
@@ -153,21 +169,70 @@ def read_csv(raw: bytes, shown: str, limits: Limits):
         )
     except ValueError:
         raise _first_bad_cell(text, header, place) from None
-    if data.shape[0] < rows:  # blank lines, or a record over several lines: is a quote left open?
-        open_at = _records(text)[1]
-        if open_at is not None:
-            raise _unclosed(text, shown, open_at)
     return data, place
 
 
-def _records(text: str) -> tuple[list[tuple[int, int, list[str]]], int | None]:
+def _decoded(raw: bytes, shown: str) -> str:
+    """The table's text, its line ends made LF; a byte that is not UTF-8 refused at its line and
+    column (the characters before it on its line, counted)."""
+    raw = raw.removeprefix(codecs.BOM_UTF8)
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        at = exc.start
+        line = raw.count(b"\n", 0, at) + raw.count(b"\r", 0, at) - raw.count(b"\r\n", 0, at) + 1
+        start = max(raw.rfind(b"\n", 0, at), raw.rfind(b"\r", 0, at)) + 1
+        before = raw[start:at].decode("utf-8", "replace")
+        raise ScenarioError(shown, line, len(before) + 1, "the table is not UTF-8 text") from None
+    if "\r" in text:
+        text = text.replace("\r\n", "\n").replace("\r", "\n")
+    if "\x00" in text:  # numpy's text drops a trailing NUL: a cell would change unseen
+        at = text.index("\x00")
+        line, col = text.count("\n", 0, at) + 1, at - text.rfind("\n", 0, at)
+        raise ScenarioError(shown, line, col, "the table holds a NUL character; it must be text")
+    return text
+
+
+def _fields(line: str) -> list[str]:
+    """The fields of one CSV line, a field of any length read (the csv module's limit raised)."""
+    with _CSV_LIMIT:
+        old = csv.field_size_limit()
+        csv.field_size_limit(max(old, len(line) + 1))
+        try:
+            return next(csv.reader([line]), [])
+        finally:
+            csv.field_size_limit(old)
+
+
+def _refuse_unclosed(text: str, shown: str) -> None:
+    """A ScenarioError where a quoted field of `text` opens and is never closed: the last quoted
+    field (QUOTED_RE), when it runs to the end."""
+    last = collections.deque(QUOTED_RE.finditer(text), maxlen=1)
+    if last and not last[0][1]:
+        at = last[0].start()
+        line = text.count("\n", 0, at) + 1
+        col = at - text.rfind("\n", 0, at)
+        message = 'a quoted field opens here and is never closed (a " is missing)'
+        raise ScenarioError(shown, line, col, message)
+
+
+def _blank_spaces(text: str) -> str:
+    """`text` with each line of spaces made empty, but for a line inside a quoted field."""
+    inside = [m.span() for m in QUOTED_RE.finditer(text) if "\n" in m[0]] if '"' in text else []
+    starts = [a for a, _ in inside]
+
+    def blank(m: re.Match) -> str:
+        k = bisect.bisect_right(starts, m.start()) - 1
+        return m[0] if k >= 0 and m.start() < inside[k][1] else ""
+
+    return _SPACES_RE.sub(blank, text)
+
+
+def _records(text: str) -> list[tuple[int, int, list[str]]]:
     """(data row from 0, its first line from 1, fields) of each CSV record after the header, blank
-    lines skipped as numpy.loadtxt skips them, and the line where the last record starts when a
-    quoted field of it is never closed (it runs to the end of the text, as numpy reads it too),
-    else None. A cell of any length is read: the csv module's field limit is raised to the text's
-    length while it reads."""
+    lines skipped as numpy.loadtxt skips them. A cell of any length is read: the csv module's field
+    limit is raised to the text's length while it reads."""
     out = []
-    last = None
     with _CSV_LIMIT:
         old = csv.field_size_limit()
         csv.field_size_limit(max(old, len(text) + 1))
@@ -177,56 +242,22 @@ def _records(text: str) -> tuple[list[tuple[int, int, list[str]]], int | None]:
             k = -1
             start = reader.line_num + 1
             for record in reader:
-                if record and not (all(not f.strip() for f in record) and len(record) <= 1):
+                if record:  # an empty line is none (a line of spaces was made one)
                     k += 1
                     out.append((k, start, record))
-                    last = start
                 start = reader.line_num + 1
         finally:
             csv.field_size_limit(old)
-    if last is None:
-        return out, None
-    tail = text.split("\n", last - 1)[-1]  # the last record, from its first line to the end
-    return out, (last if _open_quote(tail) else None)
-
-
-def _open_quote(raw: str) -> int:
-    """Character column (from 1) of a quote that opens a field of the CSV text `raw` and is never
-    closed, or 0."""
-    quoted, at, start = False, 0, True
-    i = 0
-    while i < len(raw):
-        ch = raw[i]
-        if quoted:
-            if ch == '"' and raw[i + 1 : i + 2] == '"':
-                i += 1  # "" is one quote
-            elif ch == '"':
-                quoted = False
-        elif ch == '"' and start:
-            quoted, at = True, i + 1
-        start = not quoted and ch in ",\n"
-        i += 1
-    return at if quoted else 0
+    return out
 
 
 def _csv_cell(text: str, row: int, col: int) -> tuple[int, int]:
     """(line, character column) of field `col` of data row `row` (blank lines skipped, as
     numpy.loadtxt skips them), both from 1."""
-    for k, line, _record in _records(text)[0]:
+    for k, line, _record in _records(text):
         if k == row:
             return line, _field_start(text.split("\n", line)[line - 1], col)
     return 1, 1
-
-
-def _unclosed(text: str, shown: str, line: int) -> ScenarioError:
-    """The error of a quoted field opened in the record starting at `line` and never closed."""
-    tail = text.split("\n", line - 1)[-1]
-    at = _open_quote(tail)
-    line += tail.count("\n", 0, at - 1)
-    col = at - (tail.rfind("\n", 0, at - 1) + 1)
-    return ScenarioError(
-        shown, line, col, 'a quoted field opens here and is never closed (a " is missing)'
-    )
 
 
 def _field_start(raw: str, col: int) -> int:
@@ -245,10 +276,7 @@ def _field_start(raw: str, col: int) -> int:
 def _first_bad_cell(text: str, header: list[str], place: Place) -> ScenarioError:
     """The error numpy met, found again cell by cell: a row of the wrong length or a number that
     is not one."""
-    records, open_at = _records(text)
-    if open_at is not None:  # the last record runs to the end inside a quote
-        records = records[:-1]
-    for k, line, record in records:
+    for k, line, record in _records(text):
         if len(record) != len(header):
             return ScenarioError(
                 place.shown,
@@ -259,8 +287,6 @@ def _first_bad_cell(text: str, header: list[str], place: Place) -> ScenarioError
         for c, name in enumerate(header):
             if name in NUMBERS and not NUMBER_RE.fullmatch(record[c].strip()):
                 return place(k, name, f"must be a number, not {_cut(record[c].strip())!r}")
-    if open_at is not None:
-        return _unclosed(text, place.shown, open_at)
     return ScenarioError(place.shown, 1, 1, "the table cannot be read as CSV")
 
 
@@ -293,7 +319,7 @@ def read_npy(raw: bytes, shown: str, limits: Limits):
         )
     _too_many(shown, shape[0], limits)
     header = list(dtype.names)
-    header_error(shown, header)
+    header_error(shown, header, lambda i: i + 1)  # the field's number
     for c in header:
         kind = dtype[c].kind
         if c in NUMBERS and kind not in "iuf":

@@ -441,3 +441,140 @@ def test_a_name_that_no_output_could_write_is_refused_at_its_cell(tmp_path, caps
         f"{tmp_path / 't.npy'}:2:7: error: row 2, column name: a name is text, not a lone "
         "surrogate U+D800\n",
     )
+
+
+def test_a_header_cell_past_the_csv_field_limit_is_refused_at_its_column(tmp_path, capsys):
+    """Python's csv module refuses a field of more than 131,072 characters; the header is read
+    with the limit raised, so a long column name is an unknown column, not an unexpected error."""
+    shown = tmp_path / "bodies.csv"
+    for cell in ("n" * 200_000, '"' + "n" * 200_000 + '"'):
+        text = f"id,shape,w,h,x,y,{cell}\n0,box,2,2,0,0,a\n"
+        status, err = run_validate(tmp_path, capsys, text.encode())
+        assert status == 2
+        assert err.startswith(f"{shown}:1:18: error: unknown column 'nnnnn")
+        assert len(err) < 300  # the name is cut in the message
+
+
+@pytest.mark.parametrize(
+    "blank",
+    ["   ", "\t", " \t \f", "\u00a0"],
+)
+def test_a_line_of_spaces_is_a_blank_line(tmp_path, capsys, blank):
+    """Blank lines are skipped (docs/scenario-format.md#objects-from-a-table), spaces or not:
+    at the end, in the middle, at the end without a newline; a bad cell after one is still
+    found at its own line."""
+    lf = load(write(tmp_path))
+    for text in (
+        "\n".join(ROWS) + f"\n{blank}\n",
+        "\n".join(ROWS) + f"\n{blank}",
+        "\n".join(ROWS[:2] + [blank] + ROWS[2:]) + "\n",
+        "\n".join(ROWS[:2] + [blank, blank] + ROWS[2:]) + f"\n{blank}\n\n{blank}\n",
+    ):
+        status, err = run_validate(tmp_path, capsys, text.encode())
+        assert (status, err) == (0, ""), repr(text)
+        same_bodies(load(tmp_path / "scene.yaml").bodies, lf.bodies)
+    bad = ROWS[:2] + [blank] + ["1,circle,6,6,50,20,zz,5,,#00ff00,,false,false"]
+    status, err = run_validate(tmp_path, capsys, ("\n".join(bad) + f"\n{blank}\n").encode())
+    assert (status, err) == (
+        2,
+        f"{tmp_path / 'bodies.csv'}:4:20: error: row 2, column vx: must be a number, not 'zz'\n",
+    )
+
+
+def test_a_line_of_spaces_inside_a_quoted_name_stays_in_the_name(tmp_path):
+    """Only a line of spaces that is a row of its own is blank; inside a quoted field it is
+    part of the cell (here a name that then holds more than 100 characters)."""
+    rows = ["id,shape,w,h,x,y,name", '0,box,2,2,0,0,"a', "   ", 'b"']
+    with pytest.raises(ScenarioError) as info:
+        load(write(tmp_path, rows=rows[:3] + [" " * 120, 'b"']))
+    assert (info.value.line, info.value.col) == (2, 15)
+    assert "more than 100 characters" in info.value.message
+    scene = load(write(tmp_path, rows=rows))
+    assert scene.bodies.n == 1
+
+
+def test_the_header_is_located_as_written(tmp_path, capsys):
+    """An unknown column is found where its field starts, spaces and quotes as written; a quote
+    the header never closes is refused where it opens; a blank first line is said to be one."""
+    shown = tmp_path / "bodies.csv"
+    header = 'id, shape ,"w",h,x,y,  colour'
+    status, err = run_validate(tmp_path, capsys, f"{header}\n0,box,2,2,0,0,red\n".encode())
+    assert status == 2
+    assert err.startswith(f"{shown}:1:{header.index('  colour') + 1}: error: unknown column")
+    status, err = run_validate(tmp_path, capsys, b'id,shape,w,h,x,y,"name\n0,box,2,2,0,0,a\n')
+    assert (status, err) == (
+        2,
+        f'{shown}:1:18: error: a quoted field opens here and is never closed (a " is missing)\n',
+    )
+    status, err = run_validate(tmp_path, capsys, b"  \n" + "\n".join(ROWS).encode())
+    assert (status, err) == (
+        2,
+        f"{shown}:1:1: error: the table's first line is blank; it must name the columns\n",
+    )
+
+
+def test_bytes_that_are_not_utf8_are_refused_at_their_line_and_column(tmp_path, capsys):
+    shown = tmp_path / "bodies.csv"
+    for raw, place in (
+        (b"id,shape,w,h,x,y,name\n0,box,2,2,0,0,\xe9t\xe9\n", "2:15"),
+        (b"id,shape,w,h,x,y,n\xc3\xa4me,\xff\n", "1:23"),  # counted in characters
+        (b"\xef\xbb\xbfid,shape,w,h,x,y\n\xff\n", "2:1"),
+    ):
+        status, err = run_validate(tmp_path, capsys, raw)
+        assert (status, err) == (2, f"{shown}:{place}: error: the table is not UTF-8 text\n")
+
+
+@pytest.mark.parametrize(
+    "content, where, fragment",
+    [
+        (b"id,sh\x00ape,w,h,x,y\n0,box,2,2,0,0\n", "1:6", "holds a NUL character"),
+        (b"id,shape,w,h,x,y\n0,box,2,2,0\x00,0\n", "2:12", "holds a NUL character"),
+        (b"id,shape,w,h,x,y,name\n0,box,2,2,0,0,a\x00\n", "2:16", "holds a NUL"),  # not cut
+        (b'id,shape,w,h,x,y\n0,box,2,2,0,0\n""\n', "3:1", "row 2 has 1 fields; the header"),
+        (b'id,shape,w,h,x,y\n"  "\n0,box,2,2,0,0\n', "2:1", "row 1 has 1 fields; the header"),
+        (b"\xef\xbb\xbfid,shape,w,h,x,y\n0,box,2,2,0,0\n", None, ""),
+        (b"\xef\xbb\xbf\xef\xbb\xbfid,shape,w,h,x,y\n", "1:1", "unknown column '\\ufeffid'"),
+        (b"id,shape,w,h,x,y\r0,box,2,2,0,0\r1,box,2,2,5,0\r", None, ""),
+        (b"id,shape,w,h,x,y\r0,box,2,2,0,0\r1,box,2,2,5,zz\r", "3:13", "must be a number"),
+        (b"id,shape,w,h,x,y\r\n0,box,2,2,0,0\r1,box,2,2,5,0\n", None, ""),
+        (b"id,shape,w,h,x,y", None, ""),
+        (b"id,shape,w,h,x,y\n\n \n", None, ""),
+        (b"id,shape,w,h,x,y\n0,box,2,2,0\n", "2:1", "row 1 has 5 fields; the header names 6"),
+        (b"id,shape,w,h,x,y\n0,box,2,2,0,0,\n", "2:1", "row 1 has 7 fields"),
+        (b"id,shape,w,h,x,y\n0,box,2,2,0,0\n# c\n", "3:1", "row 2 has 1 fields"),
+        (b'id,shape,w,h,x,y\n0,box,2,2,0,"0\n', "2:13", "never closed"),
+        (b'id,shape,w,h,x,y,name\n0,box,2,2,0,0,"a""b"\n', None, ""),
+        (b'id,shape,w,h,x,y\n0,box,"2",2, 0 ,0\n', None, ""),
+        (b"id,shape,w,h,x,y\n0,box,2,2,0," + b"1" * 400 + b"\n", "2:13", "finite number"),
+        (b"id,shape,w,h,x,y,name\n0,box,2,2,0,0," + b"x" * 3_000_000 + b"\n", "2:15", "100 ch"),
+        (b"id,shape,w,h,x,y" + b",x" * 50_000 + b"\n", "1:18", "column 'x' appears twice"),
+        (b"", "1:1", "the table is empty"),
+        (b"id,shape,w,h,x,y\n" + b"\n" * 1000 + b"0,box,2,2,0,q\n", "1002:13", "must be a num"),
+    ],
+)
+def test_a_hostile_table_is_read_or_refused_at_its_place(
+    tmp_path, capsys, content, where, fragment
+):
+    status, err = run_validate(tmp_path, capsys, content)
+    if where is None:
+        assert (status, err) == (0, "")
+        return
+    assert status == 2
+    assert err.startswith(f"{tmp_path / 'bodies.csv'}:{where}: error: ") and fragment in err, err
+
+
+def test_an_npy_name_of_bytes_that_are_not_utf8_is_refused_at_its_cell(tmp_path, capsys):
+    """Not replaced by U+FFFD unseen: a CSV's bytes that are not UTF-8 are refused too."""
+    numbers = [(c, "f8") for c in ("id", "w", "h", "x", "y")]
+    rec = np.zeros(2, dtype=numbers + [("shape", "S3"), ("name", "S4")])
+    rec["name"] = [b"ok", b"a\xffb"]
+    rec["id"], rec["x"], rec["w"], rec["h"], rec["shape"] = [0, 1], [0, 10], 2, 2, b"box"
+    np.save(tmp_path / "t.npy", rec)
+    status, err = run_validate(tmp_path, capsys, (tmp_path / "t.npy").read_bytes(), "t.npy")
+    assert (status, err) == (
+        2,
+        f"{tmp_path / 't.npy'}:2:7: error: row 2, column name: the cell is not UTF-8 text\n",
+    )
+    rec["name"] = [b"ok", "é".encode()]
+    np.save(tmp_path / "t.npy", rec)
+    assert load(tmp_path / "scene.yaml").names == ("ok", "é")
