@@ -106,6 +106,9 @@ def check_model(
             a plugin is registered under (entry point group `collide2d.models`) or a built-in's.
         scenes: scenarios as dicts (what `collide2d.load` takes) instead of the kit's `SCENES`.
         options: keyword arguments for the model besides the world and the bodies.
+
+    Raises:
+        ValueError: `model` is a name no model is registered under (the message lists them).
     """
     found = problems(model, scenes=scenes, options=options)
     if found:
@@ -123,10 +126,16 @@ def problems(
     """What `check_model` finds, as one text per problem ([] when the model conforms)."""
     from collide2d.api import load
     from collide2d.engine import models
+    from collide2d.engine.models.protocol import ModelError
 
+    if isinstance(model, str) and model not in models.names():
+        raise ValueError(f"unknown model {model!r}; expected one of {', '.join(models.names())}")
     name, build = _builder(model, dict(options or {}))
     if scenes is None:
-        takes = models.shapes_of(model) if isinstance(model, str) else _shapes(model)
+        try:
+            takes = models.shapes_of(model) if isinstance(model, str) else _shapes(name, model)
+        except ModelError as exc:  # its module or its SHAPES could not be read
+            return [str(exc)]
         scenes = [s for shape in takes for s in SCENES.get(shape, ())]
     found: list[str] = []
     for scene in scenes:
@@ -139,10 +148,11 @@ def problems(
     return found
 
 
-def _shapes(model) -> tuple[str, ...]:
+def _shapes(name: str, model) -> tuple[str, ...]:
+    from collide2d.engine.models import declared
     from collide2d.engine.world import KIND_NAMES
 
-    return tuple(s for s in getattr(model, "SHAPES", KIND_NAMES) if s in KIND_NAMES)
+    return declared(name, model, "SHAPES", KIND_NAMES, KIND_NAMES)
 
 
 def _builder(model, options: dict):
@@ -154,7 +164,9 @@ def _builder(model, options: dict):
         return model, lambda world, bodies: Checked(
             model, lambda w, b, **k: models.make(model, w, b, **k), world, bodies, options
         )
-    name = getattr(model, "__name__", repr(model))
+    from collide2d.engine.models import guard
+
+    name = guard.class_name(model) if isinstance(model, type) else guard.shown(model)
     return name, lambda world, bodies: Checked(name, model, world, bodies, options)
 
 

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import functools
 import importlib
+import itertools
 import re
 
 from collide2d.engine.world import KIND_NAMES, Bodies, WorldSpec
@@ -52,6 +53,8 @@ SCENARIO_OPTIONS = {
 # The entry point group of model plugins, and the names a plugin may take (a scenario's word).
 ENTRY_POINT_GROUP = "collide2d.models"
 PLUGIN_NAME = re.compile(r"[a-z][a-z0-9_-]{0,63}\Z")
+# The most words of a plugin's SHAPES or OPTIONS read (there are only a few it can mean).
+MAX_DECLARED = 64
 
 
 def make(name: str, world: WorldSpec, bodies: Bodies, **options):
@@ -73,7 +76,6 @@ def scenario_options(name: str, **settings) -> dict:
     model `name` takes and the scenario sets (None: not set, the model's default holds)."""
     takes = SCENARIO_OPTIONS[name] if name in SCENARIO_OPTIONS else options_of(name)
     return {k: v for k, v in settings.items() if k in takes and v is not None}
-
 
 
 @functools.lru_cache(maxsize=1)
@@ -103,16 +105,37 @@ def names_for(value) -> tuple[str, ...]:
 
 def plugin_class(name: str):
     """The class (or factory) of the registered plugin `name`, its module imported now;
-    `protocol.ModelError` when it cannot be."""
+    `protocol.ModelError` when it cannot be, whatever its import raised (`sys.exit` too; Ctrl-C's
+    KeyboardInterrupt passes through)."""
+    from collide2d.engine.models import guard
     from collide2d.engine.models.protocol import ModelError
 
     ep = plugins()[name]
     try:
         return ep.load()
-    except Exception as exc:
+    except KeyboardInterrupt:
+        raise
+    except BaseException as exc:
         raise ModelError(
-            name, f"could not be loaded from {ep.value}: {type(exc).__name__}: {exc}"
+            name, guard.did(exc, f"when its module was imported ({ep.value})")
         ) from exc
+
+
+def declared(name: str, model, attribute: str, default, allowed) -> tuple[str, ...]:
+    """Of what plugin class `model` (registered as `name`) says in `attribute` (SHAPES, OPTIONS),
+    the words in `allowed`, in its order; `default` when it says nothing. What it holds is the
+    plugin's: anything raised reading it is a `protocol.ModelError`."""
+    from collide2d.engine.models import guard
+    from collide2d.engine.models.protocol import ModelError
+
+    try:
+        said = getattr(model, attribute, default)
+        words = [w for w in itertools.islice(iter(said), MAX_DECLARED) if type(w) is str]
+    except KeyboardInterrupt:
+        raise
+    except BaseException as exc:
+        raise ModelError(name, guard.did(exc, f"when its {attribute} was read")) from exc
+    return tuple(w for w in words if w in allowed)
 
 
 def options_of(name: str) -> tuple[str, ...]:
@@ -122,11 +145,11 @@ def options_of(name: str) -> tuple[str, ...]:
         return SCENARIO_OPTIONS[name]
     from collide2d.engine.models.protocol import PLUGIN_OPTIONS
 
-    return tuple(o for o in getattr(plugin_class(name), "OPTIONS", ()) if o in PLUGIN_OPTIONS)
+    return declared(name, plugin_class(name), "OPTIONS", (), PLUGIN_OPTIONS)
 
 
 def shapes_of(name: str) -> tuple[str, ...]:
     """The object shapes model `name` takes (a plugin's `SHAPES`; all for the built-in ones)."""
     if name in MODEL_NAMES:
         return KIND_NAMES
-    return tuple(s for s in getattr(plugin_class(name), "SHAPES", KIND_NAMES) if s in KIND_NAMES)
+    return declared(name, plugin_class(name), "SHAPES", KIND_NAMES, KIND_NAMES)

@@ -24,6 +24,7 @@ synthetic ones); by default they are `runner.scenario.load.load` and `runner.run
 from __future__ import annotations
 
 import argparse
+import contextlib
 import sys
 import traceback
 from functools import partial
@@ -37,7 +38,7 @@ from collide2d.runner.command.exitcodes import (
     EXIT_UNEXPECTED,
 )
 from collide2d.runner.golden import golden_frames, report, shown_path
-from collide2d.runner.golden.formats import Output, add_check_formats
+from collide2d.runner.golden.formats import Output, add_check_formats, stdout_held
 from collide2d.runner.golden.fromreport import add_from_report, bless_from_report
 from collide2d.runner.golden.store import (
     GOLDENS_DIR,
@@ -184,7 +185,24 @@ def main(argv=None, *, load=None, simulate=None) -> int:
 
 def check_command(args, *, load=default_load, simulate=default_simulate) -> int:
     """`collide2d check`: 0 when every scenario matches its golden, 1 if not, 2 on bad input,
-    3 on an unexpected error in any scenario (the others are still checked)."""
+    3 on an unexpected error in any scenario (the others are still checked), never 0 when none
+    was checked. Under `--format json`, what the runs print goes to stderr (formats)."""
+    json_format = getattr(args, "format", "text") == "json"
+    with stdout_held() if json_format else contextlib.nullcontext():
+        done = _check_all(args, load, simulate)
+    if isinstance(done, int):
+        return done
+    status, out, outcomes, unused, errors = done
+    try:
+        out.finish(outcomes, unused, errors)
+    except OSError as exc:
+        status = max(status, _io_error(exc))
+    return status
+
+
+def _check_all(args, load, simulate):
+    """Check every scenario: (status so far, Output, outcomes, unused goldens, errors), or the
+    exit status of bad input found before anything ran."""
     refused = []  # (path, error) of the scenario files that could not be read
     try:
         root, scenarios = _prepare(args, load, refused=refused)
@@ -211,7 +229,11 @@ def check_command(args, *, load=default_load, simulate=default_simulate) -> int:
     outcomes, status, errors = [], EXIT_OK, []
     for path, exc in refused:  # each one case not checked; the others are still checked
         status = max(status, _scenario_failed(args, "reading", path, Path(path).stem, exc))
-        said = str(exc) if isinstance(exc, scenario_errors()) else f"{type(exc).__name__}: {exc}"
+        said = (
+            str(exc)
+            if isinstance(exc, scenario_errors())
+            else f"{type(exc).__name__}: {_text(exc)}"
+        )
         errors.append((shown_path(path), said))
     for i, (path, scn) in enumerate(scenarios, start=1):
         _progress(args, f"[{i}/{len(scenarios)}] checking {scn.name}")
@@ -226,12 +248,16 @@ def check_command(args, *, load=default_load, simulate=default_simulate) -> int:
                 viewer=viewer_of(simulate),
                 progress=_show_progress(args),
             )._record
-        except Exception as exc:  # one scenario never stops the others
+        except KeyboardInterrupt:
+            raise
+        except BaseException as exc:  # whatever stops one scenario, never the others
             status = max(status, _scenario_failed(args, "checking", path, scn.name, exc))
-            errors.append((scn.name, f"{type(exc).__name__}: {exc}"))
+            errors.append((scn.name, f"{type(exc).__name__}: {_text(exc)}"))
             continue
         outcomes.append(outcome)
         out.say(outcome.message())
+    if not outcomes and status == EXIT_OK:  # scenarios found, none checked: never a pass
+        status = EXIT_UNEXPECTED
     unused = store.unused(used) if used is not None else []
     if unused:
         out.say(
@@ -249,11 +275,7 @@ def check_command(args, *, load=default_load, simulate=default_simulate) -> int:
     failed = [o for o in outcomes if not o.ok]
     said = f", {len(errors)} not checked (errors above)" if errors else ""
     out.say(f"{len(outcomes) - len(failed)} passed, {len(failed)} failed{said}")
-    try:
-        out.finish(outcomes, unused, errors)
-    except OSError as exc:
-        status = max(status, _io_error(exc))
-    return max(status, EXIT_DIFFERENCE if failed else EXIT_OK)
+    return max(status, EXIT_DIFFERENCE if failed else EXIT_OK), out, outcomes, unused, errors
 
 
 def _io_error(exc: OSError, name: str = "") -> int:
@@ -264,7 +286,17 @@ def _io_error(exc: OSError, name: str = "") -> int:
     return EXIT_BAD_INPUT
 
 
-def _scenario_failed(args, doing: str, path, name: str, exc: Exception) -> int:
+def _text(exc: BaseException) -> str:
+    """str(exc), or "<str() failed>" when that raises (an exception of a model plugin's)."""
+    try:
+        return str(exc)
+    except KeyboardInterrupt:
+        raise
+    except BaseException:
+        return "<str() failed>"
+
+
+def _scenario_failed(args, doing: str, path, name: str, exc: BaseException) -> int:
     """Report what stopped one scenario (`name`) on stderr; returns its exit status:
     EXIT_BAD_INPUT for a refusal (a bad scenario or run, a link in the way) or a file that could
     not be read or written (a full disk), EXIT_UNEXPECTED for anything else (one line naming the
@@ -277,10 +309,16 @@ def _scenario_failed(args, doing: str, path, name: str, exc: Exception) -> int:
             text = f"collide2d: error: {name}: {text}"
         print(text, file=sys.stderr, flush=True)
         return EXIT_BAD_INPUT
-    detail = " ".join(str(exc).split())[:300]
+    detail = " ".join(_text(exc).split())[:300]
+    if type(exc).__name__ == "ModelError":  # a model plugin's doing, named (engine.models)
+        what = f"error while {doing} {name} ({shown_path(path)}): {detail}"
+    else:
+        what = (
+            f"unexpected error while {doing} {name} ({shown_path(path)}): "
+            f"{type(exc).__name__}{': ' + detail if detail else ''}"
+        )
     print(
-        f"collide2d: unexpected error while {doing} {name} ({shown_path(path)}): "
-        f"{type(exc).__name__}{': ' + detail if detail else ''}"
+        f"collide2d: {what}"
         + ("" if getattr(args, "debug", False) else " (run with --debug for the traceback)"),
         file=sys.stderr,
         flush=True,
@@ -320,7 +358,9 @@ def bless_command(args, *, load=default_load, simulate=default_simulate) -> int:
             line = check_scenario(
                 scn, store, path=path, bless=True, simulate=simulate, progress=_show_progress(args)
             ).message
-        except Exception as exc:  # one scenario never stops the others
+        except KeyboardInterrupt:
+            raise
+        except BaseException as exc:  # whatever stops one scenario, never the others
             status = max(status, _scenario_failed(args, "blessing", path, scn.name, exc))
             continue
         print(line, flush=True)

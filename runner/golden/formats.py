@@ -5,11 +5,15 @@
 summary `check --report` keeps in `summary.json` (`report.summary_dict`: counts, the summary line,
 per scenario its status, why it changed, the first differing event, problems and frames, and the
 scenarios not checked with their errors). `--junit FILE` writes JUnit XML (`junit`), one test case
-per scenario (an error case for one not checked), whichever format prints.
+per scenario (an error case for one not checked), whichever format prints. Under `--format json`
+stdout holds that document alone: while the scenarios are read and run, whatever else would print
+there (a model plugin's `print`, a write to file descriptor 1) goes to stderr (`stdout_held`).
 """
 
 from __future__ import annotations
 
+import contextlib
+import gc
 import json
 import os
 import stat
@@ -71,3 +75,38 @@ class Output:
             sys.stdout.flush()
         if self.junit:
             write_junit(self.junit, outcomes, errors)
+
+
+@contextlib.contextmanager
+def stdout_held():
+    """Everything printed to stdout meanwhile goes to stderr: `sys.stdout` and, where it can be,
+    file descriptor 1 too (code that writes to it directly, processes started meanwhile). Put
+    back after, so that the JSON document alone reaches stdout."""
+    before = sys.stdout
+    _flush(before, sys.__stdout__)
+    saved = None
+    try:
+        saved = os.dup(1)
+        os.dup2(2, 1)
+    except OSError:  # no descriptor 1 or 2 (closed): sys.stdout alone is held
+        if saved is not None:
+            os.close(saved)
+            saved = None
+    sys.stdout = sys.stderr
+    try:
+        yield
+    finally:
+        gc.collect()  # what the runs left in reference cycles goes now, its __del__ held too
+        _flush(before, sys.__stdout__, sys.stderr)  # written meanwhile: to stderr still
+        if saved is not None:
+            os.dup2(saved, 1)
+            os.close(saved)
+        sys.stdout = before
+
+
+def _flush(*streams) -> None:
+    for stream in streams:
+        try:
+            stream.flush()
+        except (AttributeError, OSError, ValueError):  # none, or closed
+            pass

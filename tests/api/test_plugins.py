@@ -148,7 +148,7 @@ class Wanders(BoxFlip):
 @pytest.mark.parametrize(
     "kind, said",
     [
-        ("raises", "raised in ticks"),
+        ("raises", "raised ZeroDivisionError in advance() at ticks"),
         ("wrongshape", "returned positions() of shape (3,)"),
         ("nan", "returned velocities() with NaN"),
         ("unordered", "events out of order"),
