@@ -6,7 +6,8 @@ line: a refused scenario raises `ScenarioError`, whose text is `FILE:LINE:COL: e
 `Result`: the final state as named columns, the events as records, the frames asked for as arrays
 and the summary. `check` compares runs with the project's goldens, or blesses them, and returns a
 `CheckResult`. The `collide2d run`, `check` and `bless` commands are a layer over these functions:
-a run from Python and a run from the command line take one path.
+a run from Python and a run from the command line take one path, and an argument is refused as
+its option is (`collide2d.arguments`: a TypeError or ValueError naming it).
 
 Importing this module costs only the standard library; the runner is imported when a function is
 first called (a command that never runs a scenario does not pay for numpy or numba).
@@ -21,6 +22,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Union
 
+from collide2d import arguments
+
 if TYPE_CHECKING:
     import numpy as np
 
@@ -30,8 +33,6 @@ if TYPE_CHECKING:
 __all__ = ["CheckResult", "Result", "ScenarioCheck", "check", "load", "run"]
 
 Source = Union[str, "os.PathLike[str]", Mapping[str, Any]]
-# The words `run(frames=...)` takes besides frame numbers.
-FRAME_WORDS = ("all", "last", "golden", "output")
 
 # Where each Scenario `load` returned came from, so that `run(scenario, model=...)` can read it
 # again under another model (the model's rules decide what a scenario may hold).
@@ -52,7 +53,8 @@ def load(
 
     Args:
         source: a scenario file (a path), or the scenario itself as a dict (what the YAML file
-            would hold: `{"version": 1, "world": {...}, "objects": [...]}`).
+            would hold: `{"version": 1, "world": {...}, "objects": [...]}`; numpy numbers and
+            arrays and tuples stand for the numbers and lists YAML gives).
         model: run it under this model instead of the one it names (a built-in, `paper`,
             `stepped` or `exact`, or a registered plugin); like `collide2d run --model`.
         fps: ticks per simulated second instead of `world.fps` (`--fps`).
@@ -68,20 +70,24 @@ def load(
 
     Raises:
         ScenarioError: the scenario is refused; `str(err)` is `FILE:LINE:COL: error: MESSAGE`
-            (for a dict, the place is in the YAML text it is written as).
+            (for a dict, the place is in the YAML text it is written as, and a value YAML would
+            not give is named by its place in the dict: `objects[1].velocity: ...`).
+        TypeError, ValueError: an argument is refused (`fps="10"`, `max_events_per_tick=0`);
+            the message starts with it.
     """
     from collide2d.runner.scenario import load as reader
 
-    overrides = {"model": model, "fps": fps, "ticks": ticks}
-    overrides["max_events_per_tick"] = max_events_per_tick
-    options = {"overrides": overrides, "limits": limits, "defaults": defaults}
+    source = arguments.source("source", source)
+    overrides = {
+        "model": arguments.model(model),
+        "fps": arguments.whole("fps", fps),
+        "ticks": arguments.whole("ticks", ticks),
+        "max_events_per_tick": arguments.whole("max_events_per_tick", max_events_per_tick, lo=1),
+    }
+    limits = arguments.limits(limits)
+    options = {"overrides": overrides, "limits": limits, "defaults": arguments.defaults(defaults)}
     if isinstance(source, Mapping):
-        import yaml
-
-        text = yaml.safe_dump(
-            dict(source), sort_keys=False, allow_unicode=True, default_flow_style=None
-        )
-        scenario = reader.loads(text, **options)
+        scenario = reader.loads(arguments.scenario_text(source), **options)
     else:
         scenario = reader.load(source, **options)
     _SOURCES[scenario] = (source, options)
@@ -157,7 +163,7 @@ def run(
             it, as `load(..., model=...)` would).
         frames: the frames (0 to `ticks`) to keep as arrays in `Result.frames`: frame numbers,
             `"all"`, `"last"`, `"golden"` (the scenario's golden frames) or `"output"` (its
-            `output.frames`); None keeps none. In memory only (see `out`).
+            `output.frames`); None keeps none. In memory only (refused with `out`).
         events: record the events (`Result.events`; with `out`, write `events.jsonl`).
         out: write the run's files (frames, GIF, event log, `final.csv`, `summary.json`) into
             `OUT/NAME/` as `collide2d run --out OUT` does, replacing a previous run whole; the
@@ -166,10 +172,16 @@ def run(
         png: with `out`, write PNG frames (default: as the scenario's `output` says).
         gif: with `out`, write `animation.gif` (default: as the scenario's `output` says).
         viewer: with `out`, write `viewer.html` (default: as the scenario's `output` says).
-        overlay: with `out`, the debug overlays drawn into the frames (default: the scenario's).
+        overlay: with `out`, the debug overlays drawn into the frames (default: the scenario's):
+            names, or one text of names separated by commas as `--overlay` takes; `"none"` or
+            `[]` for none.
         scale: with `out`, enlarge PNG and GIF frames this many times.
         quiet: with `out`, no progress bar or notes on the terminal.
-        limits: with `out`, the guards on what may be written (`--max-output-bytes` ...).
+        limits: the guards (`Limits`): on the scenario read when `scenario` is a path or a dict,
+            and with `out` on what may be written (`--max-output-bytes` ...).
+
+    The arguments marked "with `out`" are refused (ValueError) without it, as `frames` is with
+    it: a run never leaves an argument unused without a word.
 
     Returns:
         A `Result`.
@@ -179,10 +191,28 @@ def run(
         RunStopped: the model stopped the run (a runaway); `str(err)` says why. With `out`, the
             run folder then holds the run so far (`err.folder`; docs/limits.md#runaways).
         ModelError: a plugin model raised or broke the model protocol; `str(err)` names it.
+        TypeError, ValueError: an argument is refused (`frames=True`, `overlay=["nope"]`,
+            `scale=0`); the message starts with it, and nothing has run.
     """
     from collide2d.runner import run as runner
 
-    scenario = _scenario(scenario, model)
+    given = {"png": png, "gif": gif, "viewer": viewer, "overlay": overlay, "scale": scale}
+    given |= {"quiet": quiet, "frames": frames}
+    model = arguments.model(model)
+    frames = arguments.frames(frames)
+    events = arguments.flag("events", events)
+    out = arguments.folder("out", out)
+    png = arguments.flag("png", png, none=True)
+    gif = arguments.flag("gif", gif, none=True)
+    viewer = arguments.flag("viewer", viewer, none=True)
+    overlay = arguments.overlay(overlay)
+    scale = arguments.whole("scale", scale, lo=1)
+    quiet = arguments.flag("quiet", quiet)
+    limits = arguments.limits(limits)
+    checked = {"png": png, "gif": gif, "viewer": viewer, "overlay": overlay, "scale": scale}
+    checked |= {"quiet": quiet, "frames": frames}
+    arguments.with_out(out, {name: (given[name], checked[name]) for name in given})
+    scenario = _scenario(scenario, model, limits)
     if out is not None:
         options = _write_options(scenario, events, png, gif, viewer, overlay, scale, quiet)
         folder, done = runner.write_run(scenario, out, options, limits)
@@ -191,13 +221,13 @@ def run(
     return _result(runner.simulate(scenario, keep_frames=keep, log_events=events), None)
 
 
-def _scenario(scenario, model: str | None):
-    """The Scenario to run: `scenario` itself, read by `load` when it is not one, read again
-    under `model` when that differs from its own."""
+def _scenario(scenario, model: str | None, limits=None):
+    """The Scenario to run: `scenario` itself, read by `load` (under `limits`) when it is not one,
+    read again under `model` when that differs from its own."""
     from collide2d.runner.scenario.load import Scenario
 
     if not isinstance(scenario, Scenario):
-        return load(scenario, model=model)
+        return load(arguments.source("scenario", scenario), model=model, limits=limits)
     if model is None or model == scenario.model:
         return scenario
     source, options = _SOURCES.get(scenario, (scenario.path, None))
@@ -208,7 +238,7 @@ def _scenario(scenario, model: str | None):
         )
     options = dict(options or {"overrides": {}})
     options.pop("overrides", None)
-    kept = {"limits": options.get("limits"), "defaults": options.get("defaults")}
+    kept = {"limits": limits or options.get("limits"), "defaults": options.get("defaults")}
     return load(source, model=model, **kept)
 
 
@@ -219,9 +249,7 @@ def _frames(scenario, frames):
     ticks = scenario.ticks
     if frames is None:
         return FrameRule.none(ticks)
-    if isinstance(frames, str):
-        if frames not in FRAME_WORDS:
-            raise ValueError(f"frames={frames!r}: expected frame numbers or one of {FRAME_WORDS}")
+    if isinstance(frames, str):  # a word of collide2d.arguments.FRAME_WORDS
         if frames == "all":
             return FrameRule.all(ticks)
         if frames == "last":
@@ -229,7 +257,7 @@ def _frames(scenario, frames):
         if frames == "output":
             return scenario.output.frames
         return FrameRule.of(sorted(set(scenario.golden.frames)), ticks)
-    numbers = [int(k) for k in frames]
+    numbers = list(frames)
     bad = [k for k in numbers if not 0 <= k <= ticks]
     if bad:
         raise ValueError(f"frame {bad[0]} is not one of the run's frames 0 to {ticks}")
@@ -344,25 +372,59 @@ def check(
         ScenarioError: a scenario is refused.
         GoldenError: a golden cannot be written (a symbolic link in the way, CI set for bless).
         RunStopped, ModelError: as for `run`.
+        TypeError, ValueError: an argument is refused as `collide2d check` refuses it, before
+            anything runs: a `root` without a scenarios folder, no scenario to check (an empty
+            list, a project without scenario files), two scenarios of one name, a `report`
+            folder that meets the project's folders (or with `bless`).
     """
     from collide2d.runner.golden import store
+    from collide2d.runner.golden.report import check_target
 
+    items = arguments.scenarios(scenarios)
+    root = arguments.folder("root", root)
+    bless = arguments.flag("bless", bless)
+    report = arguments.folder("report", report)
+    if bless and report is not None:
+        raise ValueError(
+            f"report={arguments.brief(report)}: a report is written by a check, not by bless"
+        )
     project = _project(root)
+    folder = project.value("scenarios")
+    if root is not None and not (project.root / folder).is_dir():
+        raise ValueError(f"root={arguments.brief(root)} has no {folder}/ folder")
     goldens = store.GoldenStore(project.root, project.value("goldens"))
     goldens.check_dir()
     if bless and store.ci_active():
         raise store.GoldenError("CI is set: goldens are never written in CI")
-    report_dir = Path(report) if report is not None else None
-    done = []
-    for item in _items(scenarios, project):
-        path = None
-        if isinstance(item, Mapping):
-            item = load(item, **project.load_options())
-        elif isinstance(item, (str, os.PathLike)):
-            path = _resolve(item, project)
-            item = load(path, **project.load_options())
-        done.append(check_scenario(item, goldens, path=path, bless=bless, report=report_dir))
+    report_dir = project.apart("report", report, "report") if report is not None else None
+    if items is None:
+        items = store.scenario_files(project.root, folder)
+        if not items:
+            raise ValueError(f"no scenario files in {store.shown_path(project.root / folder)}")
+    loaded = [_loaded(item, project) for item in items]
+    named = [
+        (path or scenario.path or f"<{scenario.name}>", scenario.name) for path, scenario in loaded
+    ]
+    for refusal in store.same_names(named).values():
+        raise ValueError(refusal)
+    if report_dir is not None:
+        check_target(report_dir, [scenario.name for _, scenario in loaded])
+    done = [
+        check_scenario(scenario, goldens, path=path, bless=bless, report=report_dir)
+        for path, scenario in loaded
+    ]
     return CheckResult(tuple(done))
+
+
+def _loaded(item, project) -> tuple[Path | None, Scenario]:
+    """(its file, the Scenario) of a scenario given to `check`: read (under the project's
+    settings) when it is a file, a name or a dict."""
+    if isinstance(item, Mapping):
+        return None, load(item, **project.load_options())
+    if isinstance(item, (str, os.PathLike)):
+        path = _resolve(item, project)
+        return path, load(path, **project.load_options())
+    return None, item
 
 
 def check_scenario(
@@ -417,18 +479,6 @@ def _project(root):
         return config.at(root)
     project = config.find()
     return project if project.file is not None else config.at(find_root())
-
-
-def _items(scenarios, project) -> list:
-    """The scenarios `check` was given, as a list; None: every file of the project's folder."""
-    from collide2d.runner.golden.store import scenario_files
-    from collide2d.runner.scenario.load import Scenario
-
-    if scenarios is None:
-        return list(scenario_files(project.root, project.value("scenarios")))
-    if isinstance(scenarios, (Scenario, str, os.PathLike, Mapping)):
-        return [scenarios]
-    return list(scenarios)
 
 
 def _resolve(item, project) -> Path:
