@@ -234,12 +234,15 @@ def test_run_refuses_a_wrong_argument_naming_it(kwargs, error, said):
         ({"out": ""}, ValueError, "out='': names no folder"),
     ],
 )
-def test_run_into_a_folder_refuses_what_collide2d_run_refuses(tmp_path, kwargs, error, said):
+def test_run_into_a_folder_refuses_what_collide2d_run_refuses(
+    tmp_path, monkeypatch, kwargs, error, said
+):
+    monkeypatch.chdir(tmp_path)  # out="" would name the current folder
     kwargs = {"out": tmp_path / "out"} | kwargs
     with pytest.raises(error) as info:
         collide2d.run(two_boxes(), **kwargs)
     assert str(info.value).startswith(said)
-    assert not (tmp_path / "out").exists()
+    assert not any(tmp_path.iterdir())
 
 
 def test_run_takes_overlays_as_the_command_line_does(tmp_path):
