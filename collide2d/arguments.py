@@ -61,6 +61,8 @@ def whole(name: str, value, *, lo: int | None = None) -> int | None:
     number = _integer(value)
     if number is None:
         raise TypeError(f"{name}={brief(value)}: expected a whole number, not {_kind(value)}")
+    if not _printable(number):
+        raise ValueError(f"{name}: a whole number too long to write out is past every bound")
     if lo is not None and number < lo:
         raise ValueError(f"{name}={number}: must be at least {lo}")
     return number
@@ -244,6 +246,16 @@ def with_out(out, given: dict) -> None:
         )
 
 
+def _printable(number: int) -> bool:
+    """Whether Python writes `number` out (at most sys.get_int_max_str_digits() digits), as
+    every message that shows it does."""
+    try:
+        str(number)
+    except ValueError:
+        return False
+    return True
+
+
 def _kind(value) -> str:
     return type(value).__name__
 
@@ -318,6 +330,8 @@ class _Plain:
         if value is None or isinstance(value, bool):
             return value
         if isinstance(value, int):
+            if not _printable(value):  # YAML would hold its digits; the reader refuses >100
+                return self.refuse(at, "a whole number too long to write out")
             return int(value)
         if isinstance(value, float):
             return float(value)

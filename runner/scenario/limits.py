@@ -40,6 +40,10 @@ class Limits:
                 raise TypeError(
                     f"{f.name}={said}: expected a whole number, not {type(value).__name__}"
                 )
+            try:
+                str(number)  # a message that names the bound writes it out
+            except ValueError:
+                raise ValueError(f"{f.name}: a whole number too long to write out") from None
             if number < 1:
                 raise ValueError(f"{f.name}={number}: must be at least 1")
             object.__setattr__(self, f.name, number)

@@ -81,6 +81,9 @@ def test_numpy_values_load_under_another_model_too():
         (("world", "fps"), np.datetime64("2020-01-01"), "world.fps: a scenario holds"),
         (("name",), b"two", "name: a scenario holds numbers, text"),
         (("golden", "frames"), {0, 20}, "golden.frames: a scenario holds"),
+        pytest.param(
+            ("world", "width"), 10**5000, "world.width: a whole number too long", id="long"
+        ),
     ],
 )
 def test_a_value_yaml_would_not_give_is_refused_at_its_place(where, value, said):
@@ -147,6 +150,7 @@ def test_a_shared_list_stays_one_yaml_value_so_the_alias_bound_holds():
         ({"fps": True}, TypeError, "fps=True: expected a whole number, not bool"),
         ({"ticks": np.float64(3)}, TypeError, "ticks=np.float64(3.0): expected a whole number"),
         ({"max_events_per_tick": 0}, ValueError, "max_events_per_tick=0: must be at least 1"),
+        ({"ticks": 10**5000}, ValueError, "ticks: a whole number too long to write out"),
         ({"limits": {"max_objects": 1}}, TypeError, "limits={'max_objects': 1}: expected a"),
         ({"defaults": [("kind", "exact")]}, TypeError, "defaults=[('kind', 'exact')]: expected"),
         ({"defaults": {"substep": 2}}, ValueError, "defaults: no model setting 'substep'; did"),
@@ -187,6 +191,8 @@ def test_limits_refuse_what_the_max_options_refuse():
         collide2d.Limits(max_ticks="9")
     with pytest.raises(TypeError, match=r"^max_side=1.5: expected a whole number"):
         collide2d.Limits(max_side=1.5)
+    with pytest.raises(ValueError, match=r"^max_frames: a whole number too long to write out"):
+        collide2d.Limits(max_frames=10**5000)
 
 
 @pytest.mark.parametrize(
