@@ -6,8 +6,10 @@ per stage: `move` (move and walls), `candidates` (the candidate list and the ord
 are kept in), `narrow` (the listed pairs in contact, in order) and `pairs` (the exchange and the
 push), with `approach` (a pair's contact after a step: its normal from the direction of
 approach). A world with gravity, restitution or friction takes the settling path instead:
-`settle` (its step and run loop), `fall` (exact motion under gravity, wall bounces), `touch`
-(contacts, wake), `solver` (velocities and overlap, never adding energy) and `sleep`.
+`settle` (its step and run loop), `fall` (exact motion under gravity, wall bounces), `land` (a
+body the move took far into a static object, put back where it met it), `touch` (contacts,
+wake), `solver` (velocities and overlap, never adding energy), `sleep` and `sunk` (a body asleep
+inside a static object stops the run).
 `collide2d.engine.models.make("stepped", ...)` builds it from `Model`, which this package
 re-exports.
 

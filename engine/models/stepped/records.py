@@ -150,6 +150,8 @@ class Touch(NamedTuple):
     cores: tuple  # the exact shapes (shapes.build_cores) when colliding by them
     exact: bool  # whether objects collide by their real shapes
     hits: np.ndarray  # int64 scratch: one object's bounces in a step (fall.fall_one)
-    capped: np.ndarray  # (n,) bool scratch (touch.cap_goals)
+    capped: np.ndarray  # (n,) bool scratch (touch.cap_goals; sleep.doze marks who fell asleep)
     heads: np.ndarray  # (2n + 1,) int64 scratch: the candidate list's sort (sort.sort_pair_keys)
     bank: np.ndarray  # (1,) float64 energy given up so far and not yet spent on pushes (solver)
+    sunk: np.ndarray  # (4,) float64 a body asleep inside a static object (sunk.py): its id, the
+    # static object's, the tick, the depth (px); id -1 while there is none

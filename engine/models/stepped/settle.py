@@ -10,9 +10,11 @@ Every array is in id order and every loop runs on one thread, in id order: the s
 number of threads.
 
 A step (`step`) reads as its table of contents: move (fall.py: exact motion, wall bounces), the
-candidate list when due, the contacts (touch.py: walls, then pairs, waking the sleeping that a
-moving object touches), the velocities of all contacts together, the overlap past slop
-(solver.py), and sleep (sleep.py). With no object awake a step does nothing.
+candidate list when due, the landing of a body the move took far into a static object (land.py),
+the contacts (touch.py: walls, then pairs, waking the sleeping that a moving object touches), the
+velocities of all contacts together, the overlap past slop (solver.py), and sleep (sleep.py),
+a body falling asleep inside a static object stopping the run (sunk.py: `advance` raises
+`sunk.Sunk`, a runaway, naming it). With no object awake a step does nothing.
 """
 
 from __future__ import annotations
@@ -25,10 +27,12 @@ from collide2d.engine.broadphase import choose, marker, workspace
 from collide2d.engine.events import event_records, new_log
 from collide2d.engine.jit import njit
 from collide2d.engine.models.stepped.fall import MAX_HITS_PER_STEP, fall
+from collide2d.engine.models.stepped.land import land
 from collide2d.engine.models.stepped.move import BODY_COLUMNS
 from collide2d.engine.models.stepped.records import Fall, Physics, Step, Touch
 from collide2d.engine.models.stepped.sleep import doze
 from collide2d.engine.models.stepped.solver import correct, energy, kinetic, solve
+from collide2d.engine.models.stepped.sunk import inside, sunk_error
 from collide2d.engine.models.stepped.touch import (
     C_COLUMNS,
     CONTACTS_PER_OBJECT,
@@ -86,11 +90,13 @@ def step(F, P, T, at, sides, bufs, log):
     # move: exact motion under gravity, bounces off the walls (what they take noted)
     before = energy(F, P)
     drift, bounces, log = fall(F, P, at, sides, T.hits, log)
-    taken = max(before - energy(F, P), 0.0)
     counts[N_WALLS] += bounces
     # the candidate list anew once an awake object drifted half the margin, or one woke
     if counts[N_KEYS] < 0 or counts[N_RELIST] != 0 or drift >= P.half - DRIFT_SLACK_PX:
         keys = relist(F, P, T, keys)
+    # landing: a body the move took far into a static object, back where it met it
+    keys, _ = land(F, P, T, keys, at.dt)
+    taken = max(before - energy(F, P), 0.0)
     # contacts: walls, then pairs by ids; starting from last step's impulses
     pairs, floats, m = walls(F, P, sides, pairs, floats, at.dt)
     pairs, floats, m, log = pair_contacts(
@@ -106,8 +112,10 @@ def step(F, P, T, at, sides, bufs, log):
     T.bank[0] += limit - kinetic(F)
     T.bank[0] -= correct(F, P, pairs, floats, m, T.bank[0], sides)
     last_keys, last = keep(T, pairs, floats, m, last_keys, last)
-    # sleep: objects slow for sleep_after s
-    counts[N_AWAKE] = doze(F, P, at.dt)
+    # sleep: objects slow for sleep_after s; one asleep inside a static object stops the run
+    counts[N_AWAKE], fell = doze(F, P, at.dt, T.capped)
+    if fell:
+        inside(F, P, T, keys, at.tick, T.capped)
     return (keys, pairs, floats, last_keys, last), log
 
 
@@ -122,6 +130,8 @@ def run(F, P, T, bufs, world, tick0, ticks, log_on, log):
         at = Step(dt, width, height, T.exact, tick, tick / fps, log_on)
         for _ in range(substeps):
             bufs, log = step(F, P, T, at, sides, bufs, log)
+            if T.sunk[0] >= 0.0:  # a body asleep inside a static object: the run stops here
+                return bufs, log
     return bufs, log
 
 
@@ -216,11 +226,13 @@ class Settle:
             capped=np.zeros(n, bool),
             heads=np.zeros(2 * n + 1, np.int64),
             bank=np.zeros(1),
+            sunk=np.array([-1.0, -1.0, 0.0, 0.0]),
         )
         self.tick = 0
 
     def advance(self, ticks: int, log: bool) -> np.ndarray:
-        """Run `ticks` ticks; the events in order (empty when log is False)."""
+        """Run `ticks` ticks; the events in order (empty when log is False). Raises sunk.Sunk
+        (a runaway) when a body falls asleep inside a static object."""
         T = self._T
         world = (float(self.world.width), float(self.world.height), float(self.world.fps),
                  self.substeps)  # fmt: skip
@@ -232,6 +244,9 @@ class Settle:
         )  # fmt: skip
         keys, pairs, floats, last_keys, last = bufs
         self._T = T._replace(keys=keys, pairs=pairs, floats=floats, last_keys=last_keys, last=last)
+        if T.sunk[0] >= 0.0:
+            self.tick = int(T.sunk[2])
+            raise sunk_error(T.sunk, self.world.gravity, 1.0 / (self.world.fps * self.substeps))
         self.tick += int(ticks)
         return event_records(rows, times, int(n))
 
