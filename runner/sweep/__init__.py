@@ -1,8 +1,9 @@
 """Sweeps (`collide2d sweep`): scenarios over a matrix of settings and seeds, run on Dask.
 
 One module per role: `matrix` (the swept keys and values, each combination's scenario loaded),
-`plan` (every run checked up front, none kept loaded; the runs in sorted order), `reseed` (a
-loaded scenario drawn again for another seed), `sweepfile` (the matrix kept in YAML), `worker` (one
+`plan` (every combination checked up front, none kept loaded; the runs in sorted order),
+`seedcheck` (each run's seed checked in the background, ahead of the runs), `reseed` (a loaded
+scenario drawn again for another seed), `sweepfile` (the matrix kept in YAML), `worker` (one
 run's figures, on a worker), `cluster` (the Dask client: an embedded LocalCluster or a running
 scheduler; tasks run without losing one), `driver` (a sweep's runs on the cluster, a window at a
 time), `results` (rows sorted by parameters, the position error against `exact`, results.csv/md

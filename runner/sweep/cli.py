@@ -1,14 +1,15 @@
 """The `sweep` subcommand: its arguments, and the run that builds the matrix, runs it, writes it.
 
 `register` adds the subcommand without loading Dask; `cmd_sweep` reads the matrix (scenario files
-and `--set`/`--seeds`, or one sweep file), checks every run before anything runs (`plan.check`),
-runs them on the cluster (`--scheduler`, else an embedded LocalCluster of `--workers` processes)
-and writes OUT/sweep/ whole (`folder`; OUT is `--out`, else the project's `out` setting, else
-`out`). Exit status: 0 done, 2 bad input (nothing written), Dask not installed, a scheduler that
-does not answer or OUT/sweep taken by another sweep, 3 when a run failed unexpectedly (its row says
-so), 130 when cancelled by Ctrl-C (the rows done are written, marked incomplete). The line
-`sweep: N runs on ...` comes once the cluster is up; a Ctrl-C while it starts goes unseen
-(runner.sweep.cluster).
+and `--set`/`--seeds`, or one sweep file), checks every combination of settings before anything
+runs (`plan.check`), runs them on the cluster (`--scheduler`, else an embedded LocalCluster of
+`--workers` processes), each run sent once its seed is checked (`driver`, `seedcheck`: a refused
+one stops the sweep, bad input), and writes OUT/sweep/ whole (`folder`; OUT is `--out`, else the
+project's `out` setting, else `out`). Exit status: 0 done, 2 bad input (nothing written), Dask
+not installed, a scheduler that does not answer or OUT/sweep taken by another sweep, 3 when a run
+failed unexpectedly (its row says so), 130 when cancelled by Ctrl-C (the rows done are written,
+marked incomplete). The line `sweep: N runs on ...` comes once the cluster is up; a Ctrl-C while
+it starts goes unseen (runner.sweep.cluster).
 """
 
 from __future__ import annotations
@@ -131,8 +132,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     project = config.find()
     out_root = args.out or (project.folder("out") if project.file else "out")
 
-    def checking(total: int):
-        return cluster.progress_for(total, "checking", args.quiet)
+    def checking(total: int):  # the combinations of settings, each loaded in full
+        return cluster.progress_for(total, "checking", args.quiet, unit=" combinations")
 
     try:
         cluster.require_dask("collide2d sweep")

@@ -10,9 +10,10 @@ submits `fn(item)` for every item, a window of tasks at a time, and hands each r
 exception it raised) to `on_result(i, value, error)` as runs finish, in any order. A task whose
 worker dies is run again elsewhere by the scheduler (up to its `allowed-failures`), so every item
 gets one result; on Ctrl-C (SIGINT, answered inside `connect` even by a process started with it
-ignored) the tasks still pending are cancelled and `run_all` returns False. A worker that starts
-compiling kernels says so (an event on COMPILING_TOPIC), and this process gives the compile notice
-then (runner.compiling.told), as a run on its own gives it.
+ignored) the tasks still pending are cancelled and `run_all` returns False, and so they are when
+reading `items` or `on_result` raises (a sweep's refused seed), before the exception goes on. A
+worker that starts compiling kernels says so (an event on COMPILING_TOPIC), and this process gives
+the compile notice then (runner.compiling.told), as a run on its own gives it.
 
 Dask is the optional `dask` extra: `require_dask` raises `DaskMissing` with the install command.
 """
@@ -151,12 +152,12 @@ def _joined(Client, scheduler: str):
         ) from None
 
 
-def progress_for(total: int, label: str, quiet: bool) -> Progress | None:
+def progress_for(total: int, label: str, quiet: bool, unit: str = " runs") -> Progress | None:
     """A progress bar of runs (done/total, rate and time left) on stderr when it is a terminal and
     not quiet, else None; drawn at once, its clock running while the first runs compile."""
     if quiet or not sys.stderr.isatty():
         return None
-    return Progress(total, label, unit=" runs", waiting=True)
+    return Progress(total, label, unit=unit, waiting=True)
 
 
 def _tell_compiling() -> None:
@@ -225,9 +226,11 @@ def run_all(
             if progress is not None:
                 progress.update(done)
             send()
-    except KeyboardInterrupt:
+    except BaseException as exc:  # Ctrl-C, or what `items` or `on_result` raised
         client.cancel([f for _i, _n, f in pending.values()])
-        return False
+        if isinstance(exc, KeyboardInterrupt):
+            return False
+        raise
     finally:
         client.unsubscribe_topic(COMPILING_TOPIC)
         if progress is not None:

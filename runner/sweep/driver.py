@@ -5,7 +5,10 @@
 pay the scheduler's few milliseconds per task, while the work stays spread), each task
 `worker.run_batch` on the batch's runs as (their combination's scenario, their seed), and at most
 WINDOW_PER_THREAD tasks per worker thread in flight: the scenarios are loaded as their batch is
-sent (`plan.Plan.base`) and dropped when it is done, so memory does not grow with the runs. What
+sent (`plan.Plan.base`) and dropped when it is done, so memory does not grow with the runs. A batch
+is sent once its runs' seeds are checked (`runner.sweep.seedcheck`, in the background from the
+start, ahead of the runs); a run refused stops the sweep: the tasks in flight are cancelled and
+its located error is raised (bad input, as if refused before any run). What
 comes back is kept by run number in a `results.Table`, so each row exists once however many times
 a task was run (a task whose worker died is run again by the scheduler). A run that raised (a bug)
 gives a row with status `error` and the exception in its note; a task that kept killing its
@@ -21,6 +24,7 @@ import time
 
 from collide2d.runner.sweep import cluster
 from collide2d.runner.sweep.results import Table
+from collide2d.runner.sweep.seedcheck import SeedChecks
 from collide2d.runner.sweep.worker import error_figures, run_batch
 
 TASKS_PER_THREAD = 8
@@ -42,12 +46,13 @@ def run_sweep(client, plan, *, progress=None, on_row=None, batch=None) -> tuple[
     sent: dict[int, list] = {}  # task number -> its runs, until its result is taken
     started = time.time()
 
-    def batches():
+    def batches(checks: SeedChecks):
         runs = plan.runs()
         for i in itertools.count():
             chunk = list(itertools.islice(runs, batch))
             if not chunk:
                 return
+            checks.wait(chunk[-1].index)  # raises a refusal found at any run
             sent[i] = chunk
             yield [(plan.base(r.combo), r.seed) for r in chunk]
 
@@ -60,15 +65,16 @@ def run_sweep(client, plan, *, progress=None, on_row=None, batch=None) -> tuple[
             if on_row is not None:
                 on_row(run, row)
 
-    complete = cluster.run_all(
-        client,
-        run_batch,
-        batches(),
-        take,
-        progress=progress,
-        label="collide2d-sweep",
-        size=len,
-        window=max(2, WINDOW_PER_THREAD * threads),
-    )
+    with SeedChecks(plan) as checks:
+        complete = cluster.run_all(
+            client,
+            run_batch,
+            batches(checks),
+            take,
+            progress=progress,
+            label="collide2d-sweep",
+            size=len,
+            window=max(2, WINDOW_PER_THREAD * threads),
+        )
     table.finish()
     return table, complete

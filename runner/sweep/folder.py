@@ -57,14 +57,18 @@ def check_replaceable(root) -> Path:
 @contextlib.contextmanager
 def staged(root):
     """A `with` block holding OUT/sweep's lock and giving an empty staging folder, swapped in for
-    OUT/sweep when the block ends normally and removed otherwise."""
+    OUT/sweep when the block ends normally and removed otherwise (and OUT with it when this made
+    it and it is left empty: a sweep refused once its runs went, docs/how-to/dask.md, leaves
+    nothing)."""
     root = Path(root)
     check_replaceable(root)
+    made = not os.path.lexists(root)
     outputs.make_folder(root)
     try:
         lock = rundir.RunLock(root, NAME).__enter__()
     except rundir.OutputBusy as exc:
         raise FolderRefused(str(exc)) from None
+    swapped = False
     try:
         rundir.clean_leftovers(root, NAME)
         target = check_replaceable(root)  # again, now that no other sweep can change it
@@ -72,8 +76,12 @@ def staged(root):
         try:
             yield stage
             rundir.swap_in(stage, target)
+            swapped = True
         except BaseException:
             swapdir.remove_tree(stage)
             raise
     finally:
         lock.__exit__(None, None, None)
+        if made and not swapped:
+            with contextlib.suppress(OSError):  # not empty: another sweep's, or a user's, now
+                root.rmdir()

@@ -1,13 +1,12 @@
-"""A sweep's runs, every one checked before any starts, none kept loaded: the plan and its checks.
+"""A sweep's runs, none kept loaded: the plan, its combinations checked in full before any run.
 
-`check(scenarios, axes, seeds)` checks the whole matrix up front and returns a `Plan`. Each
-distinct combination of a scenario file and the swept values (a `matrix.Combo`) is loaded and
-checked in full once, with the first seed; what only the seed changes, the objects its `generate`
-blocks draw, is then checked for every other seed by drawing them again (`runner.sweep.reseed`:
-the placement, and the `exact` model's room to move), at the cost of the drawing alone. A seed the
-drawing refuses is loaded in full for the located message (`FILE:LINE:COL: error: in the sweep run
-..., seed=N: ...`). Progress shows runs checked on a terminal; the loaded scenarios are dropped as
-soon as they are checked, so memory does not grow with the runs.
+`check(scenarios, axes, seeds)` loads and checks in full, once, each distinct combination of a
+scenario file and the swept values (a `matrix.Combo`), with the first seed, and returns a `Plan`.
+What only a seed changes, the objects its `generate` blocks draw, is checked for every other seed
+while the sweep runs, ahead of the runs and before each is sent (`runner.sweep.seedcheck`), so a
+sweep of many seeds starts at once (docs/how-to/dask.md). Progress shows the combinations checked
+on a terminal; the loaded scenarios are dropped as soon as they are checked, so memory does not
+grow with the runs.
 
 A `Plan` keeps the combinations only (their values, columns and sort keys), grouped by what comes
 before the seed in a run's sort key (the scenario's name and the dotted keys' values) and sorted
@@ -15,11 +14,13 @@ within a group by the run settings. `Plan.runs()` yields the runs in their sorte
 order, then seeds, then the group's combinations), numbered from 0, without loading anything; the
 same order and numbering as sorting every run's parameters, so rows come out the same. A worker
 gets each run as (its combination's scenario, the seed) and draws its objects itself (`base`
-loads a combination's scenario for the runs being sent, a few at a time).
+loads a combination's scenario for the runs being sent or checked, a few at a time; the sweep
+calls it from two threads, the sender's and the seed checks').
 """
 
 from __future__ import annotations
 
+import threading
 from collections import OrderedDict
 from dataclasses import dataclass
 
@@ -27,7 +28,7 @@ from collide2d.runner import lanes
 from collide2d.runner.scenario.limits import Limits
 from collide2d.runner.sweep import matrix
 from collide2d.runner.sweep.matrix import RUN_KEYS, Combo, SweepError
-from collide2d.runner.sweep.reseed import Reseeded, reseed
+from collide2d.runner.sweep.reseed import reseed
 
 BASES_KEPT = 64  # combinations' scenarios kept loaded while their runs are sent
 
@@ -74,6 +75,7 @@ class Plan:
             for c in group:
                 self.ref_sizes[c.ref] = self.ref_sizes.get(c.ref, 0) + 1
         self._bases: OrderedDict = OrderedDict()
+        self._bases_lock = threading.Lock()
 
     def __len__(self) -> int:
         return self.total
@@ -89,15 +91,17 @@ class Plan:
 
     def base(self, combo: Combo):
         """The scenario of `combo` as loaded for its first seed (the workers draw each run's
-        own); the last BASES_KEPT stay loaded."""
-        if combo in self._bases:
-            self._bases.move_to_end(combo)
-            return self._bases[combo]
+        own); the last BASES_KEPT stay loaded. Safe to call from several threads."""
+        with self._bases_lock:
+            if combo in self._bases:
+                self._bases.move_to_end(combo)
+                return self._bases[combo]
         first = self.seeds[0] if self.seeds else None
-        scenario = matrix.load_run(combo, first, self.limits)
-        self._bases[combo] = scenario
-        while len(self._bases) > BASES_KEPT:
-            self._bases.popitem(last=False)
+        scenario = matrix.load_run(combo, first, self.limits)  # outside the lock: it takes a while
+        with self._bases_lock:
+            self._bases[combo] = scenario
+            while len(self._bases) > BASES_KEPT:
+                self._bases.popitem(last=False)
         return scenario
 
     def scenario(self, run: Run):
@@ -117,18 +121,18 @@ def check(
     limits: Limits | None = None,
     progress=None,
 ) -> Plan:
-    """Check every run of the matrix (see the module docstring); `progress(total)` gives a bar
-    (runner.output.progress.Progress) or None."""
+    """Check every combination of the matrix in full (see the module docstring);
+    `progress(total)` gives a bar of the combinations (runner.output.progress.Progress) or None."""
     limits = limits or Limits()
     count = matrix.check_axes(scenarios, axes, seeds)
     dotted = [a for a in axes if a.key not in RUN_KEYS]
-    bar = progress(count) if progress is not None else None
+    per_combo = len(seeds) if seeds else 1
+    bar = progress(count // per_combo) if progress is not None else None
     seen: dict[tuple, Combo] = {}
     names: dict[str, str] = {}
     done = 0
-    per_combo = len(seeds) if seeds else 1
     try:
-        with lanes.loads(count):
+        with lanes.loads(count // per_combo):
             for path in scenarios:
                 first = seeds[0] if seeds else None
                 for chosen, model in matrix.choices(path, axes, first, limits):
@@ -140,17 +144,8 @@ def check(
                             "told apart by the scenario's name"
                         )
                     names[name] = path
-                    key = (combo.head, combo.tail)
-                    if key in seen:  # the same runs as a combination before it
-                        done += per_combo
-                    else:
-                        seen[key] = combo
-                        done += 1
-                        for seed in (seeds or ())[1:]:
-                            _check_seed(combo, scenario, seed, limits)
-                            done += 1
-                            if bar is not None and done % 64 == 0:
-                                bar.update(done)
+                    seen.setdefault((combo.head, combo.tail), combo)  # else the same runs
+                    done += 1
                     if bar is not None:
                         bar.update(done)
                     del scenario
@@ -162,13 +157,3 @@ def check(
         groups.setdefault(combo.head, []).append(combo)
     ordered = [sorted(groups[h], key=lambda c: c.tail) for h in sorted(groups)]
     return Plan(ordered, axes, seeds, limits)
-
-
-def _check_seed(combo: Combo, scenario, seed: int, limits: Limits) -> None:
-    """Refuse the run of `combo` with `seed` as its full load would (a located error)."""
-    try:
-        reseed(scenario, seed)
-    except Reseeded as exc:
-        matrix.load_run(combo, seed, limits)  # refuses it, at its node
-        said = ", ".join(list(combo.shown) + [f"seed={seed}"])
-        raise SweepError(f"{combo.path}: in the sweep run {said}: {exc}") from None

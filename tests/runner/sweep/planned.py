@@ -1,9 +1,9 @@
-"""The sweep tests' view of a small plan: every run with its scenario loaded (as a worker has it),
-which a sweep itself never holds all at once."""
+"""The sweep tests' view of a small plan: every run checked, with its scenario loaded (as a worker
+has it), which a sweep itself never holds all at once."""
 
 from __future__ import annotations
 
-from collide2d.runner.sweep import plan
+from collide2d.runner.sweep import plan, seedcheck
 
 
 class Loaded:
@@ -17,6 +17,9 @@ class Loaded:
 
 
 def expand(paths, axes, seeds, limits=None) -> list[Loaded]:
-    """Every run of the checked matrix, in order, each with its scenario."""
+    """Every run of the matrix, in order, each checked as a sweep checks it before sending it
+    (its seed's drawing), with its scenario."""
     checked = plan.check(paths, axes, seeds, limits)
+    for run in checked.runs():
+        seedcheck.check_run(checked, run)
     return [Loaded(checked, run) for run in checked.runs()]

@@ -1,4 +1,4 @@
-"""Sweeps in bounded memory and in a folder of their own: every run checked before any starts but
+"""Sweeps in bounded memory and in a folder of their own: every run checked before it is sent but
 none kept loaded, a seed's objects drawn again exactly as the loader draws them, OUT/sweep/ locked
 and swapped in whole, the project's `out` setting, and --scheduler checked at the option."""
 
@@ -85,7 +85,7 @@ def test_a_seed_is_drawn_again_exactly_as_the_loader_draws_it_and_refused_alike(
         want = loads(edited, FIFTY)
         np.testing.assert_array_equal(run.scenario.bodies.pos, want.bodies.pos)
         np.testing.assert_array_equal(run.scenario.bodies.vel, want.bodies.vel)
-    # seed 4 loads; seed 5 is refused by the check of its drawing alone, before anything runs,
+    # seed 4 loads; seed 5 is refused by the check of its drawing alone, before its run is sent,
     # with the loader's located message naming the run
     with pytest.raises(ScenarioError) as err:
         expand([str(path)], [], (4, 5))
