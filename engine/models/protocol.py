@@ -36,9 +36,9 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
+import collide2d.engine.models.guard as guard
 from collide2d.engine.errors import Runaway
 from collide2d.engine.events import AXIS_NAMES, EV_PAIR, EV_WALL, EVENT_DTYPE, SIDE_NAMES
-from collide2d.engine.models import guard
 from collide2d.engine.world import Bodies, WorldSpec
 
 # The scenario's model settings a plugin may take (its `OPTIONS`): the shape geometry.
