@@ -28,28 +28,25 @@ SHOWN_CHARS = 80
 
 def text(obj, limit: int = TEXT_CHARS) -> str:
     """str(obj) on one line, at most `limit` characters; "<str() failed>" when str() raises."""
-    try:
-        said = str(obj)
-        if not isinstance(said, str):
-            raise TypeError
-        return " ".join(said[: limit * 4].split())[:limit]
-    except KeyboardInterrupt:
-        raise
-    except BaseException:
-        return "<str() failed>"
+    return _one_line(str, obj, limit)
 
 
 def shown(obj, limit: int = SHOWN_CHARS) -> str:
     """repr(obj) on one line, at most `limit` characters; "<repr() failed>" when repr() raises."""
+    return _one_line(repr, obj, limit)
+
+
+def _one_line(say, obj, limit: int) -> str:
+    """say(obj) (str or repr) on one line, at most `limit` characters, whatever it raises."""
     try:
-        said = repr(obj)
+        said = say(obj)
         if not isinstance(said, str):
             raise TypeError
         return " ".join(said[: limit * 4].split())[:limit]
     except KeyboardInterrupt:
         raise
     except BaseException:
-        return "<repr() failed>"
+        return f"<{say.__name__}() failed>"
 
 
 def class_name(cls: type) -> str:

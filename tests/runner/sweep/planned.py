@@ -23,3 +23,13 @@ def expand(paths, axes, seeds, limits=None) -> list[Loaded]:
     for run in checked.runs():
         seedcheck.check_run(checked, run)
     return [Loaded(checked, run) for run in checked.runs()]
+
+
+# three 10 px boxes in a 20 px world: only some seeds place them all (4 does, 5 and 154 do not)
+CRAMPED = """version: 1
+world: {width: 20, height: 20}
+model: paper
+ticks: 1
+generate:
+  - {count: 3, shape: box, size: 10, speed: 10, seed: 0}
+"""

@@ -18,18 +18,12 @@ from collide2d.runner.scenario.load import Scenario, ScenarioError, loads
 from collide2d.runner.sweep import cluster, driver
 from collide2d.runner.sweep.matrix import parse_set
 
+from .planned import CRAMPED
+
 pytest.importorskip("distributed")
 
 SCENARIOS = Path(__file__).resolve().parents[3] / "scenarios"
 FIFTY = str(SCENARIOS / "paper_fifty_boxes.yaml")
-# three 10 px boxes in a 20 px world: only some seeds place them all (4 does, 5 does not)
-CRAMPED = """version: 1
-world: {width: 20, height: 20}
-model: paper
-ticks: 1
-generate:
-  - {count: 3, shape: box, size: 10, speed: 10, seed: 0}
-"""
 
 
 def _live_scenarios() -> int:

@@ -13,6 +13,8 @@ from collide2d.runner.command.main import main
 from collide2d.runner.scenario import generate as gen
 from collide2d.runner.sweep import results
 
+from .planned import CRAMPED
+
 pytest.importorskip("distributed")
 
 SCENARIOS = Path(__file__).resolve().parents[3] / "scenarios"
@@ -20,14 +22,7 @@ FIFTY = str(SCENARIOS / "paper_fifty_boxes.yaml")
 # The longest the first run's result may take to come back (an embedded cluster of one worker
 # process starting on a busy machine): a check held back until then never waits longer.
 FIRST_RESULT_S = 90
-# three 10 px boxes in a 20 px world: these seeds place them all, 154 does not
-CRAMPED = """version: 1
-world: {width: 20, height: 20}
-model: paper
-ticks: 1
-generate:
-  - {count: 3, shape: box, size: 10, speed: 10, seed: 0}
-"""
+# seeds that place CRAMPED's boxes, and one that does not
 PLACED = (4, 29, 34, 41, 55, 66, 71, 81, 85, 93, 113, 118, 127, 142, 147, 149)
 REFUSED = 154
 
