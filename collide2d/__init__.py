@@ -9,9 +9,10 @@ The public Python API (docs/reference/api.md):
   `CheckResult`.
 
 A refused scenario raises `ScenarioError` (`FILE:LINE:COL: error: MESSAGE`); a run a model stops
-raises `RunStopped`; a plugin model that raises or breaks the model protocol raises `ModelError`
-(`collide2d.engine.models.protocol`, which also defines the protocol, `Model`). The `collide2d`
-command is a layer over these.
+raises `RunStopped`; a run written to a folder that Ctrl-C stops raises `RunInterrupted` (a
+KeyboardInterrupt) once the run so far is written; a plugin model that raises or breaks the model
+protocol raises `ModelError` (`collide2d.engine.models.protocol`, which also defines the protocol,
+`Model`). The `collide2d` command is a layer over these.
 
 The distribution installs three import packages: `collide2d` (this one: the API, the version and
 `python -m collide2d`), `collide2d.engine` (the simulation, from the repository's `engine/`
@@ -30,7 +31,7 @@ from collide2d.api import CheckResult, Result, ScenarioCheck, check, load, run
 
 if TYPE_CHECKING:
     from collide2d.engine.models.protocol import Model, ModelError
-    from collide2d.runner.run import RunStopped
+    from collide2d.runner.run import RunInterrupted, RunStopped
     from collide2d.runner.scenario.limits import Limits
     from collide2d.runner.scenario.load import Scenario, ScenarioError
 
@@ -40,6 +41,7 @@ __all__ = [
     "Model",
     "ModelError",
     "Result",
+    "RunInterrupted",
     "RunStopped",
     "Scenario",
     "ScenarioCheck",
@@ -55,6 +57,7 @@ _LAZY = {
     "Limits": "collide2d.runner.scenario.limits",
     "Model": "collide2d.engine.models.protocol",
     "ModelError": "collide2d.engine.models.protocol",
+    "RunInterrupted": "collide2d.runner.run",
     "RunStopped": "collide2d.runner.run",
     "Scenario": "collide2d.runner.scenario.load",
     "ScenarioError": "collide2d.runner.scenario.load",

@@ -190,6 +190,10 @@ def run(
         ScenarioError: the scenario is refused (or, with `out`, the output would pass a limit).
         RunStopped: the model stopped the run (a runaway); `str(err)` says why. With `out`, the
             run folder then holds the run so far (`err.folder`; docs/limits.md#runaways).
+        RunInterrupted: with `out`, Ctrl-C stopped the run; the run folder holds the run so far
+            (`err.folder`, its summary `err.summary`; docs/outputs.md#interrupted-runs). It is
+            a KeyboardInterrupt, as Ctrl-C raises without `out`: the calling program stops too
+            unless it catches it.
         ModelError: a plugin model raised or broke the model protocol; `str(err)` names it.
         TypeError, ValueError: an argument is refused (`frames=True`, `overlay=["nope"]`,
             `scale=0`); the message starts with it, and nothing has run.

@@ -24,6 +24,11 @@ default is compiled, unless the environment says `COLLIDE2D_JIT=0` (or numba's o
 `NUMBA_DISABLE_JIT=1`). Both lanes give the same bytes: the kernels' arithmetic is int64 and
 float64 in both, and the golden tests run every scenario in both lanes.
 
+A compiled kernel releases the GIL while it runs (numba's `nogil`), whatever options it declares:
+the other threads of the process run meanwhile, such as the one that ends a command within a
+second of Ctrl-C when a long chunk of ticks holds the main thread (docs/command-line.md, "Progress
+and Ctrl-C"). No kernel touches a Python object, so nothing else changes.
+
 Inside a compiled kernel, a call to another kernel is numba's own call: a `Kernel` shows numba its
 dispatcher's type (`_numba_type_`) and, for `inline="always"`, the `targetoptions` and `py_func`
 numba's inliner reads. `overload(func)` registers a numba implementation of `func` the first time
@@ -210,6 +215,7 @@ class Kernel:
             if scope.get("prange") is range:
                 scope["prange"] = numba.prange
             cache = options.pop("cache", False)
+            options.setdefault("nogil", True)  # other threads run meanwhile (module docstring)
             dispatcher = numba.njit(**options)(self.py_func)
             if cache:
                 dispatcher._cache = _package_cache()(self.py_func)

@@ -6,6 +6,7 @@ One package or module per concern, each importing only those listed before it (a
   beside the engine;
 - `scenario`: reading and checking a scenario file;
 - `output`: what the runner writes and shows, and where;
+- `interrupt`: Ctrl-C answered within a second, whatever runs (the command's watchdog);
 - `run`: a model driven over a scenario's ticks, its frames and events handed to the writers;
 - `command`: the command line and the project's settings;
 - `stress`, `bench`, `sweep` and `golden`: the commands with a package of their own (a sweep reports

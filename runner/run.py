@@ -18,11 +18,15 @@ under `auto`, a run starts interpreted and goes on compiled between two chunks o
 the summary's `kernels` says which). Kernels compiled during a run (a first run, before numba has
 cached them) are timed apart (`runner.compiling`): the summary's `compile_time_s` holds them and
 `run_time_s` leaves them out. Ctrl-C during `run_to_dir` stops the run at the end of the current
-chunk of ticks: what was written so far (events, PNG frames, the final state at that tick, a
-summary with `interrupted_at_tick`) becomes OUT/NAME, without the GIF, which would be an animation
-of part of the run. A runaway during `run_to_dir` does the same at the end of the last whole chunk
-before it (its summary holds `stopped_at_tick` and the error), and then raises RunStopped naming
-that folder.
+chunk of ticks, or at once inside the model's `advance()` (a chunk still compiling its kernels, a
+model plugin's loop), the run then ending where the last whole chunk ended: what was written so
+far (events, PNG frames, the final state at that tick, a summary with `interrupted_at_tick`)
+becomes OUT/NAME, without the GIF, which would be an animation of part of the run, and then
+RunInterrupted (a KeyboardInterrupt) is raised, naming that folder: a Python caller stops too, as
+it would on Ctrl-C anywhere else. A runaway during `run_to_dir` does the same at the end of the
+last whole chunk before it (its summary holds `stopped_at_tick` and the error), and then raises
+RunStopped naming that folder. (What the main thread cannot answer in time, a compiled kernel
+running on, is the `collide2d` command's watchdog's: runner.interrupt.)
 """
 
 from __future__ import annotations
@@ -30,9 +34,7 @@ from __future__ import annotations
 import contextlib
 import os
 import shutil
-import signal
 import sys
-import threading
 import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
@@ -45,7 +47,7 @@ from collide2d.engine.errors import Runaway
 from collide2d.engine.events import empty_events
 from collide2d.engine.invariants import energies, momentum
 from collide2d.engine.picture.raster import Renderer
-from collide2d.runner import compiling, lanes
+from collide2d.runner import compiling, interrupt, lanes
 from collide2d.runner.output import budget
 from collide2d.runner.output import files as outputs
 from collide2d.runner.output import folder as rundir
@@ -56,10 +58,11 @@ from collide2d.runner.scenario.frames import FrameRule
 from collide2d.runner.scenario.limits import Limits
 from collide2d.runner.scenario.load import Scenario, ScenarioError
 
-# Ticks per model call when nothing else ends a chunk: about CHUNK_S seconds of ticks at the
-# pace of the calls so far (FIRST_CHUNK_TICKS before any), at most CHUNK_TICKS: long enough that
-# the kernel dominates, short enough that events stream out, progress moves and Ctrl-C stops the
-# run within a fraction of a second even where one tick takes long (a dense scene).
+# Ticks per model call when nothing else ends a chunk: about CHUNK_S seconds of ticks and of
+# their outputs at the pace of the chunks so far (FIRST_CHUNK_TICKS before any), at most
+# CHUNK_TICKS: long enough that the kernel dominates, short enough that events stream out, progress
+# moves and Ctrl-C stops the run within a fraction of a second even where one tick takes long or
+# makes many events to write (a dense scene).
 CHUNK_TICKS = 65_536
 CHUNK_S = 0.25
 FIRST_CHUNK_TICKS = 16
@@ -75,6 +78,16 @@ class RunStopped(Exception):
     def __init__(self, message: str, folder: Path | None = None):
         super().__init__(message)
         self.folder = folder
+
+
+class RunInterrupted(KeyboardInterrupt):
+    """Ctrl-C stopped a run that writes its files: OUT/NAME (`folder`) holds the run so far, its
+    `summary` (summary.json's, with `interrupted_at_tick`) too. str(err) says where it stopped."""
+
+    def __init__(self, message: str, folder: Path, summary: dict):
+        super().__init__(message)
+        self.folder = folder
+        self.summary = summary
 
 
 @dataclass
@@ -109,10 +122,12 @@ def drive(
     the model at tick 0 and after every tick (the viewer records each tick's state); the model then
     advances one tick per call. overlay: a `runner.output.overlay.Overlay`; it may wrap the model,
     takes the events and draws over each frame before `on_frame` sees it. interruptible: Ctrl-C
-    (SIGINT, in the main thread) ends the run after the current chunk of ticks; the summary then
-    holds `interrupted_at_tick`. And a runaway ends it where the last whole chunk ended, instead of
-    raising RunStopped: the returned model is then that state (its positions, velocities and
-    event counts), and the summary holds `stopped_at_tick` and `stopped` (RunStopped's message).
+    (SIGINT, in the main thread) ends the run after the current chunk of ticks, or inside the
+    model's `advance()` at once, where the last whole chunk ended; the summary then holds
+    `interrupted_at_tick`. And a runaway ends it where the last whole chunk ended, instead of
+    raising RunStopped. Ended where the last whole chunk ended, the returned model is that state
+    (its positions, velocities and event counts); after a runaway the summary holds
+    `stopped_at_tick` and `stopped` (RunStopped's message).
     """
     if not isinstance(frames, FrameRule):
         frames = FrameRule.of(frames, scenario.ticks)
@@ -146,9 +161,10 @@ def _drive(
     start = _energy_momentum(scenario, model)
     began = time.perf_counter()
     compiled_before = compiling.seconds()
-    interrupted = _Interrupt() if interruptible else None
+    interrupted = interrupt.RunStop() if interruptible else None
     kept = _Kept(model) if interruptible else None  # the state at the last whole chunk's end
     stopped = None
+    cut = False  # Ctrl-C inside the model's advance(): the run ends where the last chunk ended
     pace = _Pace()
 
     if on_tick is not None:
@@ -157,7 +173,7 @@ def _drive(
     if next_frame == 0:
         on_frame(0, _drawn(renderer, model, 0, overlay))
         next_frame = frames.next_from(1)
-    with interrupted or _NoInterrupt():
+    with interrupted or contextlib.nullcontext():
         while model.tick < scenario.ticks and not (interrupted and interrupted.seen):
             stop = min(scenario.ticks, model.tick + pace.ticks())
             if next_frame is not None:
@@ -165,9 +181,12 @@ def _drive(
             if on_tick is not None:
                 stop = model.tick + 1
             stop = model.tick + lane.step(stop - model.tick)
+            ticks = stop - model.tick
+            pace.start()
             try:
-                with lane.timed(stop - model.tick), pace.timed(stop - model.tick):
-                    events = model.advance(stop - model.tick, logging)
+                with lane.timed(ticks):
+                    with interrupted.advancing() if interrupted else contextlib.nullcontext():
+                        events = model.advance(ticks, logging)
             except Runaway as exc:
                 when = (
                     f"tick {stop}" if stop == model.tick + 1 else f"ticks {model.tick + 1}-{stop}"
@@ -178,6 +197,11 @@ def _drive(
                 )
                 if kept is None:
                     raise RunStopped(stopped) from None
+                break
+            except BaseException as exc:
+                if not (interrupted and interrupted.seen and interrupt.from_ctrl_c(exc)):
+                    raise
+                cut = True
                 break
             if log_events and len(events) and on_events is not None:
                 on_events(events)
@@ -193,9 +217,10 @@ def _drive(
                 progress.update(model.tick)
             if kept is not None:
                 kept.take(model)
+            pace.took(ticks)
     run_time = time.perf_counter() - began - (compiling.seconds() - compiled_before)
-    if stopped is not None:
-        model = kept  # the broken model's state is past the outputs written: the kept one is not
+    if stopped is not None or cut:
+        model = kept  # the model's state is past the outputs written: the kept one is not
     if progress is not None:
         progress.close()
 
@@ -278,51 +303,25 @@ def _drawn(renderer, model, k: int, overlay) -> np.ndarray:
 
 
 class _Pace:
-    """How many ticks the next model call runs: CHUNK_S seconds at the pace of the last call;
-    `timed` wraps each call, leaving out the time spent compiling kernels."""
+    """How many ticks the next model call runs: CHUNK_S seconds at the pace of the last chunk,
+    from `start` (before the call) to `took` (once its events are written and its frame drawn:
+    in a dense scene, writing the events takes longer than the ticks), leaving out the time spent
+    compiling kernels."""
 
     def __init__(self):
-        self.per_tick = None  # seconds per tick of the last call
+        self.per_tick = None  # seconds per tick of the last chunk
 
     def ticks(self) -> int:
         if self.per_tick is None:
             return FIRST_CHUNK_TICKS
         return int(min(CHUNK_TICKS, max(1, CHUNK_S / max(self.per_tick, 1e-9))))
 
-    @contextlib.contextmanager
-    def timed(self, ticks: int):
-        began, compiled = time.perf_counter(), compiling.seconds()
-        yield
-        spent = time.perf_counter() - began - (compiling.seconds() - compiled)
+    def start(self) -> None:
+        self._began, self._compiled = time.perf_counter(), compiling.seconds()
+
+    def took(self, ticks: int) -> None:
+        spent = time.perf_counter() - self._began - (compiling.seconds() - self._compiled)
         self.per_tick = max(spent, 0.0) / max(ticks, 1)
-
-
-class _Interrupt:
-    """While open (in the main thread), SIGINT sets `seen` instead of raising KeyboardInterrupt."""
-
-    def __init__(self):
-        self.seen = False
-        self.previous = None
-
-    def __enter__(self):
-        if threading.current_thread() is threading.main_thread():
-            self.previous = signal.signal(signal.SIGINT, self._caught)
-        return self
-
-    def _caught(self, signum, frame) -> None:
-        self.seen = True
-
-    def __exit__(self, *exc) -> None:
-        if self.previous is not None:
-            signal.signal(signal.SIGINT, self.previous)
-
-
-class _NoInterrupt:
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc) -> None:
-        return None
 
 
 def simulate(
@@ -430,6 +429,13 @@ def write_run(
     except rundir.OutputBusy as exc:
         raise ScenarioError(scenario.path or "<scenario>", 1, 1, str(exc)) from None
     summary = result.summary
+    if "interrupted_at_tick" in summary:  # Ctrl-C: the run so far is written, then the caller's
+        raise RunInterrupted(
+            f"interrupted at tick {summary['interrupted_at_tick']:,} of {scenario.ticks:,}; "
+            f"{target} holds the run so far (no GIF)",
+            target,
+            summary,
+        )
     if "stopped_at_tick" in summary:  # a runaway: the run so far is written, then the error
         raise RunStopped(
             f"{summary['stopped']}\n{target} holds the run up to tick "

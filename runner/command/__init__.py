@@ -8,7 +8,7 @@ The commands with a package of their own (`runner.golden`, `runner.stress`, `run
 `runner.sweep`) are loaded by name, only when their command runs.
 
 It may import `collide2d.engine`, `runner.lanes`, `runner.compiling`, `runner.scenario`,
-`runner.output` and `runner.run`: everything below the command line. Only `python -m collide2d`
-and the commands with a package of their own import it (the exit statuses, the shared options,
-the settings).
+`runner.output`, `runner.interrupt` and `runner.run`: everything below the command line. Only
+`python -m collide2d` and the commands with a package of their own import it (the exit statuses,
+the shared options, the settings).
 """

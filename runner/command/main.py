@@ -9,7 +9,10 @@ bench or sweep code; `--help` and an unknown command load them all. Exit status:
 found a difference, 2 bad input or usage, 3 an unexpected error (one line naming the scenario; the
 traceback too with `--debug`), a model plugin's crash or protocol break among them (the line names
 the model). A refused scenario prints `FILE:LINE:COL: error: MESSAGE` on stderr
-and writes nothing.
+and writes nothing. Ctrl-C is exit 130 (130 is what a command stopped by Ctrl-C returns); the
+`collide2d` command itself ends within a second of it, whatever it runs (runner.interrupt), and
+`main(argv)` called from Python raises KeyboardInterrupt once the command has answered it, so that
+the calling program (a test suite) stops too.
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ import threading
 import traceback
 from importlib import resources
 
+from collide2d.runner import interrupt
 from collide2d.runner.command.exitcodes import (
     EXIT_BAD_INPUT,
     EXIT_INTERRUPTED,
@@ -167,6 +171,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         limits_from_args,
         overrides_from_args,
     )
+    from collide2d.runner.run import RunInterrupted
 
     project = config.find()
     if args.out and (project.file or project.scenarios.is_dir()):
@@ -184,19 +189,29 @@ def cmd_run(args: argparse.Namespace) -> int:
         path, **overrides_from_args(args), limits=limits, defaults=project.model_defaults()
     )
     out_root = args.out or (project.folder("out") if project.file else "out")
-    result = collide2d.run(
-        scenario,
-        events=scenario.output.events if args.events is None else args.events,
-        out=out_root,
-        png=args.png,
-        gif=args.gif,
-        viewer=args.viewer,
-        overlay=args.overlay,
-        scale=args.scale,
-        quiet=args.quiet,
-        limits=limits,
-    )
-    target, summary = result.folder, result.summary
+    try:
+        result = collide2d.run(
+            scenario,
+            events=scenario.output.events if args.events is None else args.events,
+            out=out_root,
+            png=args.png,
+            gif=args.gif,
+            viewer=args.viewer,
+            overlay=args.overlay,
+            scale=args.scale,
+            quiet=args.quiet,
+            limits=limits,
+        )
+    except RunInterrupted as stop:  # Ctrl-C: the run so far is written (docs/outputs.md)
+        _ran(args, scenario, stop.folder, stop.summary)
+        interrupt.told(f"collide2d: {stop}")
+        return EXIT_INTERRUPTED
+    _ran(args, scenario, result.folder, result.summary)
+    return EXIT_OK
+
+
+def _ran(args: argparse.Namespace, scenario, target, summary: dict) -> None:
+    """The line saying what a run did (not with --quiet)."""
     if not args.quiet:
         counts = summary["events"]
         compiled = summary.get("compile_time_s", 0.0)
@@ -209,14 +224,6 @@ def cmd_run(args: argparse.Namespace) -> int:
             f"{counts['wall']:,} wall and {plural(counts['pair'], 'pair event')} "
             f"in {summary['run_time_s']:.3f}s{also} -> {target}"
         )
-    if "interrupted_at_tick" in summary:
-        print(
-            f"collide2d: interrupted at tick {summary['interrupted_at_tick']:,} of "
-            f"{scenario.ticks:,}; {target} holds the run so far (no GIF)",
-            file=sys.stderr,
-        )
-        return EXIT_INTERRUPTED
-    return EXIT_OK
 
 
 def plural(count: int, noun: str) -> str:
@@ -278,10 +285,12 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    if argv is None:  # the `collide2d` command itself (not a call from Python)
+    called = argv is not None  # from Python, not the `collide2d` command itself
+    if not called:
         from collide2d.runner.command import crashwatch
 
         crashwatch.watch()  # a fatal signal (a crash in a kernel) is told, never silent
+        interrupt.watch()  # Ctrl-C ends the command within a second, whatever it runs
     argv = sys.argv[1:] if argv is None else list(argv)
     command = command_of(argv)
     known = any(command in commands for _m, _f, commands in REGISTRARS)
@@ -295,7 +304,10 @@ def main(argv: list[str] | None = None) -> int:
 
             quiet = getattr(args, "quiet", False) or not sys.stderr.isatty()
             compiling.install(None if quiet else compile_notice)
-        return _answered(args)
+        status = _answered(args)
+    if called and status == EXIT_INTERRUPTED:
+        raise KeyboardInterrupt  # the caller's Ctrl-C too, answered by the command (above)
+    return status
 
 
 def _answered(args: argparse.Namespace) -> int:
@@ -309,7 +321,7 @@ def _answered(args: argparse.Namespace) -> int:
         print(str(err), file=sys.stderr)
         return EXIT_BAD_INPUT
     except Exception as err:
-        if _from_ctrl_c(err):
+        if interrupt.from_ctrl_c(err):
             return _interrupted()
         if type(err).__name__ == "RunStopped":  # runner.run's, not imported unless a run ran
             print(str(err), file=sys.stderr)
@@ -324,21 +336,8 @@ def _answered(args: argparse.Namespace) -> int:
 
 
 def _interrupted() -> int:
-    print("collide2d: interrupted; outputs already written are whole", file=sys.stderr)
+    interrupt.told("collide2d: interrupted; outputs already written are whole")
     return EXIT_INTERRUPTED
-
-
-def _from_ctrl_c(err: BaseException) -> bool:
-    """Whether `err` comes of a Ctrl-C: a compiled kernel that Ctrl-C stopped is reported by
-    numba as a SystemError ("returned a result with an exception set") whose cause, at the end of
-    the chain, is the KeyboardInterrupt."""
-    seen = set()
-    while err is not None and id(err) not in seen:
-        if isinstance(err, KeyboardInterrupt):
-            return True
-        seen.add(id(err))
-        err = err.__cause__ or err.__context__
-    return False
 
 
 # A Ctrl-C that arrives while Python runs a finalizer (`__del__`: numba's compiler frees LLVM
@@ -349,11 +348,9 @@ INTERRUPT_RETRY_S = 0.01
 
 def _interrupt(signum, frame):
     """Raise KeyboardInterrupt, or, inside a finalizer, raise it a moment later (SIGALRM)."""
-    while frame is not None:
-        if frame.f_code.co_name == "__del__" and hasattr(signal, "setitimer"):
-            signal.setitimer(signal.ITIMER_REAL, INTERRUPT_RETRY_S)
-            return
-        frame = frame.f_back
+    if hasattr(signal, "setitimer") and interrupt.in_finalizer(frame):
+        signal.setitimer(signal.ITIMER_REAL, INTERRUPT_RETRY_S)
+        return
     raise KeyboardInterrupt
 
 

@@ -23,7 +23,7 @@ import stat
 from dataclasses import dataclass
 from pathlib import Path
 
-from collide2d.runner.output.swap import temp_name
+from collide2d.runner.output.swap import temp_beside
 
 
 @dataclass
@@ -94,7 +94,7 @@ def _write_temp(target: Path, data: bytes) -> Path:
             mode = None
         flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0)
         while tmp is None:
-            candidate = target.with_name(temp_name(target.name))
+            candidate = temp_beside(target)
             with contextlib.suppress(FileExistsError):
                 fd = os.open(candidate, flags, 0o666)
                 tmp = candidate

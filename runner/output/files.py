@@ -61,7 +61,7 @@ def _open_temp(path: Path) -> tuple[Path, int]:
     """
     flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0)
     while True:
-        tmp = path.with_name(swapdir.temp_name(path.name))
+        tmp = swapdir.temp_beside(path)
         try:
             return tmp, os.open(tmp, flags, 0o666)
         except FileExistsError:

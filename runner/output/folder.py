@@ -13,6 +13,10 @@ and the old run stays as it was.
 Nothing is followed through a symbolic link: a link at `OUT/NAME` or inside it is refused, and the
 old folder is removed only when it holds nothing but the files a run writes, so a file a user put
 there is never deleted (the run is refused and names it instead).
+
+A process ended before its run is written (Ctrl-C that it did not answer in time,
+runner.interrupt) leaves OUT as a failed run does: `abandon` removes its staging folders and
+temporary files (runner.output.swap.abandon) and the lock files it holds.
 """
 
 from __future__ import annotations
@@ -34,6 +38,8 @@ except ImportError:  # pragma: no cover - not on POSIX
 RUN_FILES = ("animation.gif", "events.jsonl", "final.csv", "summary.json", "viewer.html")
 FRAME_FILE_RE = re.compile(r"^frame_\d{6,}\.png$")
 STAGE = "run"  # the kind of a staging folder: `OUT/.NAME.PID.XXXXXXXX.run.tmp`
+
+_held: set[Path] = set()  # the lock files of the RunLocks this process holds, for `abandon`
 
 
 class OutputBusy(Exception):
@@ -77,11 +83,13 @@ class RunLock:
         os.ftruncate(fd, 0)
         os.write(fd, f"{os.getpid()}\n".encode("ascii"))
         self.fd = fd
+        _held.add(self.path)
         return self
 
     def __exit__(self, *exc) -> None:
         if self.fd is None:
             return
+        _held.discard(self.path)
         with contextlib.suppress(FileNotFoundError):
             os.unlink(self.path)
         os.close(self.fd)  # releases the flock
@@ -133,6 +141,17 @@ def clean_leftovers(root: Path, name: str) -> None:
     (the run was cut between its two renames), and removed otherwise.
     """
     swapdir.recover(Path(root) / name, swapdir.leftovers(root, name, (STAGE, swapdir.OLD)))
+
+
+def abandon() -> list[Path]:
+    """Undo the writes this process has not finished, as it is about to end: its staging folders
+    and temporary files removed, its locks' files unlinked (the kernel drops the locks with the
+    process). Returns the output folders whose new run was removed, as they were before it."""
+    undone = swapdir.abandon()
+    for path in list(_held):
+        with contextlib.suppress(OSError):
+            os.unlink(path)
+    return undone
 
 
 def new_stage(root: Path, name: str) -> Path:

@@ -14,10 +14,17 @@ fails the old folder is put back and the new one removed. A writer killed betwee
 leaves the old folder whole under its aside name: `recover` puts it back when TARGET is missing and
 removes the other leftovers it is given. A tree is removed only when it is a real folder, and links
 inside it are removed, never followed.
+
+A process that must end before its writes are done (Ctrl-C that the command did not answer in
+time, runner.interrupt) first calls `stop_renames`, which waits for a swap under way and lets no
+other start, then `abandon`, which removes every temporary file and folder of its own (named with
+its pid) in the folders it made them in, except an old folder moved aside. What it leaves is what
+a finished or failed write leaves: the old folder whole, nothing half written.
 """
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import errno
 import os
@@ -25,12 +32,18 @@ import re
 import secrets
 import shutil
 import stat
+import threading
 from pathlib import Path
 
 TMP_SUFFIX = ".tmp"
 OLD = "old"  # the kind of the old folder moved aside during a swap
 _AT_FDCWD = -100
 _RENAME_EXCHANGE = 2
+
+# The folders this process has made temporaries in (for `abandon`), and the lock held while it
+# renames folders (for `stop_renames`).
+_made_in: set[str] = set()
+_renaming = threading.Lock()
 
 
 def temp_name(name: str, kind: str = "") -> str:
@@ -40,10 +53,18 @@ def temp_name(name: str, kind: str = "") -> str:
     return f".{name}.{os.getpid()}.{secrets.token_hex(4)}{middle}{TMP_SUFFIX}"
 
 
+def temp_beside(path: Path, kind: str = "") -> Path:
+    """A fresh temporary name beside `path` (`temp_name` of its name, in its folder), that
+    folder noted for `abandon`."""
+    path = Path(path)
+    _made_in.add(os.fspath(path.parent))
+    return path.with_name(temp_name(path.name, kind))
+
+
 def temp_path(parent: Path, name: str, kind: str) -> Path:
     """A temporary folder name of ours for PARENT/NAME that nothing holds yet (not created)."""
     while True:
-        path = Path(parent) / temp_name(name, kind)
+        path = temp_beside(Path(parent) / name, kind)
         if _lstat(path) is None:
             return path
 
@@ -51,7 +72,7 @@ def temp_path(parent: Path, name: str, kind: str) -> Path:
 def make_temp(parent: Path, name: str, kind: str) -> Path:
     """A new empty temporary folder of ours for PARENT/NAME."""
     while True:
-        path = Path(parent) / temp_name(name, kind)
+        path = temp_beside(Path(parent) / name, kind)
         try:
             os.mkdir(path)
             return path
@@ -86,9 +107,10 @@ def newest_aside(found) -> Path | None:
 def recover(target: Path, found) -> None:
     """Undo what killed swaps of TARGET left: put the newest old folder aside among `found` back
     when TARGET is missing, then remove the rest of `found`."""
-    back = newest_aside(found) if _lstat(target) is None else None
-    if back is not None:
-        os.rename(back, target)
+    with _renaming:
+        back = newest_aside(found) if _lstat(target) is None else None
+        if back is not None:
+            os.rename(back, target)
     for path, _pid, _kind in found:
         if path != back:
             remove_tree(path)
@@ -130,6 +152,11 @@ def swap_in(new: Path, target: Path, *, atomic: bool = False) -> None:
     atomic: swap the two names in one step where the system can (else two renames).
     When a rename fails the old folder is put back (if it can be) and `new` is removed.
     """
+    with _renaming:
+        _swap_in(new, target, atomic)
+
+
+def _swap_in(new: Path, target: Path, atomic: bool) -> None:
     parent, aside = Path(target).parent, None
     try:
         if _lstat(target) is not None:
@@ -151,6 +178,40 @@ def swap_in(new: Path, target: Path, *, atomic: bool = False) -> None:
     fsync_dir(parent)
     if aside is not None:
         remove_tree(aside)
+
+
+def stop_renames(timeout: float) -> bool:
+    """Wait up to `timeout` seconds for a swap under way to end, and let no other start in this
+    process (for good: it is about to end); False when the swap did not end in time."""
+    return _renaming.acquire(timeout=timeout)
+
+
+def abandon() -> list[Path]:
+    """Remove the temporary files and folders of this process (its pid in their names) from every
+    folder it made one in, but an old folder moved aside (a swap cut between its two renames:
+    `recover` puts it back); returns the targets of the folders removed (PARENT/NAME of each
+    `.NAME.PID.HEX.KIND.tmp`), which are as they were before this process wrote them."""
+    ours = re.compile(
+        rf"\.(?P<name>.+)\.{os.getpid()}\.[0-9a-f]{{8}}"
+        rf"(?:\.(?P<kind>[a-z]+))?{re.escape(TMP_SUFFIX)}"
+    )
+    undone = []
+    for parent in sorted(_made_in):
+        try:
+            entries = list(os.scandir(parent))
+        except OSError:  # gone with a staging folder removed before it
+            continue
+        for entry in sorted(entries, key=lambda e: e.name):
+            m = ours.fullmatch(entry.name)
+            if m is None or m["kind"] == OLD:
+                continue
+            if entry.is_dir(follow_symlinks=False):
+                remove_tree(Path(entry.path))
+                undone.append(Path(parent) / m["name"])
+            else:
+                with contextlib.suppress(OSError):
+                    os.unlink(entry.path)
+    return undone
 
 
 def fsync_dir(path: Path) -> None:

@@ -12,7 +12,7 @@ and the plot), `folder` (OUT/sweep/ locked and swapped in whole), `cli` (the sub
 imported only when a sweep or a cluster check runs.
 
 It may import what the command line may (`collide2d.engine`, `runner.lanes`, `runner.compiling`,
-`runner.scenario`, `runner.output`, `runner.run`), the command line's shared parts
-(`runner.command`: options, settings, exit statuses, the crash watcher) and `runner.bench` (the
-position error, the plots); the command line loads it by name, `check` on a cluster too.
+`runner.scenario`, `runner.output`, `runner.interrupt`, `runner.run`), the command line's shared
+parts (`runner.command`: options, settings, exit statuses, the crash watcher) and `runner.bench`
+(the position error, the plots); the command line loads it by name, `check` on a cluster too.
 """

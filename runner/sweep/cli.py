@@ -19,6 +19,7 @@ import os
 import sys
 from pathlib import Path
 
+from collide2d.runner import interrupt
 from collide2d.runner.command.exitcodes import EXIT_BAD_INPUT, EXIT_OK, EXIT_UNEXPECTED
 from collide2d.runner.output.progress import say
 
@@ -143,15 +144,18 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         # the bar from the start: starting the cluster and compiling the kernels take a while
         progress = cluster.progress_for(len(runs), "sweep", args.quiet)
         try:
-            with (
-                cluster.connect(args.workers, args.scheduler) as client,
-                folder.staged(out_root) as stage,
-            ):
-                if not args.quiet:  # the cluster is up: from here a Ctrl-C writes the rows done
-                    where = args.scheduler or f"{args.workers or os.cpu_count()} local workers"
-                    say(f"sweep: {len(runs)} runs on {where}")
-                table, complete = driver.run_sweep(client, runs, progress=progress)
-                written = results.write(stage, table, complete)
+            with cluster.connect(args.workers, args.scheduler) as client:
+                with folder.staged(out_root) as stage:
+                    if not args.quiet:  # the cluster is up: from here Ctrl-C writes the rows done
+                        where = args.scheduler or f"{args.workers or os.cpu_count()} local workers"
+                        say(f"sweep: {len(runs)} runs on {where}")
+                    table, complete = driver.run_sweep(client, runs, progress=progress)
+                    written = results.write(stage, table, complete)
+                if not complete:  # said before the cluster closes, which may take seconds
+                    interrupt.told(  # that Ctrl-C does not wait for (runner.interrupt)
+                        f"sweep: cancelled; {table.done} of {len(runs)} runs written, marked "
+                        f"incomplete -> {Path(out_root) / folder.NAME}"
+                    )
         finally:
             if progress is not None:
                 progress.close()
@@ -165,11 +169,6 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         return EXIT_BAD_INPUT
     target = Path(out_root) / folder.NAME
     if not complete:
-        print(
-            f"sweep: cancelled; {table.done} of {len(runs)} runs written, marked incomplete -> "
-            f"{target}",
-            file=sys.stderr,
-        )
         return EXIT_CANCELLED
     failed = [r for r in table.rows() if r["status"] == "error"]
     for row in failed:

@@ -22,7 +22,8 @@ def interrupted(started: str, cmd: list, cwd, wait_s: float = 0.0, timeout_s: fl
     """Start `cmd` as `started` says, in a process group of its own; once it has printed its first
     line on stderr (and `wait_s` more seconds), send SIGINT to the whole group, as a terminal's
     Ctrl-C does. Returns (that first line, the process, its stdout, the rest of its stderr) once
-    it has ended; a process still running after `timeout_s` is killed."""
+    it has ended, the process's `took_s` the seconds from SIGINT to its end; a process still
+    running after `timeout_s` is killed."""
     proc = subprocess.Popen(
         [*STARTED[started], *map(str, cmd)],
         cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL,
@@ -32,7 +33,9 @@ def interrupted(started: str, cmd: list, cwd, wait_s: float = 0.0, timeout_s: fl
         first = proc.stderr.readline()
         time.sleep(wait_s)
         os.killpg(proc.pid, signal.SIGINT)
+        sent = time.monotonic()
         out, err = proc.communicate(timeout=timeout_s)
+        proc.took_s = time.monotonic() - sent
     finally:
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)

@@ -390,6 +390,7 @@ def test_ctrl_c_stops_any_command_even_started_with_sigint_ignored(tmp_path, sta
     )
     assert first.startswith("error"), first  # the first progress line: the bench was under way
     assert proc.returncode == 130, err
+    assert proc.took_s < 1.5, f"ended {proc.took_s:.2f} s after Ctrl-C"
     assert "interrupted; outputs already written are whole" in err
     assert "Traceback" not in err
     assert not (tmp_path / "bench").exists()

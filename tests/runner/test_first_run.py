@@ -220,9 +220,10 @@ output: {frames: none, gif: false, events: true}
 """
 
 
-def test_ctrl_c_stops_a_dense_run_within_a_second_or_so(tmp_path):
+def test_ctrl_c_stops_a_dense_run_within_a_second_keeping_the_run_so_far(tmp_path):
     # a tick of 4,000 boxes takes about half a millisecond: a model call of tens of thousands of
-    # ticks would hold Ctrl-C for half a minute; calls of about a quarter of a second do not
+    # ticks would hold Ctrl-C for half a minute; calls of about a quarter of a second do not, when
+    # the quarter counts the writing of their many events too (which takes longer than the ticks)
     path = tmp_path / "dense.yaml"
     path.write_text(DENSE)
     out = tmp_path / "out"
@@ -248,7 +249,7 @@ def test_ctrl_c_stops_a_dense_run_within_a_second_or_so(tmp_path):
     assert proc.returncode == 130
     summary = json.loads((out / "dense" / "summary.json").read_text())
     assert 0 < summary["interrupted_at_tick"] < 1_000_000
-    assert took < 8.0, f"the run went on {took:.1f} s after Ctrl-C"
+    assert took < 1.5, f"the run went on {took:.1f} s after Ctrl-C"
 
 
 def read_all(fd: int) -> bytes:

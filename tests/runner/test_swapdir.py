@@ -125,3 +125,21 @@ def test_alive_and_fsync_of_a_folder(tmp_path):
     assert not swapdir.alive(_dead_pid())
     swapdir.fsync_dir(tmp_path)
     swapdir.fsync_dir(tmp_path / "missing")  # nothing to flush, no error
+
+
+def test_abandon_removes_what_this_process_was_writing_but_a_folder_moved_aside(
+    tmp_path, monkeypatch
+):
+    """A process ended before its writes are done (runner.interrupt): its staging folders and
+    temporary files go, an old folder a cut swap left aside stays for `recover`, and so does
+    what another process left."""
+    monkeypatch.setattr(swapdir, "_made_in", set())
+    target = _folder(tmp_path / "demo", "the old run")
+    stage = swapdir.make_temp(tmp_path, "demo", "run")
+    (stage / "events.jsonl").write_text("half a log")
+    swapdir.temp_beside(tmp_path / "final.csv").write_text("half a file")
+    aside = _folder(swapdir.temp_path(tmp_path, "other", swapdir.OLD), "an old run aside")
+    theirs = _folder(tmp_path / f".demo.{_dead_pid()}.0123abcd.run.tmp", "another's")
+    assert swapdir.abandon() == [target]
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["demo", aside.name, theirs.name])
+    assert (target / "file.txt").read_text() == "the old run"

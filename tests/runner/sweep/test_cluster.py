@@ -204,6 +204,7 @@ def test_ctrl_c_writes_the_rows_done_marked_incomplete(tmp_path, started):
     )  # fmt: skip
     assert first == "sweep: 40 runs on 2 local workers\n"  # printed once the cluster is up
     assert proc.returncode == 130, f"stdout: {out_text!r}; stderr: {err_text!r}"
+    assert proc.took_s < 1.5, f"ended {proc.took_s:.2f} s after Ctrl-C"  # the cluster not awaited
     assert _group_ends(proc.pid), "a worker process outlived the sweep"
     assert "Traceback" not in err_text and "KeyboardInterrupt" not in err_text
     status = json.loads((out / "sweep" / "sweep.json").read_text())
