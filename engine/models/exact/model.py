@@ -47,9 +47,7 @@ collided is not predicted against itself again (on straight lines it cannot meet
 of the two has another event), so a rounding error cannot make it collide twice. Zero-time chains
 (a row of touching boxes hit at one end) then run as a sequence of events at one instant. A tick
 that needs more than `max_events_per_tick` events raises EventCapExceeded: a runaway is an error,
-never a hang. With gravity, restitution or friction an object that meets the same partners again
-and again at one instant (bounces dying away that floating point never ends) stops the run far
-sooner, named (NotYetExact; jam.py, an event storm).
+never a hang.
 
 An object with no room to move on an axis would collide again and again at one instant: one
 that moves on an axis along which it touches (or overlaps) a wall or a static object on both
@@ -70,7 +68,7 @@ the event log (engine/events.py). The events themselves are applied in apply.py 
 `on_wall`, `on_pair`); this module runs the main loop, `_run`: take the next event, apply it,
 predict again for what it touched. The kernel `_run` (with `predict` inlined) allocates nothing:
 growing the heap or the event log is done in Python between calls (the kernel stops before an event
-it has no room for, and resumes)."""
+it has no room for, and resumes). """
 
 from __future__ import annotations
 
@@ -88,7 +86,6 @@ from collide2d.engine.events import (
     EV_WALL,
     put_event,
 )
-from collide2d.engine.models.exact import jam
 from collide2d.engine.models.exact.apply import (
     on_cross,
     on_leave,
@@ -130,14 +127,7 @@ from collide2d.engine.models.exact.horizonqueue import (
     new_horizons,
     next_top,
 )
-from collide2d.engine.models.exact.jam import (
-    carried_error,
-    jam_error,
-    new_instants,
-    recurs,
-    rest_error,
-    storm_error,
-)
+from collide2d.engine.models.exact.jam import carried_error, jam_error, rest_error
 from collide2d.engine.models.exact.prediction import predict, set_job
 from collide2d.engine.models.exact.state import (
     AX,
@@ -159,14 +149,12 @@ from collide2d.engine.models.exact.state import (
     S_HEAP_N,
     S_LOGGED,
     S_PAIRS,
-    S_STORM,
     S_TICK,
     S_TICK_EVENTS,
     S_WALLS,
     SF_T_NOW,
     SH,
     SHAPE,
-    ST_SIZE,
     STATIC,
     STATUS_CAP,
     STATUS_CARRIED,
@@ -174,7 +162,6 @@ from collide2d.engine.models.exact.state import (
     STATUS_HEAP_FULL,
     STATUS_LOG_FULL,
     STATUS_REST,
-    STATUS_STORM,
     STOP,
     SW,
     TLOC,
@@ -234,22 +221,16 @@ def _run(state, jobs, stack, tick_to, log, cap, everyone, rows, times):
     event): the work the local re-prediction saves. The events and the state are the same, to
     the bit: a prediction reads only the pair's state, and only an event changes it.
 
-    Under gravity, restitution or friction each moving object's events at one instant with the
-    one before, with a partner it has just met, are counted in S.instants (jam.recurs): more than
-    st[S_STORM] of them (0: none counted) are an event storm.
-
     Returns a status: STATUS_DONE; STATUS_HEAP_FULL / STATUS_LOG_FULL (grow, call again: nothing
     was lost); STATUS_CAP (a runaway; stops mid-tick, before the event past the cap, so that a call
-    with a higher cap would resume); STATUS_STORM (a storm, stopped as at the cap, the object it
-    was seen on in jobs' row 0). st[S_LOGGED] counts the rows written, st[S_WALLS] and st[S_PAIRS]
-    every event, logged or not. `state` is the State record as plain tuples
+    with a higher cap would resume). st[S_LOGGED] counts the rows written, st[S_WALLS] and
+    st[S_PAIRS] every event, logged or not. `state` is the State record as plain tuples
     (state.plain).
     """
     S = named(state)
     F, N, cells, HT, HI, HN = S.F, S.N, S.cells, S.HT, S.HI, S.HN
     st, stf, world, Q = S.st, S.stf, S.world, S.Q
     QT, QS = Q.time, Q.state
-    storm, instants = st[S_STORM], S.instants
     n = F.shape[0]
     extra_room = n * n if everyone else 0
     # (The loop's steps are written out here, not as inlined helpers: helpers cost ~15 % of the
@@ -325,23 +306,10 @@ def _run(state, jobs, stack, tick_to, log, cap, everyone, rows, times):
                 n_jobs = on_cross(a, b, N, cells, world, jobs)
             else:
                 st[S_TICK_EVENTS] += 1
-                over = st[S_TICK_EVENTS] > cap
-                stormy = -1  # the object a storm is seen on
-                if storm > 0 and not over and not world.elastic:
-                    # its partner: the other object, or -1 - side (a wall, its stop, its leave)
-                    pa = float(b) if rank == RANK_PAIR else -1.0 - b
-                    if N[a, STATIC] == 0 and recurs(a, pa, t, instants, storm):
-                        stormy = a
-                    if rank == RANK_PAIR and N[b, STATIC] == 0:
-                        if recurs(b, float(a), t, instants, storm) and stormy < 0:
-                            stormy = b
-                if over or stormy >= 0:  # put it back: a call with a higher cap resumes
+                if st[S_TICK_EVENTS] > cap:  # put it back: a call with a higher cap resumes
                     st[S_TICK_EVENTS] -= 1
                     if not horizon:
                         push(HT, HI, HN, st, e)
-                    if stormy >= 0:
-                        set_job(jobs, 0, stormy, -1, JOB_EVENT)
-                        return STATUS_STORM
                     return STATUS_CAP
                 # what a (and b) rested on before: -1 nothing (nothing rests without gravity)
                 rest_a = S.R[a] if falls(world) else -1
@@ -471,7 +439,6 @@ class Model:
         self._P[:, E] = bodies.restitution
         self._P[:, MU] = bodies.friction
         self._R = np.full(n, -1, np.int64)
-        self._instants = new_instants(n)
         self.gravity = world.has_gravity
         self._N = np.zeros((n, 8), np.int64)
         self._N[:, PARTNER] = -1
@@ -511,7 +478,7 @@ class Model:
         self._horizons = new_horizons(
             static, bucket_width(self._F, static, self.cell_size, world.width, world.height)
         )
-        self._st = np.zeros(ST_SIZE, np.int64)
+        self._st = np.zeros(9, np.int64)
         self._stf = np.zeros(1)
         self._jobs = np.zeros((JOB_ROWS, 3), np.int64)  # scratch: the prediction jobs of one event
         self._stack = np.zeros(INSTANT_STACK, np.int64)  # scratch: walking one instant's entries
@@ -520,9 +487,8 @@ class Model:
         """The arrays the kernels share."""
         cells, s_start, s_items = self._G
         HT, HI, HN = self._heap
-        return State(self._F, self._N, self._P, self._R, self._instants, self._C, cells,
-                     s_start, s_items, HT, HI, HN, self._horizons, self._st, self._stf,
-                     self._world)  # fmt: skip
+        return State(self._F, self._N, self._P, self._R, self._C, cells, s_start, s_items,
+                     HT, HI, HN, self._horizons, self._st, self._stf, self._world)  # fmt: skip
 
     def advance(self, ticks: int, log: bool = True) -> np.ndarray:
         """Run `ticks` ticks; the events in the order they happened (empty when log is False)."""
@@ -540,9 +506,6 @@ class Model:
             elif status == STATUS_CAP:
                 self._broken = self._runaway()
                 raise self._broken
-            elif status == STATUS_STORM:
-                self._broken = self._storm()
-                raise self._broken
             elif status == STATUS_REST or status == STATUS_CARRIED:
                 self._broken = self._resting(status)
                 raise self._broken
@@ -551,13 +514,11 @@ class Model:
         self.tick = int(self._st[S_TICK])
         return events.event_records(rows, times, int(self._st[S_LOGGED]))
 
-    def _call(self, target, log, cap, rows, times, storm=None) -> int:
-        """One call of the kernel `_run` on the model's state, counting storms past `storm`
-        repeats (default jam.STORM_EVENTS; 0: none); its status. (Interpreted, a time past
-        float64's range, as a subnormal speed gives, is inf as compiled, and inf - inf is nan as
-        compiled: no numpy warning.)"""
+    def _call(self, target, log, cap, rows, times) -> int:
+        """One call of the kernel `_run` on the model's state; its status. (Interpreted, a time
+        past float64's range, as a subnormal speed gives, is inf as compiled, and inf - inf is nan
+        as compiled: no numpy warning.)"""
         everyone = self.repredict == "all"
-        self._st[S_STORM] = jam.STORM_EVENTS if storm is None else storm
         with np.errstate(over="ignore", invalid="ignore"):
             if self._plain is None:
                 self._plain = plain(self._state())
@@ -584,32 +545,16 @@ class Model:
             f"tick {int(st[S_TICK]) + 1} needed more than {self.max_events_per_tick} events "
             f"(max_events_per_tick); stopped as a runaway at t = {t!r} s"
         )
-        rows, times = self._recent()
-        return jam_error(rows, times, float(self._stf[SF_T_NOW]), self._F, self._N, self._world,
-                         said)  # fmt: skip
-
-    def _storm(self) -> NotYetExact | NoRoom:
-        """The error of a run stopped by an event storm (jam.storm_error: the objects of the
-        contacts that recur, named). The model is stopped for good, so it runs up to RECENT more
-        events of that tick, logged and not counted for storms, to see them."""
-        t, first = float(self._stf[SF_T_NOW]), int(self._jobs[0, J_OBJ])
-        tick = int(self._st[S_TICK]) + 1
-        rows, times = self._recent()
-        return storm_error(first, rows, times, t, self._F, self._N, self._world, tick)
-
-    def _recent(self) -> tuple[np.ndarray, np.ndarray]:
-        """The rows and times of up to RECENT more events of the tick stopped in, logged (the
-        model is stopped for good, and its event counts stay those of the events before)."""
-        st = self._st
         counts = st[S_WALLS : S_PAIRS + 1].copy()
         st[S_LOGGED] = 0
         rows, times = events.new_log(True, RECENT)
         cap = int(st[S_TICK_EVENTS]) + RECENT
-        while self._call(int(st[S_TICK]) + 1, True, cap, rows, times, 0) == STATUS_HEAP_FULL:
+        while self._call(int(st[S_TICK]) + 1, True, cap, rows, times) == STATUS_HEAP_FULL:
             self._grow_heap()
-        st[S_WALLS : S_PAIRS + 1] = counts
+        st[S_WALLS : S_PAIRS + 1] = counts  # the counts stay those of the events before the stop
         n = int(st[S_LOGGED])
-        return rows[:n], times[:n]
+        return jam_error(rows[:n], times[:n], float(self._stf[SF_T_NOW]), self._F, self._N,
+                         self._world, said)  # fmt: skip
 
     def _resting(self, status: int) -> NotYetExact:
         """The error of a run stopped where a falling body would come to rest on another, or a
