@@ -47,7 +47,9 @@ collided is not predicted against itself again (on straight lines it cannot meet
 of the two has another event), so a rounding error cannot make it collide twice. Zero-time chains
 (a row of touching boxes hit at one end) then run as a sequence of events at one instant. A tick
 that needs more than `max_events_per_tick` events raises EventCapExceeded: a runaway is an error,
-never a hang.
+never a hang. With gravity, restitution or friction an object that meets the same partners again
+and again with next to no time passing (bounces dying away that floating point never ends) stops
+the run far sooner, named (NotYetExact; jam.py, an event storm).
 
 An object with no room to move on an axis would collide again and again at one instant: one
 that moves on an axis along which it touches (or overlaps) a wall or a static object on both
@@ -62,20 +64,23 @@ The kernel counts the wall and pair events as they happen, logged or not (`event
 
 The parts live in their own modules beside this one: the state layout (floats F (n, 8), ints N (n,
 8), P (n, 4), R (n,), scalar state; state.py), the horizon queue (horizonqueue.py), the event queue
-(a 4-ary heap; heap.py), the grid's per-cell lists (cells.py), the predictions (prediction.py) and a
-jam's objects (jam.py); from the shared engine, objects with no room to move (engine/noroom.py) and
-the event log (engine/events.py). The events themselves are applied in apply.py (`on_cross`,
+(a 4-ary heap; heap.py), the grid's per-cell lists (cells.py), the predictions (prediction.py), the
+storm count and the words for a stop (jam.py) and the error a stopped kernel raises (stops.py, a
+part of the Model class); from the shared engine, objects with no room to move (engine/noroom.py)
+and the event log (engine/events.py). The events themselves are applied in apply.py (`on_cross`,
 `on_wall`, `on_pair`); this module runs the main loop, `_run`: take the next event, apply it,
 predict again for what it touched. The kernel `_run` (with `predict` inlined) allocates nothing:
 growing the heap or the event log is done in Python between calls (the kernel stops before an event
-it has no room for, and resumes). """
+it has no room for, and resumes)."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from collide2d.engine import events, models
-from collide2d.engine.errors import EventCapExceeded, NoRoom, NotYetExact
+
+# the cap's error, raised by way of stops.py, is the model's to name: callers import it from here
+from collide2d.engine.errors import EventCapExceeded, NoRoom  # noqa: F401
 from collide2d.engine.events import (
     AXIS_NAMES,
     EV_LEAVE,
@@ -127,7 +132,7 @@ from collide2d.engine.models.exact.horizonqueue import (
     new_horizons,
     next_top,
 )
-from collide2d.engine.models.exact.jam import carried_error, jam_error, rest_error
+from collide2d.engine.models.exact.jam import STORM_EVENTS, new_instants, storm_seen
 from collide2d.engine.models.exact.prediction import predict, set_job
 from collide2d.engine.models.exact.state import (
     AX,
@@ -137,7 +142,6 @@ from collide2d.engine.models.exact.state import (
     INV_MASS,
     J_EXTRA,
     J_OBJ,
-    J_SKIP,
     JOB_CONTACTS,
     JOB_EVENT,
     JOB_FIRST,
@@ -149,12 +153,14 @@ from collide2d.engine.models.exact.state import (
     S_HEAP_N,
     S_LOGGED,
     S_PAIRS,
+    S_STORM,
     S_TICK,
     S_TICK_EVENTS,
     S_WALLS,
     SF_T_NOW,
     SH,
     SHAPE,
+    ST_SIZE,
     STATIC,
     STATUS_CAP,
     STATUS_CARRIED,
@@ -162,6 +168,7 @@ from collide2d.engine.models.exact.state import (
     STATUS_HEAP_FULL,
     STATUS_LOG_FULL,
     STATUS_REST,
+    STATUS_STORM,
     STOP,
     SW,
     TLOC,
@@ -180,6 +187,7 @@ from collide2d.engine.models.exact.state import (
     rest_side,
     rest_support,
 )
+from collide2d.engine.models.exact.stops import Stops
 from collide2d.engine.noroom import no_room, no_room_message
 from collide2d.engine.shapes import GEOMETRIES, build_cores
 from collide2d.engine.world import Bodies, WorldSpec
@@ -203,10 +211,6 @@ ROWS_PER_EVENT = 3
 # A bounce on a wall that would rise less than this (px) under gravity ends it: the object rests.
 REST_HEIGHT = 0.01
 
-# Who a runaway involves: once a tick stops at the cap, the model (stopped for good) runs up to
-# RECENT more events with the log on and looks at them, so the hot loop keeps no record of its own.
-RECENT = 64
-
 # --- the kernel ----------------------------------------------------------------------------------
 
 
@@ -221,10 +225,15 @@ def _run(state, jobs, stack, tick_to, log, cap, everyone, rows, times):
     event): the work the local re-prediction saves. The events and the state are the same, to
     the bit: a prediction reads only the pair's state, and only an event changes it.
 
+    Under gravity, restitution or friction each moving object's events at one instant with the
+    one before, with a partner it has just met, are counted in S.instants (jam.recurs): more than
+    st[S_STORM] of them (0: none counted) are an event storm.
+
     Returns a status: STATUS_DONE; STATUS_HEAP_FULL / STATUS_LOG_FULL (grow, call again: nothing
     was lost); STATUS_CAP (a runaway; stops mid-tick, before the event past the cap, so that a call
-    with a higher cap would resume). st[S_LOGGED] counts the rows written, st[S_WALLS] and
-    st[S_PAIRS] every event, logged or not. `state` is the State record as plain tuples
+    with a higher cap would resume); STATUS_STORM (a storm, stopped as at the cap, the object it
+    was seen on in jobs' row 0). st[S_LOGGED] counts the rows written, st[S_WALLS] and st[S_PAIRS]
+    every event, logged or not. `state` is the State record as plain tuples
     (state.plain).
     """
     S = named(state)
@@ -306,10 +315,15 @@ def _run(state, jobs, stack, tick_to, log, cap, everyone, rows, times):
                 n_jobs = on_cross(a, b, N, cells, world, jobs)
             else:
                 st[S_TICK_EVENTS] += 1
-                if st[S_TICK_EVENTS] > cap:  # put it back: a call with a higher cap resumes
+                over = st[S_TICK_EVENTS] > cap
+                stormy = -1 if over else storm_seen(rank, a, b, t, S)  # the object it is seen on
+                if over or stormy >= 0:  # put it back: a call with a higher cap resumes
                     st[S_TICK_EVENTS] -= 1
                     if not horizon:
                         push(HT, HI, HN, st, e)
+                    if stormy >= 0:
+                        set_job(jobs, 0, stormy, -1, JOB_EVENT)
+                        return STATUS_STORM
                     return STATUS_CAP
                 # what a (and b) rested on before: -1 nothing (nothing rests without gravity)
                 rest_a = S.R[a] if falls(world) else -1
@@ -387,7 +401,7 @@ def _run(state, jobs, stack, tick_to, log, cap, everyone, rows, times):
             predict(jobs, job, t, S)
 
 
-class Model:
+class Model(Stops):
     """Event-driven elastic model; see the module docstring. Surface as in engine.models."""
 
     def __init__(
@@ -439,6 +453,7 @@ class Model:
         self._P[:, E] = bodies.restitution
         self._P[:, MU] = bodies.friction
         self._R = np.full(n, -1, np.int64)
+        self._instants = new_instants(n)
         self.gravity = world.has_gravity
         self._N = np.zeros((n, 8), np.int64)
         self._N[:, PARTNER] = -1
@@ -478,7 +493,7 @@ class Model:
         self._horizons = new_horizons(
             static, bucket_width(self._F, static, self.cell_size, world.width, world.height)
         )
-        self._st = np.zeros(9, np.int64)
+        self._st = np.zeros(ST_SIZE, np.int64)
         self._stf = np.zeros(1)
         self._jobs = np.zeros((JOB_ROWS, 3), np.int64)  # scratch: the prediction jobs of one event
         self._stack = np.zeros(INSTANT_STACK, np.int64)  # scratch: walking one instant's entries
@@ -487,8 +502,9 @@ class Model:
         """The arrays the kernels share."""
         cells, s_start, s_items = self._G
         HT, HI, HN = self._heap
-        return State(self._F, self._N, self._P, self._R, self._C, cells, s_start, s_items,
-                     HT, HI, HN, self._horizons, self._st, self._stf, self._world)  # fmt: skip
+        return State(self._F, self._N, self._P, self._R, self._instants, self._C, cells,
+                     s_start, s_items, HT, HI, HN, self._horizons, self._st, self._stf,
+                     self._world)  # fmt: skip
 
     def advance(self, ticks: int, log: bool = True) -> np.ndarray:
         """Run `ticks` ticks; the events in the order they happened (empty when log is False)."""
@@ -503,22 +519,21 @@ class Model:
                 self._grow_heap()
             elif status == STATUS_LOG_FULL:
                 rows, times = events.grown(rows), events.grown(times)
-            elif status == STATUS_CAP:
-                self._broken = self._runaway()
-                raise self._broken
-            elif status == STATUS_REST or status == STATUS_CARRIED:
-                self._broken = self._resting(status)
+            elif status != STATUS_DONE:  # stopped: at the cap, a storm or a rest (stops.py)
+                self._broken = self._stopped(status)
                 raise self._broken
             else:
                 break
         self.tick = int(self._st[S_TICK])
         return events.event_records(rows, times, int(self._st[S_LOGGED]))
 
-    def _call(self, target, log, cap, rows, times) -> int:
-        """One call of the kernel `_run` on the model's state; its status. (Interpreted, a time
-        past float64's range, as a subnormal speed gives, is inf as compiled, and inf - inf is nan
-        as compiled: no numpy warning.)"""
+    def _call(self, target, log, cap, rows, times, storm=None) -> int:
+        """One call of the kernel `_run` on the model's state, counting storms past `storm`
+        repeats (default jam.STORM_EVENTS; 0: none); its status. (Interpreted, a time past
+        float64's range, as a subnormal speed gives, is inf as compiled, and inf - inf is nan as
+        compiled: no numpy warning.)"""
         everyone = self.repredict == "all"
+        self._st[S_STORM] = STORM_EVENTS if storm is None else storm
         with np.errstate(over="ignore", invalid="ignore"):
             if self._plain is None:
                 self._plain = plain(self._state())
@@ -533,36 +548,6 @@ class Model:
     def event_counts(self) -> tuple[int, int]:
         """(wall events, pair events) so far, logged or not."""
         return int(self._st[S_WALLS]), int(self._st[S_PAIRS])
-
-    def _runaway(self) -> EventCapExceeded | NoRoom:
-        """The error of a tick stopped at the cap: NoRoom when the objects of the events that
-        would come next, at the instant it stopped, are jammed on an axis (jam.jammed: they
-        collide again and again with no time passing, having no room to move), naming them; else
-        EventCapExceeded. The model is stopped for good, so it runs up to RECENT more events of
-        that tick, logged, to see them."""
-        st, t = self._st, float(self._stf[SF_T_NOW])
-        said = (
-            f"tick {int(st[S_TICK]) + 1} needed more than {self.max_events_per_tick} events "
-            f"(max_events_per_tick); stopped as a runaway at t = {t!r} s"
-        )
-        counts = st[S_WALLS : S_PAIRS + 1].copy()
-        st[S_LOGGED] = 0
-        rows, times = events.new_log(True, RECENT)
-        cap = int(st[S_TICK_EVENTS]) + RECENT
-        while self._call(int(st[S_TICK]) + 1, True, cap, rows, times) == STATUS_HEAP_FULL:
-            self._grow_heap()
-        st[S_WALLS : S_PAIRS + 1] = counts  # the counts stay those of the events before the stop
-        n = int(st[S_LOGGED])
-        return jam_error(rows[:n], times[:n], float(self._stf[SF_T_NOW]), self._F, self._N,
-                         self._world, said)  # fmt: skip
-
-    def _resting(self, status: int) -> NotYetExact:
-        """The error of a run stopped where a falling body would come to rest on another, or a
-        circle slide round a static box's corner (STATUS_REST), or a body another rests on is
-        knocked into motion (STATUS_CARRIED): the pair is in the first row of the jobs."""
-        a, b = int(self._jobs[0, J_OBJ]), int(self._jobs[0, J_SKIP])
-        said = rest_error if status == STATUS_REST else carried_error
-        return said(a, b, int(self._st[S_TICK]) + 1, float(self._stf[SF_T_NOW]))
 
     def rests(self) -> dict[int, tuple[int, int]]:
         """{object: (side, support)} of the objects resting now: the side each presses into

@@ -2,9 +2,10 @@
 statuses.
 
 The exact model (model.py) keeps its objects in two arrays, floats F (n, 8) and ints N (n, 8),
-what only gravity and impacts read in P (n, 4) and R (n,), and its counters in `st` (int64) and
-`stf` (float64); the event queue (heap.py), the grid lists (cells.py) and the predictions
-(prediction.py) all read them by the names below.
+what only gravity and impacts read in P (n, 4) and R (n,), what the storm check counts in
+`instants` (jam.py), and its counters in `st` (int64) and `stf` (float64); the event queue
+(heap.py), the grid lists (cells.py) and the predictions (prediction.py) all read them by the
+names below.
 Its kernels share one record, `State`, read by field, which holds the others: `World` (the
 world's sides, fps and grid), `Cores` (the exact shapes) and `Horizons` (the horizon queue,
 horizonqueue.py); a heap entry travels as an `Entry`.
@@ -82,6 +83,7 @@ class State(NamedTuple):
     N: np.ndarray  # (n, 8) int64, columns below
     P: np.ndarray  # (n, 4) float64, columns below: acceleration, restitution, friction
     R: np.ndarray  # (n,) int64: the wall side each object rests on (-1: none)
+    instants: np.ndarray  # (n, 5) float64: each object's events at one instant (jam.py)
     C: Cores  # exact shapes
     cells: np.ndarray  # the grid's per-cell lists of movers (cells.py)
     s_start: np.ndarray  # each cell's first entry in s_items (static objects)
@@ -137,9 +139,12 @@ DIR_LEFT, DIR_RIGHT, DIR_UP, DIR_DOWN = range(4)
 
 # Scalar state st (int64): heap size, ticks done, events in the current tick, query stamp, event
 # rows written in this `advance`, objects given their first prediction, wall events and pair
-# events so far (logged or not), rests begun on a body that is not static (stacks). stf (float64):
-# the current time, s.
+# events so far (logged or not), rests begun on a body that is not static (stacks), the repeats
+# at one instant that make an event storm (jam.py; 0: none counted). stf (float64): the current
+# time, s.
 S_HEAP_N, S_TICK, S_TICK_EVENTS, S_STAMP, S_LOGGED, S_FIRST, S_WALLS, S_PAIRS, S_STACKED = range(9)
+S_STORM = 9
+ST_SIZE = 10
 SF_T_NOW = 0
 
 
@@ -149,6 +154,7 @@ STATUS_HEAP_FULL = 2
 STATUS_LOG_FULL = 3
 STATUS_REST = 4  # a falling body would rest on another (the pair in jobs' first row)
 STATUS_CARRIED = 5  # a body that carries another is knocked (it and the carried one, jobs' row 0)
+STATUS_STORM = 6  # an event storm: the same contacts again and again at one instant (jam.py)
 
 INF = np.inf
 # Small helpers are inlined into the kernels (`hot`). The kernels (`kernel`) allocate nothing and
@@ -192,6 +198,7 @@ def named(state):
         S.N,
         S.P,
         S.R,
+        S.instants,
         Cores(*S.C),
         S.cells,
         S.s_start,
