@@ -56,6 +56,8 @@ import hashlib
 import os
 from contextvars import ContextVar
 
+from collide2d.engine import kernelstore
+
 PARALLEL_FROM_NUMBA = (0, 68)
 
 prange = range
@@ -117,6 +119,8 @@ def cache_empty() -> bool:
     """True when numba's cache surely holds no kernel of collide2d: NUMBA_CACHE_DIR is set and
     holds no index file, or it is not set and the package's own cache folders (beside the sources,
     where numba writes while it may) hold none; False when it may hold one. Loads nothing."""
+    if kernelstore.available():
+        return False  # the kernels the wheel ships
     folder = os.environ.get("NUMBA_CACHE_DIR", "")
     if folder:
         return not _has_index(folder)
@@ -145,6 +149,8 @@ def readiness(kernel: Kernel) -> str:
     cache = getattr(dispatcher, "_cache", None)
     index = getattr(cache, "_cache_file", None)
     try:
+        if isinstance(cache, kernelstore.Stacked):
+            return "cached" if cache.holds_any() else "cold"
         return "cached" if index is not None and index._load_index() else "cold"
     except Exception:  # an unreadable index: numba would compile
         return "cold"
@@ -218,7 +224,7 @@ class Kernel:
             options.setdefault("nogil", True)  # other threads run meanwhile (module docstring)
             dispatcher = numba.njit(**options)(self.py_func)
             if cache:
-                dispatcher._cache = _package_cache()(self.py_func)
+                dispatcher._cache = _kernel_cache(self.py_func)
             self._dispatcher = dispatcher
         return self._dispatcher
 
@@ -286,6 +292,44 @@ def _package_fingerprint(root: str) -> str:
     return digest.hexdigest()
 
 
+def _kernel_cache(py_func):
+    """The on-disk cache of a kernel: numba's own (`_package_cache`), over the kernels the wheel
+    ships where it has them (engine.kernelstore); the store alone in the prebuild that writes it."""
+    if kernelstore.building():
+        return _store_cache()(py_func)
+    own = _package_cache()(py_func)
+    if kernelstore.available():
+        return kernelstore.Stacked(own, _store_cache()(py_func))
+    return own
+
+
+@functools.cache
+def _store_cache():
+    return kernelstore.store_cache(_reloading_impl())
+
+
+@functools.cache
+def _reloading_impl():
+    """numba's cache implementation, putting a loaded kernel's reload hooks back on its code.
+
+    numba runs a loaded kernel's reload hooks (a parallel kernel's: start the threading layer)
+    but leaves them off its code library, from where a caller compiled later in this process
+    takes its own: that caller would be cached without them (module docstring)."""
+    from numba.core.caching import FunctionCache
+
+    base = FunctionCache._impl_class
+
+    def rebuild(self, target_context, payload):
+        result = base.rebuild(self, target_context, payload)
+        hooks = getattr(result, "reload_init", None)
+        kept = getattr(getattr(result, "library", None), "_reload_init", None)
+        if hooks and isinstance(kept, set):
+            kept.update(hooks)
+        return result
+
+    return type("ReloadingCacheImpl", (base,), {"rebuild": rebuild})
+
+
 @functools.cache
 def _package_cache():
     """numba's on-disk cache of a function, made stale by an edit anywhere in its package.
@@ -314,26 +358,11 @@ def _package_cache():
         Locator.__name__ = Locator.__qualname__ = locator.__name__
         return Locator
 
-    base = FunctionCache._impl_class
-
-    def rebuild(self, target_context, payload):
-        # numba runs a loaded kernel's reload hooks (a parallel kernel's: start the threading
-        # layer) but leaves them off its code library, from where a caller compiled later in this
-        # process takes its own: that caller would be cached without them (module docstring)
-        result = base.rebuild(self, target_context, payload)
-        hooks = getattr(result, "reload_init", None)
-        kept = getattr(getattr(result, "library", None), "_reload_init", None)
-        if hooks and isinstance(kept, set):
-            kept.update(hooks)
-        return result
-
+    base = _reloading_impl()
     impl = type(
         "PackageCacheImpl",
         (base,),
-        {
-            "_locator_classes": [package_wide(cls) for cls in base._locator_classes],
-            "rebuild": rebuild,
-        },
+        {"_locator_classes": [package_wide(cls) for cls in base._locator_classes]},
     )
     return type("PackageCache", (FunctionCache,), {"_impl_class": impl})
 
