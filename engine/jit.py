@@ -19,7 +19,8 @@ The lane is a context variable: `compiled()` says which lane this thread runs, a
 between two chunks of ticks, `runner.lanes`). What the runner weighs comes from here too:
 `recording()` collects the kernels a block calls interpreted (the kernels a run needs, not all),
 `readiness(kernel)` says whether one is compiled in this process, cached on disk or cold, and
-`cache_empty()` whether numba's cache surely holds none, without loading numba. The
+`cache_empty()` whether numba's cache surely holds none and `stored(kernel)` whether the kernels
+the wheel ships hold it (engine.kernelstore), both without loading numba. The
 default is compiled, unless the environment says `COLLIDE2D_JIT=0` (or numba's own
 `NUMBA_DISABLE_JIT=1`). Both lanes give the same bytes: the kernels' arithmetic is int64 and
 float64 in both, and the golden tests run every scenario in both lanes.
@@ -119,8 +120,6 @@ def cache_empty() -> bool:
     """True when numba's cache surely holds no kernel of collide2d: NUMBA_CACHE_DIR is set and
     holds no index file, or it is not set and the package's own cache folders (beside the sources,
     where numba writes while it may) hold none; False when it may hold one. Loads nothing."""
-    if kernelstore.available():
-        return False  # the kernels the wheel ships
     folder = os.environ.get("NUMBA_CACHE_DIR", "")
     if folder:
         return not _has_index(folder)
@@ -137,6 +136,12 @@ def _has_index(folder: str) -> bool:
         if any(name.endswith(".nbi") for name in files):
             return True
     return False
+
+
+def stored(kernel: Kernel) -> bool:
+    """Whether the kernels the wheel ships (engine.kernelstore) have code of `kernel`, of some
+    specialisation. Loads nothing."""
+    return kernelstore.holds(f"{kernel.py_func.__module__}.{kernel.py_func.__qualname__}")
 
 
 def readiness(kernel: Kernel) -> str:

@@ -51,17 +51,21 @@ def building() -> bool:
 def fingerprint() -> str:
     """A digest of every Python source of the engine and the runner, by their paths inside the
     package: the same in a clone and in an installed wheel."""
-    engine = os.path.dirname(os.path.abspath(__file__))
+    return sources_digest(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+
+def sources_digest(parent: str) -> str:
+    """The digest of the Python sources of PACKAGES in the folder `parent` (the one holding the
+    engine), each by its path from `parent` and its bytes."""
     digest = hashlib.sha256()
     for package in PACKAGES:
-        root = os.path.join(os.path.dirname(engine), package)
-        for folder, dirs, files in sorted(os.walk(root)):
+        for folder, dirs, files in sorted(os.walk(os.path.join(parent, package))):
             dirs.sort()
             for name in sorted(files):
                 if name.endswith(".py"):
                     path = os.path.join(folder, name)
-                    relative = os.path.relpath(path, os.path.dirname(engine))
-                    digest.update(relative.replace(os.sep, "/").encode())
+                    relative = os.path.relpath(path, parent).replace(os.sep, "/")
+                    digest.update(relative.encode())
                     with open(path, "rb") as f:
                         digest.update(hashlib.sha256(f.read()).digest())
     return digest.hexdigest()
@@ -104,6 +108,30 @@ def available() -> bool:
     return manifest() is not None and not building()
 
 
+def holds(name: str) -> bool:
+    """Whether the store has code of the kernel named `module.qualname` (of some
+    specialisation), from its file names: loads nothing."""
+    return available() and name.replace("<", "").replace(">", "") in _listing()
+
+
+@functools.cache
+def _listing() -> frozenset:
+    """`module.qualname` of every kernel in the store (without `<` and `>`, as numba names its
+    files), from its index files' names (`STEM.QUALNAME-LINE.PYTHON.nbi` in the module's folder)."""
+    found = set()
+    suffix = f".{python_tag()}.nbi"
+    for module in os.listdir(STORE):
+        folder = os.path.join(STORE, module)
+        if not os.path.isdir(folder):
+            continue
+        stem = module.rsplit(".", 1)[-1] + "."
+        for name in os.listdir(folder):
+            if name.endswith(suffix) and name.startswith(stem):
+                qualname = name[len(stem) : -len(suffix)].rsplit("-", 1)[0]
+                found.add(f"{module}.{qualname}")
+    return frozenset(found)
+
+
 def write_manifest(magic: tuple, kernels: int) -> str:
     """After a prebuild: the manifest that makes the store readable (returns its path)."""
     import numba
@@ -120,6 +148,7 @@ def write_manifest(magic: tuple, kernels: int) -> str:
         json.dump(found, f, indent=1)
         f.write("\n")
     manifest.cache_clear()
+    _listing.cache_clear()
     return path
 
 

@@ -10,6 +10,8 @@ One package or module per concern, each importing only those listed before it (a
 - `run`: a model driven over a scenario's ticks, its frames and events handed to the writers;
 - `command`: the command line and the project's settings;
 - `stress`, `bench`, `sweep` and `golden`: the commands with a package of their own (a sweep reports
-  the position error as `bench` measures it, and `check` runs on a cluster through `sweep`).
+  the position error as `bench` measures it, and `check` runs on a cluster through `sweep`);
+- `prebuild`: the kernels a wheel ships, compiled by running scenes through `command` (a release
+  step, not a command of `collide2d`).
 Each package's docstring says what it may import.
 """

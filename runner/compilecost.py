@@ -14,7 +14,8 @@ gets half a core, twice the wall time. So `seconds` scales the table by `speed_f
 
 `seconds(kernels)` is the estimate for the kernels a run calls: NUMBA_START_S when numba is not
 loaded yet, then per kernel nothing when this process has it already, CACHED_LOAD_S when numba's
-cache on disk holds it (engine.jit.readiness), else its table seconds (UNKNOWN_KERNEL_S for one
+cache on disk holds it (engine.jit.readiness) or the kernels the wheel ships do (engine.jit.stored,
+which loads nothing), else its table seconds (UNKNOWN_KERNEL_S for one
 the table lacks: a plugin's). Looking at numba's cache loads numba, unless the cache is surely
 empty (engine.jit.cache_empty: a cold CI job's): a caller that may do without (runner.lanes) asks
 `lower_bound` first, which loads nothing.
@@ -27,7 +28,7 @@ import json
 import time
 from importlib import resources
 
-from collide2d.engine import jit
+from collide2d.engine import jit, kernelstore
 
 # Seconds to import numba and start its threading layer, measured on this project's 2-core
 # machine at a load of about 2 (0.4-0.6 s).
@@ -102,7 +103,7 @@ def parts(kernel, cache_empty: bool = False) -> tuple[float, float]:
     second is to be scaled by `speed_factor()`. `cache_empty` (engine.jit.cache_empty): numba's
     cache is not looked at, which would load numba."""
     if cache_empty:
-        return 0.0, cold_seconds(kernel)
+        return (CACHED_LOAD_S, 0.0) if jit.stored(kernel) else (0.0, cold_seconds(kernel))
     ready = jit.readiness(kernel)
     if ready == "compiled":
         return 0.0, 0.0
@@ -140,4 +141,8 @@ def model_seconds(model: str) -> float:
     slower or busier machine slows both alike)."""
     prefixes = MODEL_KERNELS[model]
     kernels = table()["kernels"]
-    return NUMBA_START_S + sum(s for name, s in kernels.items() if name.startswith(prefixes))
+    return NUMBA_START_S + sum(
+        CACHED_LOAD_S if kernelstore.holds(name) else s
+        for name, s in kernels.items()
+        if name.startswith(prefixes)
+    )

@@ -28,8 +28,10 @@ def run(args, cwd, env=None) -> subprocess.CompletedProcess:
     return proc
 
 
-def test_init_then_pytest_and_check_in_a_fresh_virtualenv_from_the_wheel(tmp_path):
-    source = tmp_path / "source"  # built from a copy: the build leaves nothing in the checkout
+def installed_wheel(tmp_path: Path, extras: str = "") -> Path:
+    """collide2d's wheel, built from a copy of the checkout (the build leaves nothing in it) and
+    installed with `extras` into a fresh virtualenv: its bin folder."""
+    source = tmp_path / "source"
     ignore = shutil.ignore_patterns("__pycache__", "*.egg-info", "build")
     for part in ("collide2d", "engine", "runner"):
         shutil.copytree(ROOT / part, source / part, ignore=ignore)
@@ -38,11 +40,15 @@ def test_init_then_pytest_and_check_in_a_fresh_virtualenv_from_the_wheel(tmp_pat
     pip = [sys.executable, "-m", "pip"]
     run([*pip, "wheel", "--no-deps", "-q", "-w", tmp_path / "w", source], tmp_path)
     (wheel,) = (tmp_path / "w").glob("collide2d-*.whl")
-
     env_dir = tmp_path / "venv"
     venv.create(env_dir, with_pip=True)
     bin_dir = env_dir / "bin"
-    run([bin_dir / "python", "-m", "pip", "install", "-q", f"{wheel}[test]"], tmp_path)
+    run([bin_dir / "python", "-m", "pip", "install", "-q", f"{wheel}{extras}"], tmp_path)
+    return bin_dir
+
+
+def test_init_then_pytest_and_check_in_a_fresh_virtualenv_from_the_wheel(tmp_path):
+    bin_dir = installed_wheel(tmp_path, "[test]")
 
     project = tmp_path / "project"
     project.mkdir()
@@ -64,3 +70,28 @@ def test_init_then_pytest_and_check_in_a_fresh_virtualenv_from_the_wheel(tmp_pat
     assert "scenarios/example.yaml::golden PASSED" in checked.stdout
     check = run([bin_dir / "collide2d", "check"], project, env)
     assert check.stdout.splitlines()[-1] == "1 passed, 0 failed"
+
+
+def test_a_wheel_built_after_the_prebuild_runs_a_pile_compiled_with_nothing_to_compile(tmp_path):
+    """The kernels the wheel ships (docs/explanation/kernels.md#kernels-in-the-wheel): built
+    after `python -m collide2d.runner.prebuild`, as CI builds it, the wheel holds the store, and
+    a fresh virtualenv with an empty numba cache runs the gravity pile compiled without compiling
+    a kernel."""
+    store = ROOT / "engine" / "compiled" / "manifest.json"
+    if not store.is_file():
+        if os.environ.get("CI"):
+            pytest.fail("CI runs the prebuild before the tests: engine/compiled/ is missing")
+        pytest.skip("no kernel store in this checkout: python -m collide2d.runner.prebuild")
+    bin_dir = installed_wheel(tmp_path)
+
+    from collide2d.runner.prebuild import pile_scene
+
+    (tmp_path / "pile.yaml").write_text(pile_scene(1000, ticks=300))
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("NUMBA_", "COLLIDE2D_"))}
+    env = {**env, "NUMBA_CACHE_DIR": str(tmp_path / "empty-cache")}
+    env.pop("PYTHONPATH", None)
+    command = [bin_dir / "collide2d", "run", "pile.yaml", "--out", "out", "--jit", "on"]
+    run(command, tmp_path, env)
+    summary = json.loads((tmp_path / "out" / "pile1000" / "summary.json").read_text())
+    assert summary["kernels"] == "compiled" and summary["compile_time_s"] == 0.0
+    assert not list((tmp_path / "empty-cache").rglob("*.nbc"))

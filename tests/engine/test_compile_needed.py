@@ -119,7 +119,7 @@ for f in (sort.sort_keys, sort._sift_keys, sort._heap_sort_timed, sort._sift_ord
 def test_the_sorts_compile_once_not_again_for_a_literal_zero(tmp_path):
     """A literal 0 passed where a count or an index goes compiles a kernel a second time (numba
     types it as Literal[int](0)); the paper model's pair sort and the heap sorts pass typed ints."""
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    env = dict(os.environ, COLLIDE2D_KERNEL_STORE="off", NUMBA_CACHE_DIR=str(tmp_path / "cache"))
     got = subprocess.run(
         [sys.executable, "-c", SIGNATURES], capture_output=True, text=True, env=env, check=True
     ).stdout.split()
@@ -149,7 +149,9 @@ class Listen(event.Listener):
 event.register("numba:compile", Listen())
 """
 
-FINDERS = LISTEN + """
+FINDERS = (
+    LISTEN
+    + """
 import numpy as np
 from numba import njit
 from collide2d.engine import broadphase as bp
@@ -172,6 +174,7 @@ assert split_candidates(finder, lo, hi, movable, 1.0, order, keys, bp.workspace(
 names = ("sweep_candidates", "grid_candidates", "cell_candidates", "cell_candidates_split_into")
 print(*(name for name in names if name in compiled))
 """
+)
 
 
 @pytest.mark.skipif(os.environ.get("NUMBA_DISABLE_JIT") == "1", reason="nothing compiles")
@@ -179,14 +182,16 @@ def test_the_sweep_compiles_no_other_pair_finder(tmp_path):
     """broadphase.find_pairs (the start-up overlap check) and broadphase.find_split (the paper
     and stepped models' pair stages) compile the one finder their method names, not the grid's
     and the cells' too."""
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    env = dict(os.environ, COLLIDE2D_KERNEL_STORE="off", NUMBA_CACHE_DIR=str(tmp_path / "cache"))
     got = subprocess.run(
         [sys.executable, "-c", FINDERS], capture_output=True, text=True, env=env, check=True
     ).stdout.split()
     assert got == ["sweep_candidates"]
 
 
-SPRITES = LISTEN + """
+SPRITES = (
+    LISTEN
+    + """
 from collide2d.engine.picture.sprites import sprites
 from collide2d.runner.scenario.load import loads
 scene = loads(
@@ -197,13 +202,14 @@ start, offsets = sprites(scene.bodies)
 assert start.tolist() == [0, 6], start
 print(*sorted(name for name in ("_circle", "_polygon") if name in compiled) or ["none"])
 """
+)
 
 
 @pytest.mark.skipif(os.environ.get("NUMBA_DISABLE_JIT") == "1", reason="nothing compiles")
 def test_the_sprites_of_boxes_compile_no_circle_or_polygon_drawing(tmp_path):
     """The viewer's sprites (engine.picture.sprites) draw through the shapes marker, as the renderer
     does: a scene of boxes compiles no circle or polygon rasteriser for them."""
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    env = dict(os.environ, COLLIDE2D_KERNEL_STORE="off", NUMBA_CACHE_DIR=str(tmp_path / "cache"))
     got = subprocess.run(
         [sys.executable, "-c", SPRITES], capture_output=True, text=True, env=env, check=True
     ).stdout.split()

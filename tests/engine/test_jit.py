@@ -110,7 +110,12 @@ def test_an_edit_of_a_called_kernels_file_alone_compiles_the_caller_afresh(tmp_p
     package.mkdir()
     (package / "__init__.py").write_text("")
     (package / "caller.py").write_text(CALLER)
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), PYTHONPATH=str(tmp_path))
+    env = dict(
+        os.environ,
+        COLLIDE2D_KERNEL_STORE="off",
+        NUMBA_CACHE_DIR=str(tmp_path / "cache"),
+        PYTHONPATH=str(tmp_path),
+    )
     env.pop("COLLIDE2D_JIT", None)
     code = (
         "from numba.core import event\n"
@@ -186,7 +191,12 @@ def test_readiness_says_cold_cached_or_compiled_and_an_empty_cache_is_seen_witho
     (package / "__init__.py").write_text("")
     (package / "caller.py").write_text(CALLER)
     (package / "callee.py").write_text(CALLEE.format(factor=2))
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), PYTHONPATH=str(tmp_path))
+    env = dict(
+        os.environ,
+        COLLIDE2D_KERNEL_STORE="off",
+        NUMBA_CACHE_DIR=str(tmp_path / "cache"),
+        PYTHONPATH=str(tmp_path),
+    )
     env.pop("COLLIDE2D_JIT", None)
     code = (
         "import sys\nfrom collide2d.engine import jit\nfrom pkg.caller import f\n"

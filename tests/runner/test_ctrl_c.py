@@ -308,7 +308,7 @@ def test_ctrl_c_while_kernels_compile_ends_the_command_within_a_second(tmp_path,
     if command == "run":
         cmd += [path, "--out", tmp_path / "out", "--quiet"]
     cached = "stepped*/*.nbi" if command == "run" else "*/*.nbi"  # one folder per package
-    env = {**os.environ, "NUMBA_CACHE_DIR": str(cache)}
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(cache), "COLLIDE2D_KERNEL_STORE": "off"}
     stop = interrupted(cmd, when=lambda _err: any(cache.glob(cached)), env=env, cwd=project)
     assert stop.returncode == 130, stop.err
     assert stop.took < SECOND, f"ended {stop.took:.2f} s after Ctrl-C"

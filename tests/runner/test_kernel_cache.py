@@ -56,7 +56,7 @@ def test_runs_of_a_dense_then_a_sparse_scene_leave_a_cache_later_commands_load(t
     (project / "pyproject.toml").write_text('[project]\nname = "p"\n\n[tool.collide2d]\n')
     (project / "scenarios" / "sparse.yaml").write_text(SPARSE)
     (tmp_path / "dense.yaml").write_text(DENSE)
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    env = dict(os.environ, COLLIDE2D_KERNEL_STORE="off", NUMBA_CACHE_DIR=str(tmp_path / "cache"))
     env.pop("COLLIDE2D_JIT", None)
     env.pop("CI", None)  # the sequence blesses, which CI refuses
     out = str(tmp_path / "out")
@@ -98,7 +98,7 @@ sys.exit(cli.main())
 @pytest.mark.skipif(not os.path.exists("/bin/sh"), reason="the watcher is a POSIX shell")
 def test_a_command_that_dies_in_a_kernel_names_the_signal_and_the_cache_to_clear(tmp_path):
     cache = tmp_path / "kernel cache"
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache))
+    env = dict(os.environ, COLLIDE2D_KERNEL_STORE="off", NUMBA_CACHE_DIR=str(cache))
     env.pop("PYTHONFAULTHANDLER", None)
     done = subprocess.run(
         [sys.executable, "-c", CRASHING_RUN], cwd=tmp_path, env=env, capture_output=True,
@@ -143,7 +143,12 @@ for since in sys.argv[1:]:
 @pytest.mark.skipif(not hasattr(os, "getuid"), reason="the records' folder is a POSIX user's")
 def test_a_worker_that_dies_of_a_signal_gives_its_rows_the_reason(tmp_path):
     pytest.importorskip("distributed")
-    env = dict(os.environ, TMPDIR=str(tmp_path), NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    env = dict(
+        os.environ,
+        COLLIDE2D_KERNEL_STORE="off",
+        TMPDIR=str(tmp_path),
+        NUMBA_CACHE_DIR=str(tmp_path / "cache"),
+    )
     env.pop("PYTHONFAULTHANDLER", None)
 
     def python(code: str, *args: str) -> subprocess.CompletedProcess:

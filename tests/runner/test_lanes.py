@@ -153,6 +153,7 @@ def test_compiling_is_estimated_from_the_table_and_the_cache(monkeypatch, tmp_pa
     monkeypatch.setattr(compilecost, "speed_factor", lambda: 2.0)
     monkeypatch.setattr(compilecost.jit, "loaded", lambda: False)
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))  # empty: every kernel compiles
+    monkeypatch.setenv("COLLIDE2D_KERNEL_STORE", "off")  # (none from the wheel's store)
     assert jit.cache_empty()
     estimate = compilecost.seconds(kernels)
     assert estimate == pytest.approx(compilecost.NUMBA_START_S + 2.0 * cold)
@@ -271,7 +272,7 @@ def test_a_cold_check_of_small_scenarios_never_starts_numba(tmp_path):
         f"status = main(['check', '--root', {str(root)!r}, '--quiet', *{names!r}])\n"
         "print(status, 'numba' in sys.modules)"
     )
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    env = dict(os.environ, COLLIDE2D_KERNEL_STORE="off", NUMBA_CACHE_DIR=str(tmp_path / "cache"))
     for name in ("COLLIDE2D_JIT", "NUMBA_DISABLE_JIT", "CI"):
         env.pop(name, None)
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env,

@@ -44,6 +44,7 @@ MAY_IMPORT = {
     "bench": BELOW_COMMAND | {"command"},
     "sweep": BELOW_COMMAND | {"command", "bench", "interrupt"},
     "golden": BELOW_COMMAND | {"command", "sweep"},
+    "prebuild": {"engine", "command", "bench"},
     "__main__": {"command"},
 }
 # The packages whose docstrings also name each of their modules.

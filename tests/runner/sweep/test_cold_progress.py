@@ -83,7 +83,7 @@ def test_a_cold_cluster_run_shows_its_bar_and_the_notice_before_any_run_is_done(
     (tmp_path / "scenarios").mkdir()
     (tmp_path / "scenarios" / "small.yaml").write_text(SMALL)
     (tmp_path / "cache").mkdir()  # an empty kernel cache, as a CI job starts with
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    env = dict(os.environ, COLLIDE2D_KERNEL_STORE="off", NUMBA_CACHE_DIR=str(tmp_path / "cache"))
     env.pop("NUMBA_DISABLE_JIT", None)
 
     def seen(text: str) -> bool:  # stop once both are there (or a run is done)
