@@ -114,6 +114,12 @@ def holds(name: str) -> bool:
     return available() and name.replace("<", "").replace(">", "") in _listing()
 
 
+def holds_model(model: str) -> bool:
+    """Whether the store has kernels of the built-in model `model` (the prebuild ran its scenes)."""
+    prefix = f"collide2d.engine.models.{model}."
+    return available() and any(name.startswith(prefix) for name in _listing())
+
+
 @functools.cache
 def _listing() -> frozenset:
     """`module.qualname` of every kernel in the store (without `<` and `>`, as numba names its

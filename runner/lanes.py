@@ -22,9 +22,11 @@ loaded; a big one compiles after a short look (PROBE_S); one whose
 kernels numba's cache holds goes compiled after a tick or two, for the cost of loading them. The
 kernels a run needs are the ones it calls (engine.jit.recording), not every kernel. The first
 chunks are short (1, 1, 2, 4, ... ticks) so that a slow scene is measured after a tick or two.
-What no pace sees, the bounces of a huge mass ratio within one tick of the exact model, is
-estimated up front: a run whose bounces would take longer interpreted (EVENT_INTERPRETED_S each)
-than compiling the exact model's kernels starts compiled.
+What no pace sees is estimated up front: the bounces of a huge mass ratio within one tick of the
+exact model (a run whose bounces would take longer interpreted, EVENT_INTERPRETED_S each, than
+compiling the exact model's kernels starts compiled), and the first tick of a big scene whose
+model's kernels the wheel ships (engine.kernelstore): a run whose one tick would take longer
+interpreted (TICK_INTERPRETED_S an object) than starting numba and loading them starts compiled.
 
 Mode `on` compiles every run and `off` interprets every run (slow for big scenes); the command
 line's `--jit MODE` sets it (`set_mode`), else `COLLIDE2D_JIT` in the environment, else `auto`.
@@ -46,7 +48,7 @@ from contextvars import ContextVar
 
 import numpy as np
 
-from collide2d.engine import jit
+from collide2d.engine import jit, kernelstore
 from collide2d.runner import compilecost
 
 MODES = ("auto", "on", "off")
@@ -72,6 +74,13 @@ EVENT_INTERPRETED_S = 4e-4
 # standard scene's 5,000 boxes) takes less than compiling the loading kernels.
 LOAD_INTERPRETED_MAX_OBJECTS = 2_000
 LOAD_INTERPRETED_S = 1.3e-4
+# Seconds an interpreted tick takes per object, at the least (the bench's standard scene of
+# 20,000 boxes: 28 us under stepped, 38 under paper, 42 under exact; the gravity pile, 36), and
+# the seconds to load a model's kernels from the kernels the wheel ships once numba has started:
+# a scene whose first tick would take longer interpreted than numba's start and that load (from
+# about 40,000 objects) starts compiled.
+TICK_INTERPRETED_S = 2.5e-5
+STORED_LOAD_S = 0.5
 
 _clock = time.perf_counter
 _cpu = time.process_time
@@ -125,6 +134,16 @@ def bursts_past_compiling(scenario) -> bool:
     return bounces * EVENT_INTERPRETED_S > compilecost.model_seconds("exact")
 
 
+def big_and_stored(scenario) -> bool:
+    """Whether one interpreted tick of `scenario` would take longer than starting numba and
+    loading its model's kernels from the kernels the wheel ships (engine.kernelstore), which hold
+    them: such a run starts compiled, where a first tick interpreted would cost seconds."""
+    if not kernelstore.holds_model(scenario.model):
+        return False
+    tick = scenario.bodies.n * TICK_INTERPRETED_S
+    return tick > compilecost.start_seconds() + STORED_LOAD_S
+
+
 def _wall_bounces(scenario) -> float:
     """About how many wall bounces the objects make in one tick: each axis's distance travelled
     over the room the object has on it (at least a pixel), summed over the moving objects."""
@@ -158,7 +177,7 @@ class RunLane:
         self.called = jit.Called()
         self._ready: dict = {}  # kernel -> seconds to get it ready, once asked
         self._empty: bool | None = None
-        if self.may_switch and bursts_past_compiling(scenario):
+        if self.may_switch and (bursts_past_compiling(scenario) or big_and_stored(scenario)):
             self.compiled = self.started_compiled = True
             self.may_switch = False
 

@@ -26,6 +26,7 @@ from collide2d.engine import kernelstore
 
 # The bench's standard scene at sizes that take each broad phase (as the compile-time table's).
 STANDARD_N = (30, 300, 3000)
+STANDARD_TICKS = 30
 # The gravity pile: boxes dropped in rows that settle on the floor.
 PILE_N = (1000, 10000)
 PILE_TICKS = 300
@@ -63,7 +64,7 @@ def _compile_scenes(scenarios: Path) -> int:
     with tempfile.TemporaryDirectory() as out:
         sources = [(f"pile {n}", pile_scene(n)) for n in PILE_N]
         sources += [
-            (f"standard {model} {n}", standard_scene(n, model, ticks=3))
+            (f"standard {model} {n}", standard_scene(n, model, ticks=STANDARD_TICKS))
             for model in ("paper", "stepped", "exact")
             for n in STANDARD_N
         ]

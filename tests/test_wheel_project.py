@@ -28,9 +28,12 @@ def run(args, cwd, env=None) -> subprocess.CompletedProcess:
     return proc
 
 
-def installed_wheel(tmp_path: Path, extras: str = "") -> Path:
+@pytest.fixture(scope="module")
+def bin_dir(tmp_path_factory) -> Path:
     """collide2d's wheel, built from a copy of the checkout (the build leaves nothing in it) and
-    installed with `extras` into a fresh virtualenv: its bin folder."""
+    installed with the test extra into a fresh virtualenv: its bin folder (one for the module's
+    tests)."""
+    tmp_path = tmp_path_factory.mktemp("wheel")
     source = tmp_path / "source"
     ignore = shutil.ignore_patterns("__pycache__", "*.egg-info", "build")
     for part in ("collide2d", "engine", "runner"):
@@ -43,12 +46,11 @@ def installed_wheel(tmp_path: Path, extras: str = "") -> Path:
     env_dir = tmp_path / "venv"
     venv.create(env_dir, with_pip=True)
     bin_dir = env_dir / "bin"
-    run([bin_dir / "python", "-m", "pip", "install", "-q", f"{wheel}{extras}"], tmp_path)
+    run([bin_dir / "python", "-m", "pip", "install", "-q", f"{wheel}[test]"], tmp_path)
     return bin_dir
 
 
-def test_init_then_pytest_and_check_in_a_fresh_virtualenv_from_the_wheel(tmp_path):
-    bin_dir = installed_wheel(tmp_path, "[test]")
+def test_init_then_pytest_and_check_in_a_fresh_virtualenv_from_the_wheel(tmp_path, bin_dir):
 
     project = tmp_path / "project"
     project.mkdir()
@@ -72,26 +74,34 @@ def test_init_then_pytest_and_check_in_a_fresh_virtualenv_from_the_wheel(tmp_pat
     assert check.stdout.splitlines()[-1] == "1 passed, 0 failed"
 
 
-def test_a_wheel_built_after_the_prebuild_runs_a_pile_compiled_with_nothing_to_compile(tmp_path):
+def test_a_wheel_built_after_the_prebuild_runs_a_pile_compiled_with_nothing_to_compile(
+    tmp_path, bin_dir
+):
     """The kernels the wheel ships (docs/explanation/kernels.md#kernels-in-the-wheel): built
     after `python -m collide2d.runner.prebuild`, as CI builds it, the wheel holds the store, and
-    a fresh virtualenv with an empty numba cache runs the gravity pile compiled without compiling
-    a kernel."""
+    a fresh virtualenv with an empty numba cache runs the gravity pile (stepped) and the bench's
+    standard scene under the paper and exact models compiled, without compiling a kernel: the
+    compile budget of a wheel's first run is zero."""
     store = ROOT / "engine" / "compiled" / "manifest.json"
     if not store.is_file():
         if os.environ.get("CI"):
             pytest.fail("CI runs the prebuild before the tests: engine/compiled/ is missing")
         pytest.skip("no kernel store in this checkout: python -m collide2d.runner.prebuild")
-    bin_dir = installed_wheel(tmp_path)
 
+    from collide2d.runner.bench.scenes import standard_scene
     from collide2d.runner.prebuild import pile_scene
 
-    (tmp_path / "pile.yaml").write_text(pile_scene(1000, ticks=300))
+    scenes = {"pile1000": pile_scene(1000, ticks=300)}
+    scenes |= {f"standard {m}": standard_scene(300, m, ticks=30) for m in ("paper", "exact")}
     env = {k: v for k, v in os.environ.items() if not k.startswith(("NUMBA_", "COLLIDE2D_"))}
     env = {**env, "NUMBA_CACHE_DIR": str(tmp_path / "empty-cache")}
     env.pop("PYTHONPATH", None)
-    command = [bin_dir / "collide2d", "run", "pile.yaml", "--out", "out", "--jit", "on"]
-    run(command, tmp_path, env)
-    summary = json.loads((tmp_path / "out" / "pile1000" / "summary.json").read_text())
-    assert summary["kernels"] == "compiled" and summary["compile_time_s"] == 0.0
+    for name, text in scenes.items():
+        (tmp_path / "scene.yaml").write_text(text)
+        command = [bin_dir / "collide2d", "run", "scene.yaml", "--out", "out", "--jit", "on"]
+        run(command, tmp_path, env)
+        (summary,) = (tmp_path / "out").glob("*/summary.json")
+        found = json.loads(summary.read_text())
+        assert found["kernels"] == "compiled" and found["compile_time_s"] == 0.0, (name, found)
+        shutil.rmtree(tmp_path / "out")
     assert not list((tmp_path / "empty-cache").rglob("*.nbc"))

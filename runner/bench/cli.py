@@ -3,12 +3,13 @@
 `register` adds the subcommand without loading the parts; `cmd_bench` loads them when
 `collide2d bench` runs, runs the parts asked for (default: scaling, error, skips, targets) and
 writes OUT/bench/bench.csv, bench.md and the plots. The parts that read scenario files (FILE_PARTS)
-read them from `--scenarios`, else from the project's scenarios folder (runner.command.settings);
-when that folder lacks the benchmark scenarios (a user's project), the default run leaves those
-parts out and says so. On a terminal a bar counts the parts done from the start, the progress
-lines printed above it. Exit status: 0 when every target of the headline is met, 1 when one is
-missed (each named on stderr), 2 on bad input (a part asked for whose scenarios are missing, a
-report folder that is a symbolic link).
+read them from `--scenarios`, else from the project's scenarios folder (runner.command.settings),
+else, when that folder lacks the benchmark scenarios (a user's project, an installed wheel), from
+the copies the package ships (runner.bench.scenes). On a terminal a bar counts the parts done from
+the start, the progress lines printed above it. Exit status: 0 when every target of the headline
+is met, 1 when one is missed (each named on stderr), 2 on bad input (a part asked for whose
+scenarios are missing from the folder `--scenarios` names, a report folder that is a symbolic
+link).
 """
 
 from __future__ import annotations
@@ -43,21 +44,15 @@ def cmd_bench(args: argparse.Namespace) -> int:
     in_process = args.in_process or quick
     folder = Path(args.scenarios) if args.scenarios else project_scenarios()
     missing = [n for n in scenes.NEEDED_SCENARIOS if not (folder / f"{n}.yaml").is_file()]
-    reading = [p for p in parts if p in FILE_PARTS]
-    if missing and reading:
-        if args.scenarios or args.part:  # asked for by name: refused
-            print(
-                f"collide2d bench: error: {folder} lacks {missing[0]}.yaml; point "
-                "--scenarios at a folder of the benchmark scenarios",
-                file=sys.stderr,
-            )
-            return EXIT_BAD_INPUT
-        parts = tuple(p for p in parts if p not in FILE_PARTS)
+    if missing and not args.scenarios:  # a user's project, an installed wheel: the copies shipped
+        folder, missing = scenes.PACKAGED_SCENARIOS, []
+    if missing and any(p in FILE_PARTS for p in parts):
         print(
-            f"collide2d bench: {folder} lacks {missing[0]}.yaml, so no {', '.join(reading)} "
-            "part (point --scenarios at a folder of the benchmark scenarios)",
+            f"collide2d bench: error: {folder} lacks {missing[0]}.yaml; point "
+            "--scenarios at a folder of the benchmark scenarios",
             file=sys.stderr,
         )
+        return EXIT_BAD_INPUT
     target = Path(args.out) / REPORT_DIR
     if target.is_symlink():
         print(f"collide2d bench: error: {target} is a symbolic link", file=sys.stderr)

@@ -4,7 +4,8 @@ The standard scene: boxes of STANDARD_SIZE_PX covering STANDARD_COVERAGE of a wo
 STANDARD_ASPECT, speeds STANDARD_SPEEDS px/s in random directions, at STANDARD_FPS, seeded; as
 scenario text, so it runs through the same loader and `collide2d run` as any scenario. The other
 parts read scenario files (`NEEDED_SCENARIOS`) from the project's scenarios/ folder, or the folder
-given with `--scenarios`.
+given with `--scenarios`; where neither holds them (an installed wheel), from the copies the package
+ships (`PACKAGED_SCENARIOS`).
 """
 
 from __future__ import annotations
@@ -36,6 +37,9 @@ NEEDED_SCENARIOS = (*BENCH_SCENARIOS, DEMO_SCENARIO, SMALL_SCENARIO)
 # Where they are unless `--scenarios` says otherwise: the project's scenarios/ folder, next to the
 # runner package.
 PROJECT_SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
+# Copies of NEEDED_SCENARIOS shipped in the package (tests keep them equal to the project's), for
+# a bench run where no project folder holds them (collide2d installed from a wheel).
+PACKAGED_SCENARIOS = Path(__file__).resolve().parents[1] / "data"
 
 
 def standard_world(n: int) -> tuple[int, int]:

@@ -171,6 +171,19 @@ def test_a_huge_mass_ratio_starts_compiled_a_small_one_interpreted():
         assert not lanes.bursts_past_compiling(loads(CHAIN.replace("mass: 1e10", f"mass: {ratio}")))
 
 
+def test_a_big_scene_whose_models_kernels_the_wheel_ships_starts_compiled(monkeypatch):
+    """One interpreted tick of the scene would take longer than starting numba and loading the
+    stored kernels: the run starts compiled; a small scene, or a model the store lacks, does not."""
+    monkeypatch.setattr(lanes, "TICK_INTERPRETED_S", 0.01)  # GAS: 3 s a tick; SMALL: 0.02 s
+    monkeypatch.setattr(lanes.kernelstore, "holds_model", lambda model: model == "paper")
+    gas, small = loads(GAS), loads(SMALL)
+    assert lanes.RunLane(gas, 0).started_compiled and not lanes.RunLane(gas, 0).may_switch
+    assert not lanes.RunLane(small, 0).started_compiled
+    assert not lanes.RunLane(loads(GAS + "model: exact\n"), 0).started_compiled
+    monkeypatch.setattr(lanes.kernelstore, "holds_model", lambda model: False)
+    assert not lanes.RunLane(gas, 0).started_compiled
+
+
 def test_an_object_crossing_its_room_a_million_times_a_tick_starts_compiled():
     fast = (
         "version: 1\nworld: {width: 40, height: 40, fps: 1}\nmodel: exact\nticks: 3\n"

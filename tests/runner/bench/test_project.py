@@ -1,14 +1,14 @@
-"""`collide2d bench` as a user runs it in a project of their own: it reads the project's
-scenarios folder (not one beside the installed package), leaves out the parts whose benchmark
-scenarios the project lacks, exits 1 when a target of the headline is missed, and on a terminal
-shows a bar of its parts from the start."""
+"""`collide2d bench` as a user runs it in a project of their own: where the project's scenarios
+folder lacks the benchmark scenarios it reads the copies the package ships (equal to this
+repository's), exits 1 when a target of the headline is missed, and on a terminal shows a bar of
+its parts from the start."""
 
 from __future__ import annotations
 
 import io
 import sys
 
-from collide2d.runner.bench import goals
+from collide2d.runner.bench import goals, scenes
 from collide2d.runner.command.main import main
 
 PAPER_40 = ["--n", "40", "--model", "paper"]
@@ -22,19 +22,22 @@ def project(tmp_path):
     return tmp_path
 
 
-def test_quick_bench_in_a_users_project_reads_its_scenarios_and_runs_the_rest(
+def test_quick_bench_in_a_users_project_reads_the_benchmark_scenarios_the_package_ships(
     tmp_path, monkeypatch, capsys
 ):
     monkeypatch.chdir(project(tmp_path))
-    code = main(["bench", "--quick", *PAPER_40, "--out", "out"])
+    code = main(["bench", "--quick", "--part", "error", *PAPER_40, "--out", "out", "--quiet"])
     err = capsys.readouterr().err
-    assert "cases lacks bench_tunnelling.yaml, so no error, skips, targets part" in err
     assert code == 0, err
-    assert (tmp_path / "out" / "bench" / "bench.csv").is_file()
-    # named, a part whose scenarios are missing is refused, nothing written
-    code = main(["bench", "--quick", "--part", "targets", "--out", "again"])
-    assert code == 2 and "cases lacks bench_tunnelling.yaml" in capsys.readouterr().err
-    assert not (tmp_path / "again").exists()
+    assert "lacks" not in err
+    rows = (tmp_path / "out" / "bench" / "bench.csv").read_text()
+    assert "bench_tunnelling" in rows and "bench_mass_ratio_chain" in rows
+
+
+def test_the_benchmark_scenarios_the_package_ships_are_the_projects():
+    for name in scenes.NEEDED_SCENARIOS:
+        shipped = (scenes.PACKAGED_SCENARIOS / f"{name}.yaml").read_bytes()
+        assert shipped == (scenes.PROJECT_SCENARIOS / f"{name}.yaml").read_bytes(), name
 
 
 def test_a_missed_target_is_exit_status_1_and_named(tmp_path, monkeypatch, capsys):
