@@ -2,10 +2,10 @@
 
 A kernel's first compilation costs seconds (a model's kernels together: tens of seconds, minutes on
 a busy machine), where pymunk or Box2D start at once. So a release compiles the kernels once,
-before the wheel is built (`python -m collide2d.runner.prebuild`), into `engine/compiled/` inside
-the package, and every install loads them from there: a first run goes compiled at once, with
-nothing to compile for the scenes the store covers (docs/explanation/kernels.md, "Kernels in the
-wheel").
+before the wheel is built (`python -m collide2d.runner.prebuild`), into the package's folder
+`engine/compiled-kernels/`, and every install loads them from there: a first run goes compiled
+at once, with nothing to compile for the scenes the store covers (docs/explanation/kernels.md,
+"Kernels in the wheel").
 
 What makes the store travel, where numba's own cache stays on the machine that wrote it:
 
@@ -31,7 +31,7 @@ import json
 import os
 import sys
 
-STORE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "compiled")
+STORE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "compiled-kernels")
 MANIFEST = "manifest.json"
 # Set in the environment of the process that compiles the store (with NUMBA_CPU_NAME=generic).
 BUILDING = "COLLIDE2D_KERNEL_STORE_BUILD"

@@ -82,10 +82,10 @@ def test_a_wheel_built_after_the_prebuild_runs_a_pile_compiled_with_nothing_to_c
     a fresh virtualenv with an empty numba cache runs the gravity pile (stepped) and the bench's
     standard scene under the paper and exact models compiled, without compiling a kernel: the
     compile budget of a wheel's first run is zero."""
-    store = ROOT / "engine" / "compiled" / "manifest.json"
+    store = ROOT / "engine" / "compiled-kernels" / "manifest.json"
     if not store.is_file():
         if os.environ.get("CI"):
-            pytest.fail("CI runs the prebuild before the tests: engine/compiled/ is missing")
+            pytest.fail("CI runs the prebuild first: engine/compiled-kernels/ is missing")
         pytest.skip("no kernel store in this checkout: python -m collide2d.runner.prebuild")
 
     from collide2d.runner.bench.scenes import standard_scene

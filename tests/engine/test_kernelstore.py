@@ -130,7 +130,7 @@ def test_a_store_written_for_other_sources_python_or_numba_is_not_read(
 def test_the_sources_digest_is_the_same_in_a_clone_and_an_install_and_changes_with_any_source(
     tmp_path,
 ):
-    ignore = shutil.ignore_patterns("__pycache__", "compiled")
+    ignore = shutil.ignore_patterns("__pycache__", "compiled-kernels")
     clone, install = tmp_path / "clone", tmp_path / "site-packages" / "collide2d"
     for parent in (clone, install):
         for package in kernelstore.PACKAGES:
