@@ -85,20 +85,34 @@ def manifest() -> dict | None:
             found = json.load(f)
     except (OSError, ValueError):
         return None
-    try:
-        from importlib.metadata import version
-
-        numba_version = version("numba")
-    except Exception:  # no numba installed: nothing compiles, nothing to load
-        return None
     fits = (
         isinstance(found, dict)
         and found.get("fingerprint") == fingerprint()
         and found.get("python") == python_tag()
-        and found.get("numba") == numba_version
+        and found.get("numba") == numba_version()
         and isinstance(found.get("magic"), list)
     )
     return found if fits else None
+
+
+def numba_version() -> str | None:
+    """The installed numba's version, from its distribution's `.dist-info` folder name (as
+    installers name it), without importing numba or importlib.metadata (a run that stays
+    interpreted loads neither); None when numba or that folder is not found."""
+    import importlib.util
+
+    spec = importlib.util.find_spec("numba")
+    if spec is None or not spec.origin:
+        return None
+    site = os.path.dirname(os.path.dirname(spec.origin))
+    try:
+        names = os.listdir(site)
+    except OSError:
+        return None
+    for name in sorted(names):
+        if name.startswith("numba-") and name.endswith(".dist-info"):
+            return name[len("numba-") : -len(".dist-info")]
+    return None
 
 
 def available() -> bool:

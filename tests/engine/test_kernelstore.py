@@ -11,6 +11,7 @@ import os
 import shutil
 import subprocess
 import sys
+from importlib.metadata import version
 from pathlib import Path
 
 import pytest
@@ -102,8 +103,6 @@ def test_a_kernel_the_prebuild_compiled_loads_from_the_store_where_numba_would_c
 def test_a_store_written_for_other_sources_python_or_numba_is_not_read(
     tmp_path, monkeypatch, stale
 ):
-    from importlib.metadata import version
-
     fits = {
         "fingerprint": kernelstore.fingerprint(),
         "python": kernelstore.python_tag(),
@@ -146,8 +145,6 @@ def test_the_sources_digest_is_the_same_in_a_clone_and_an_install_and_changes_wi
 def test_the_store_says_which_kernels_it_holds_from_its_file_names_without_loading_numba(
     tmp_path, monkeypatch
 ):
-    from importlib.metadata import version
-
     folder = tmp_path / "collide2d.engine.broadphase"
     folder.mkdir()
     tag = kernelstore.python_tag()
@@ -175,3 +172,7 @@ def test_the_store_says_which_kernels_it_holds_from_its_file_names_without_loadi
     finally:
         kernelstore.manifest.cache_clear()
         kernelstore._listing.cache_clear()
+
+
+def test_numbas_version_is_read_without_importing_it():
+    assert kernelstore.numba_version() == version("numba")
