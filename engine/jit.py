@@ -12,7 +12,8 @@ module (not numba's). A call runs it in one of two lanes:
 
 Compiled kernels are cached on disk as numba caches them, but stamped fresh only while every
 source of their package is as it was (`_package_cache`): numba itself checks only the kernel's own
-file, though the code it keeps has the kernels it calls compiled in.
+file, though the code it keeps has the kernels it calls compiled in. Under numba's own cache lie
+the kernels a wheel ships compiled (engine.kernelstore), read where numba's own cache has none.
 
 The lane is a context variable: `compiled()` says which lane this thread runs, and
 `lane(compiled)` sets it for a `with` block (the runner picks one per run and may switch it
