@@ -46,8 +46,7 @@ def bin_dir(tmp_path_factory) -> Path:
     env_dir = tmp_path / "venv"
     venv.create(env_dir, with_pip=True)
     bin_dir = env_dir / "bin"
-    install = [bin_dir / "python", "-m", "pip", "install", "-q", "--no-compile"]
-    run([*install, f"{wheel}[test]"], tmp_path)
+    run([bin_dir / "python", "-m", "pip", "install", "-q", f"{wheel}[test]"], tmp_path)
     return bin_dir
 
 
