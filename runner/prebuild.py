@@ -6,7 +6,8 @@ of scenes compiled, in a process of its own told to compile for a generic CPU an
 kernel in the store: each bundled scenario under its own model with its own outputs (so the
 picture kernels compile too), the bench's standard scene under every model at sizes that take
 each broad phase, the gravity pile of the docs' first-run figures at 1,000 and 10,000 boxes, and
-`collide2d bench --quick` (its scaling, error, skips and targets parts).
+`collide2d bench --quick` (its scaling, error, skips and targets parts; `--no-bench` leaves it out,
+as CI does to keep within its time).
 Last it writes the store's manifest, which makes the store readable where the same sources, Python
 and numba run. A kernel no scene reached compiles on the user's machine as before.
 """
@@ -56,7 +57,7 @@ def pile_scene(n: int, ticks: int = 300) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _compile_scenes(scenarios: Path) -> int:
+def _compile_scenes(scenarios: Path, bench: bool = True) -> int:
     """In the prebuild's child process: run every scene compiled, as `collide2d run` does;
     returns the number of kernel files in the store."""
     from collide2d.runner.bench.scenes import standard_scene
@@ -78,8 +79,9 @@ def _compile_scenes(scenarios: Path) -> int:
                 source = path
             runs = str(Path(out) / "runs")
             commands.append((name, ["run", str(source), "--out", runs, "--jit", "on", "--quiet"]))
-        bench = ["bench", "--quick", "--scenarios", str(scenarios), "--out", out, "--quiet"]
-        commands.append(("bench --quick", bench))
+        if bench:
+            quick = ["bench", "--quick", "--scenarios", str(scenarios), "--out", out, "--quiet"]
+            commands.append(("bench --quick", quick))
         for done, (name, argv) in enumerate(commands, 1):
             began = time.perf_counter()
             status = command(argv)
@@ -106,12 +108,17 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--scenarios", type=Path, default=Path("scenarios"), help="the bundled scenarios' folder"
     )
+    parser.add_argument(
+        "--no-bench",
+        action="store_true",
+        help="leave out `collide2d bench --quick` (its kernels then compile on its first run)",
+    )
     parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if not args.scenarios.is_dir():
         parser.error(f"{args.scenarios}: no such folder (run from the project's folder)")
     if args.child:
-        _compile_scenes(args.scenarios)
+        _compile_scenes(args.scenarios, bench=not args.no_bench)
         return 0
     shutil.rmtree(kernelstore.STORE, ignore_errors=True)
     os.makedirs(kernelstore.STORE)
@@ -120,6 +127,7 @@ def main(argv: list[str] | None = None) -> int:
     env.pop("NUMBA_CPU_FEATURES", None)
     env.pop("NUMBA_DISABLE_JIT", None)
     command = [sys.executable, "-m", "collide2d.runner.prebuild", "--child"]
+    command += ["--no-bench"] if args.no_bench else []
     began = time.perf_counter()
     status = subprocess.call([*command, "--scenarios", str(args.scenarios)], env=env)
     if status:
