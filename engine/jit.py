@@ -283,18 +283,7 @@ def _package_root(path: str) -> str | None:
 def _package_fingerprint(root: str) -> str:
     """A digest of every Python source under `root`: changes when any of them does."""
     digest = hashlib.sha256()
-    for folder, dirs, files in sorted(os.walk(root)):
-        dirs.sort()
-        for name in sorted(files):
-            if name.endswith(".py"):
-                path = os.path.join(folder, name)
-                digest.update(os.path.relpath(path, root).encode())
-                try:
-                    with open(path, "rb") as f:
-                        digest.update(hashlib.sha256(f.read()).digest())
-                except OSError:  # a file this process may not read: its size and time stand in
-                    stat = os.stat(path)
-                    digest.update(f"{stat.st_size}:{stat.st_mtime_ns}".encode())
+    kernelstore.hash_sources(digest, root, root)
     return digest.hexdigest()
 
 

@@ -59,16 +59,25 @@ def sources_digest(parent: str) -> str:
     engine), each by its path from `parent` and its bytes."""
     digest = hashlib.sha256()
     for package in PACKAGES:
-        for folder, dirs, files in sorted(os.walk(os.path.join(parent, package))):
-            dirs.sort()
-            for name in sorted(files):
-                if name.endswith(".py"):
-                    path = os.path.join(folder, name)
-                    relative = os.path.relpath(path, parent).replace(os.sep, "/")
-                    digest.update(relative.encode())
+        hash_sources(digest, os.path.join(parent, package), parent)
+    return digest.hexdigest()
+
+
+def hash_sources(digest, root: str, base: str) -> None:
+    """Add every Python source under `root` to `digest` (a hashlib object): its path from `base`
+    and its bytes (its size and time where this process may not read it)."""
+    for folder, dirs, files in sorted(os.walk(root)):
+        dirs.sort()
+        for name in sorted(files):
+            if name.endswith(".py"):
+                path = os.path.join(folder, name)
+                digest.update(os.path.relpath(path, base).replace(os.sep, "/").encode())
+                try:
                     with open(path, "rb") as f:
                         digest.update(hashlib.sha256(f.read()).digest())
-    return digest.hexdigest()
+                except OSError:
+                    stat = os.stat(path)
+                    digest.update(f"{stat.st_size}:{stat.st_mtime_ns}".encode())
 
 
 def python_tag() -> str:
