@@ -134,6 +134,35 @@ MODEL_KERNELS = {
 }  # fmt: skip
 
 
+# The engine's modules shared by the models (a model's burst of compiling takes those it calls).
+SHARED_KERNELS = ("collide2d.engine.contact.", "collide2d.engine.events.",
+                  "collide2d.engine.shapes.", "collide2d.engine.broadphase.",
+                  "collide2d.engine.sort.", "collide2d.engine.response.",
+                  "collide2d.engine.motion.", "collide2d.engine.noroom.")  # fmt: skip
+MODELS = "collide2d.engine.models."
+PICTURE = "collide2d.engine.picture."
+
+
+def burst(kernel: str) -> tuple[str, float]:
+    """(what compiles, table CPU seconds to compile it from an empty cache) when `kernel`
+    (module.qualname) starts a burst of compiling: its model's kernels and the shared ones, the
+    drawing kernels or the loading ones, leaving out those the wheel ships; ("kernels", 0.0) for a
+    kernel the table does not know (a plugin's, or another process's: "")."""
+    if kernel.startswith(MODELS):
+        model = kernel[len(MODELS):].split(".")[0]
+        what, prefixes = f"the {model} model's kernels", MODEL_KERNELS.get(
+            model, (f"{MODELS}{model}.", *SHARED_KERNELS))
+    elif kernel.startswith(PICTURE):
+        what, prefixes = "the drawing kernels", (PICTURE,)
+    elif kernel.startswith(MODEL_KERNELS["load"]):
+        what, prefixes = "the scenario-loading kernels", MODEL_KERNELS["load"]
+    else:
+        return "kernels", 0.0
+    kernels = table()["kernels"]
+    held = kernelstore.holds
+    return what, sum(s for n, s in kernels.items() if n.startswith(prefixes) and not held(n))
+
+
 def model_seconds(model: str) -> float:
     """CPU seconds to start numba and compile the kernels of `model`'s runs ("load": of loading a
     scenario) from an empty cache, on the table's machine (the table's kernels under

@@ -49,7 +49,7 @@ from contextvars import ContextVar
 import numpy as np
 
 from collide2d.engine import jit, kernelstore
-from collide2d.runner import compilecost
+from collide2d.runner import compilecost, compiling
 
 MODES = ("auto", "on", "off")
 # How many times faster compiled kernels run a tick than interpreted ones, at the least (measured
@@ -177,6 +177,7 @@ class RunLane:
         self.called = jit.Called()
         self._ready: dict = {}  # kernel -> seconds to get it ready, once asked
         self._empty: bool | None = None
+        self._cold = 0.0  # table seconds of compiling the kernels called so far, once asked
         if self.may_switch and (bursts_past_compiling(scenario) or big_and_stored(scenario)):
             self.compiled = self.started_compiled = True
             self.may_switch = False
@@ -218,6 +219,7 @@ class RunLane:
             return  # measure longer before paying more than has been measured
         if saved > SWITCH_MARGIN * cost:
             self.compiled, self.may_switch = True, False
+            compiling.expect(self._cold)  # for the compile notice (runner.command.compilenotice)
 
     def share(self, spent: float) -> float:
         """The share of a core this run's ticks have had (its CPU time over its wall time): a
@@ -239,7 +241,7 @@ class RunLane:
         for entry, under in self.called.entries.items():
             needed |= {entry} if self._ready[entry][1] == 0.0 else under
         load = sum(self._ready[k][0] for k in needed)
-        cold = sum(self._ready[k][1] for k in needed)
+        cold = self._cold = sum(self._ready[k][1] for k in needed)
         scaled = cold * compilecost.speed_factor() if cold else 0.0
         return compilecost.start_seconds(share) + (load + scaled) / share
 

@@ -235,13 +235,6 @@ def plural(count: int, noun: str) -> str:
 COMPILING_COMMANDS = ("run", "check", "bless", "validate", "stress", "bench", "sweep")
 
 
-def compile_notice() -> None:
-    """The one line a terminal shows when kernels start compiling (above a progress bar drawn)."""
-    from collide2d.runner.output import progress
-
-    progress.say("compiling kernels, first run only (numba caches them for later runs) …")
-
-
 def command_of(argv: list[str]) -> str | None:
     """The subcommand named in argv (the first word that is not an option), or None."""
     for word in argv:
@@ -301,9 +294,10 @@ def main(argv: list[str] | None = None) -> int:
         args = parser.parse_args(argv)
         if args.command in COMPILING_COMMANDS:
             from collide2d.runner import compiling
+            from collide2d.runner.command.compilenotice import CompileNotice
 
             quiet = getattr(args, "quiet", False) or not sys.stderr.isatty()
-            compiling.install(None if quiet else compile_notice)
+            compiling.install(None if quiet else CompileNotice())
         status = _answered(args)
     if called and status == EXIT_INTERRUPTED:
         raise KeyboardInterrupt  # the caller's Ctrl-C too, answered by the command (above)

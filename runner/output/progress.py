@@ -31,7 +31,13 @@ class Progress:
     """A bar for `total` ticks (or other `unit`s: a sweep counts runs) written to `stream`."""
 
     def __init__(
-        self, total: int, label: str, stream=None, unit: str = " ticks", waiting: bool = False
+        self,
+        total: int,
+        label: str,
+        stream=None,
+        unit: str = " ticks",
+        waiting: bool = False,
+        bar_format: str | None = None,
     ):
         from tqdm import tqdm
 
@@ -46,6 +52,7 @@ class Progress:
             leave=False,
             mininterval=REDRAW_S,
             delay=0 if waiting else SHOW_AFTER_S,
+            bar_format=bar_format,
         )
         self.done = 0
         self._stop = threading.Event()

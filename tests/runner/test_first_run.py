@@ -24,8 +24,9 @@ import pytest
 
 import collide2d
 from collide2d.engine import jit
-from collide2d.runner import compiling
-from collide2d.runner.command.main import compile_notice, main
+from collide2d.runner import compilecost, compiling
+from collide2d.runner.command.compilenotice import CompileNotice
+from collide2d.runner.command.main import main
 from collide2d.runner.output import progress
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -57,9 +58,20 @@ def cli(*args, **kwargs) -> subprocess.CompletedProcess:
 
 
 @pytest.mark.skipif(os.environ.get("NUMBA_DISABLE_JIT") == "1", reason="nothing compiles")
-def test_compile_time_is_counted_once_per_compilation_and_the_notice_said_once():
-    told = []
-    compiling.install(lambda: told.append(1))
+def test_compile_time_is_counted_once_per_compilation_and_the_watcher_hears_each_kernel():
+    heard = []
+
+    class Watcher:
+        def begin(self, kernel):
+            heard.append(("begin", kernel))
+
+        def compiled(self, kernel):
+            heard.append(("compiled", kernel))
+
+        def end(self):
+            heard.append(("end",))
+
+    compiling.install(Watcher())
     jit.numba_module()  # numba loaded the engine's way, as a run loads it (the listener with it)
     before = compiling.seconds()
 
@@ -75,9 +87,17 @@ def test_compile_time_is_counted_once_per_compilation_and_the_notice_said_once()
     assert outer(3) == 8
     took = time.perf_counter() - started
     assert 0 < compiling.seconds() - before <= took  # nested compilations counted once
-    assert told == [1]
+    here = f"{__name__}.test_compile_time_is_counted_once_per_compilation_and_the_watcher_hears"
+    name = here + "_each_kernel.<locals>."
+    assert heard == [
+        ("begin", name + "outer"),
+        ("compiled", name + "inner"),
+        ("compiled", name + "outer"),
+        ("end",),
+    ]
     outer(4)  # compiled: nothing more
-    assert told == [1] and compiling.seconds() - before <= took
+    assert len(heard) == 4 and compiling.seconds() - before <= took
+    compiling.install(None)
 
 
 def test_summary_reports_compile_time_apart_from_run_time(tmp_path):
@@ -95,16 +115,67 @@ def test_a_terminal_gets_the_compile_notice_unless_quiet(tmp_path, monkeypatch):
 
     monkeypatch.setattr(sys, "stderr", Terminal())
     assert main(["run", str(small(tmp_path)), "--out", str(tmp_path / "o")]) == 0
-    assert compiling._state["notice"] in (compile_notice, None)  # None once it was said
+    assert isinstance(compiling._state["watcher"], CompileNotice)
     assert main(["run", str(small(tmp_path)), "--out", str(tmp_path / "o"), "--quiet"]) == 0
-    assert compiling._state["notice"] is None
+    assert compiling._state["watcher"] is None
 
 
-def test_the_notice_is_one_line_on_stderr(capsys):
-    compile_notice()
+@pytest.fixture
+def cold_table(monkeypatch):
+    """compilecost as on the table's machine, with no kernel in the wheel's store."""
+    monkeypatch.setattr(compilecost, "speed_factor", lambda: 1.0)
+    monkeypatch.setattr(compilecost.kernelstore, "holds", lambda name: False)
+    return compilecost.table()["kernels"]
+
+
+def test_the_notice_says_once_what_compiles_and_about_how_long(capsys, cold_table):
+    stepped = ("collide2d.engine.models.stepped.", *compilecost.SHARED_KERNELS)
+    expected = sum(s for name, s in cold_table.items() if name.startswith(stepped))
+    assert expected > 30  # the stepped model and the shared modules, from an empty cache
+    drawing = sum(s for name, s in cold_table.items() if name.startswith(compilecost.PICTURE))
+    notice = CompileNotice()
+    notice.begin("collide2d.engine.models.stepped.step.run")
+    notice.end()
+    notice.begin("collide2d.engine.models.stepped.settle.run")  # a later burst: said already
+    notice.end()
+    notice.begin("collide2d.engine.picture.pixels.draw")  # another kind of kernel
+    notice.end()
+    said = [line for line in capsys.readouterr().err.splitlines() if "first run" in line]
+    assert said == [
+        f"compiling the stepped model's kernels, first run only: about {expected:.0f} s "
+        "(numba caches them for later runs) …",
+        f"compiling the drawing kernels, first run only: about {drawing:.0f} s "
+        "(numba caches them for later runs) …",
+    ]
+    compiling.expect(12.4)  # a run's lane switching to compiled kernels knows which it called
+    lane = CompileNotice()
+    lane.begin("collide2d.engine.models.stepped.step.run")
+    lane.end()
+    assert "stepped model's kernels, first run only: about 12 s" in capsys.readouterr().err
+    CompileNotice().begin("")  # another process's (a sweep's worker), or a plugin's kernels
     assert capsys.readouterr().err == (
         "compiling kernels, first run only (numba caches them for later runs) …\n"
     )
+
+
+def test_the_notice_bar_counts_the_kernels_compiled_against_the_estimate(cold_table):
+    notice = CompileNotice()
+    notice.begin("collide2d.engine.models.exact.model._run")
+    bar = notice.bar
+    assert bar is not None and bar.bar.total == round(compilecost.burst(
+        "collide2d.engine.models.exact.model._run")[1])
+    notice.compiled("collide2d.engine.models.exact.apply.rest_on")
+    notice.compiled("collide2d.engine.models.exact.apply._settle")
+    table = cold_table
+    assert bar.done == round(table["collide2d.engine.models.exact.apply.rest_on"]
+                             + table["collide2d.engine.models.exact.apply._settle"])
+    for _ in range(200):  # more than expected: the bar stays short of full until the end
+        notice.compiled("collide2d.engine.models.exact.model._run")
+    assert bar.done == bar.bar.total - 1
+    notice.end()
+    assert notice.bar is None and bar not in progress._open
+    notice.begin("boxflip.model.step")  # a plugin's kernels: no estimate, no bar
+    assert notice.bar is None
 
 
 def test_run_loads_only_the_modules_of_its_command(tmp_path):

@@ -33,13 +33,13 @@ MAX_MODULES = 16
 BELOW_COMMAND = {"engine", "lanes", "compiling", "scenario", "output", "run"}
 MAY_IMPORT = {
     "compilecost": {"engine"},
-    "lanes": {"engine", "compilecost"},
+    "lanes": {"engine", "compilecost", "compiling"},
     "compiling": {"engine"},
     "scenario": {"engine", "lanes"},
     "output": {"engine", "scenario"},
     "interrupt": {"output"},
     "run": {"engine", "lanes", "compiling", "scenario", "output", "interrupt"},
-    "command": BELOW_COMMAND | {"interrupt"},
+    "command": BELOW_COMMAND | {"interrupt", "compilecost"},
     "stress": BELOW_COMMAND | {"command"},
     "bench": BELOW_COMMAND | {"command"},
     "sweep": BELOW_COMMAND | {"command", "bench", "interrupt"},
