@@ -9,7 +9,8 @@ project's `out` setting, else `out`). Exit status: 0 done, 2 bad input (nothing 
 not installed, a scheduler that does not answer or OUT/sweep taken by another sweep, 3 when a run
 failed unexpectedly (its row says so), 130 when cancelled by Ctrl-C (the rows done are written,
 marked incomplete). The line `sweep: N runs on ...` comes once the cluster is up; a Ctrl-C while
-it starts goes unseen (runner.sweep.cluster).
+it starts goes unseen (runner.sweep.cluster). Each run done prints a line on stdout (`finished`),
+in the order they finish; `--quiet` prints none.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from pathlib import Path
 
 from collide2d.runner import interrupt
 from collide2d.runner.command.exitcodes import EXIT_BAD_INPUT, EXIT_OK, EXIT_UNEXPECTED
+from collide2d.runner.output import escape
 from collide2d.runner.output.progress import say
 
 EXIT_CANCELLED = 130
@@ -126,6 +128,28 @@ def matrix_from_args(args):
     return paths, axes, seeds, limits
 
 
+def finished(total: int, keys: list[str], quiet: bool):
+    """`on_row` for the driver: a line on stdout for each run done, above the bar (not quiet):
+    `sweep: [3/8] NAME model=stepped seed=2: ok, 12 pair events, 0.123s`."""
+    if quiet:
+        return None
+    count = {"done": 0}
+
+    def told(run, row: dict) -> None:
+        count["done"] += 1
+        params = run.params
+        shown = " ".join(f"{k}={params[k]}" for k in [*keys, "seed"] if k in params)
+        what = escape.one_line(f"{params['scenario']} {shown}".strip())
+        if row["status"] == "ok":
+            pairs = f"{row['pair_events']:,} pair event{'' if row['pair_events'] == 1 else 's'}"
+            how = f"ok, {pairs}, {row['run_time_s']:.3f}s"
+        else:
+            how = f"{row['status']}: {escape.one_line(row['note'])}"
+        say(f"sweep: [{count['done']}/{total}] {what}: {how}", sys.stdout)
+
+    return told
+
+
 def cmd_sweep(args: argparse.Namespace) -> int:
     from collide2d.runner.command import settings as config
     from collide2d.runner.sweep import cluster, driver, folder, matrix, plan, results
@@ -149,7 +173,10 @@ def cmd_sweep(args: argparse.Namespace) -> int:
                     if not args.quiet:  # the cluster is up: from here Ctrl-C writes the rows done
                         where = args.scheduler or f"{args.workers or os.cpu_count()} local workers"
                         say(f"sweep: {len(runs)} runs on {where}")
-                    table, complete = driver.run_sweep(client, runs, progress=progress)
+                    done = finished(len(runs), [a.key for a in axes], args.quiet)
+                    table, complete = driver.run_sweep(
+                        client, runs, progress=progress, on_row=done
+                    )
                     written = results.write(stage, table, complete)
                 if not complete:  # said before the cluster closes, which may take seconds
                     interrupt.told(  # that Ctrl-C does not wait for (runner.interrupt)

@@ -66,6 +66,23 @@ def test_sweep_on_the_default_local_cluster_matches_an_in_process_one(tmp_path, 
     assert json.loads((out / "sweep" / "sweep.json").read_text())["complete"] is True
 
 
+def test_a_sweep_prints_a_line_for_each_run_as_it_finishes(tmp_path):
+    out = tmp_path / "out"
+    done = _cli("sweep", FIFTY, "--set", "model=paper,stepped", "--set", "ticks=10", "--seeds",
+                "1-2", "--workers", "1", "--out", str(out))
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+    runs = [line for line in lines if line.startswith("sweep: [")]
+    assert [line.split("]")[0] for line in runs] == [f"sweep: [{k}/4" for k in range(1, 5)]
+    told = {line.split("] ", 1)[1].split(":")[0] for line in runs}
+    assert told == {
+        f"paper_fifty_boxes model={model} ticks=10 seed={seed}"
+        for model in ("paper", "stepped") for seed in (1, 2)
+    }
+    assert all(": ok, " in line and "pair event" in line for line in runs)
+    assert lines[-1].startswith("sweep: 4 runs -> ")
+
+
 def test_check_on_a_cluster_says_what_a_local_check_says(tmp_path):
     root = tmp_path / "project"
     (root / "scenarios").mkdir(parents=True)
