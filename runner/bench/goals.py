@@ -8,7 +8,10 @@ not (runner.bench.report).
 - EXACT_EVENTS_PER_S: the exact model's events/s by scene of the exact part, at least;
 - EXACT_GRAVITY_RATIO: the exact model's events/s on a gas under gravity over the same gas
   without it (the gravity part), at least;
-- LOAD: seconds (and peak MB) to load that many objects, by how (runner.bench.load), at most.
+- LOAD: seconds (and peak MB) to load that many objects, by how (runner.bench.load), at most;
+- COMPILE_BUDGET_S: seconds a model's kernels take to compile for its standard scene from an
+  empty kernel cache, at most, when nothing is precompiled (the jit part; none at all where the
+  wheel ships them).
 """
 
 from __future__ import annotations
@@ -23,3 +26,4 @@ LOAD = {
     "YAML block list, fast lane": (3.0, 300),
     "CSV table": (0.3, None),
 }
+COMPILE_BUDGET_S = {"paper": 3.0, "stepped": 8.0, "exact": 8.0}

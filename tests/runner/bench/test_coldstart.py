@@ -5,7 +5,8 @@ in the rows, the headline and bench.md."""
 
 from __future__ import annotations
 
-from collide2d.runner.bench import report
+from collide2d.engine import kernelstore
+from collide2d.runner.bench import goals, report
 from collide2d.runner.bench import targets as coldstart
 from collide2d.runner.bench.scenes import PROJECT_SCENARIOS
 
@@ -45,6 +46,7 @@ def test_rows_compare_auto_with_the_faster_lane(monkeypatch, tmp_path):
         return (limit, "stopped") if limit is not None and wall > limit else (wall, lane)
 
     monkeypatch.setattr(coldstart, "run_cold", fake)
+    monkeypatch.setattr(coldstart, "compile_budgets", lambda quick, echo, tmp: [])
     rows = coldstart.cold_start(True, quiet)
     # on stopped once past both others (3.0 + 1 s): it cannot be the faster
     assert rows and all(r["ratio"] == 3.0 / 2.5 and r["met"] for r in rows)
@@ -56,6 +58,36 @@ def test_rows_compare_auto_with_the_faster_lane(monkeypatch, tmp_path):
     assert not any(r["on_stopped"] for r in rows)
     assert not any(r["met"] for r in rows)
     what, figure, target, met = [h for h in report.headline(rows) if "--jit auto" in h[0]][0]
-    assert (figure, target, met) == ("1.60", "<= 1.5", "✗")
+    assert (figure, target, met) == ("1.60", "<= 1.2", "✗")
     md = report.markdown(rows, "collide2d bench --part jit", 1.0)
     assert "## Compiled, interpreted or auto" in md and "> 50.0" in md
+
+
+def test_each_model_is_held_to_its_compile_budget_or_to_none_where_the_wheel_ships_it(
+    monkeypatch, tmp_path
+):
+    compiled = {"paper": 2.9, "stepped": 47.0, "exact": 0.0}
+    stored = {"exact"}
+    ran = []
+
+    def fake(path, mode, tmp, limit=None):
+        model = path.read_text().split("model: ")[1].split()[0]
+        ran.append((model, mode))
+        return 1.0, {"compile_time_s": compiled[model], "kernels": "compiled"}
+
+    monkeypatch.setattr(coldstart, "_cold", fake)
+    monkeypatch.setattr(kernelstore, "holds_model", lambda model: model in stored)
+    rows = coldstart.compile_budgets(False, quiet, tmp_path)
+    assert ran == [("paper", "on"), ("stepped", "on"), ("exact", "on")]
+    got = {r["model"]: (r["value"], r["target"], r["met"]) for r in rows}
+    assert got == {
+        "paper": (2.9, f"<= {goals.COMPILE_BUDGET_S['paper']:g}", True),
+        "stepped": (47.0, f"<= {goals.COMPILE_BUDGET_S['stepped']:g}", False),
+        "exact": (0.0, "<= 0", True),
+    }
+    head = {what: (figure, target, met) for what, figure, target, met in report.headline(rows)}
+    assert head["stepped model compiling, standard scene, empty cache (nothing precompiled), s"] == (
+        "47.0", "<= 8", "✗")
+    assert "## Compiling each model's kernels" in report.markdown(rows, "bench", 1.0)
+    compiled["exact"] = 0.4  # a kernel the store lacks compiled: the wheel's promise missed
+    assert [r["met"] for r in coldstart.compile_budgets(True, quiet, tmp_path)] == [False]
