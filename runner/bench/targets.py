@@ -164,7 +164,7 @@ def run_cold(path: Path, mode: str, tmp: Path, limit: float | None = None) -> tu
     return (wall, "stopped") if summary is None else (wall, summary.get("kernels", ""))
 
 
-def _cold(path: Path, mode: str, tmp: Path, limit: float | None = None) -> tuple[float, dict | None]:
+def _cold(path: Path, mode: str, tmp: Path, limit: float | None = None):
     """(wall s, the run's summary.json) of `collide2d run PATH --jit MODE` from an empty kernel
     cache; (limit, None) when it passes `limit` seconds."""
     with tempfile.TemporaryDirectory(prefix="cache-", dir=tmp) as cache:

@@ -86,8 +86,8 @@ def test_each_model_is_held_to_its_compile_budget_or_to_none_where_the_wheel_shi
         "exact": (0.0, "<= 0", True),
     }
     head = {what: (figure, target, met) for what, figure, target, met in report.headline(rows)}
-    assert head["stepped model compiling, standard scene, empty cache (nothing precompiled), s"] == (
-        "47.0", "<= 8", "✗")
+    stepped = "stepped model compiling, standard scene, empty cache (nothing precompiled), s"
+    assert head[stepped] == ("47.0", "<= 8", "✗")
     assert "## Compiling each model's kernels" in report.markdown(rows, "bench", 1.0)
     compiled["exact"] = 0.4  # a kernel the store lacks compiled: the wheel's promise missed
     assert [r["met"] for r in coldstart.compile_budgets(True, quiet, tmp_path)] == [False]
