@@ -92,16 +92,18 @@ def seconds() -> float:
     return _state["seconds"]
 
 
-def expect(cold: float) -> None:
-    """The next burst of compiling is expected to take `cold` of the measured table's seconds
-    (runner.compilecost): a run's lane knows the kernels it has called when it switches."""
-    _state["expected"] = cold
+def expect(cold: float, kernels: set[str]) -> None:
+    """The next burst of compiling, when it begins with one of `kernels` (module.qualname), is
+    expected to take `cold` of the measured table's seconds (runner.compilecost): a run's lane
+    knows the kernels it has called when it switches."""
+    _state["expected"] = (cold, kernels)
 
 
-def expected() -> float | None:
-    """What `expect` said of the burst beginning now (None: nothing), said once."""
-    cold, _state["expected"] = _state["expected"], None
-    return cold
+def expected(kernel: str) -> float | None:
+    """What `expect` said of the burst beginning now with `kernel` (None: nothing, or of other
+    kernels: a lane whose kernels were all cached compiled none); said once."""
+    said, _state["expected"] = _state["expected"], None
+    return said[0] if said is not None and kernel in said[1] else None
 
 
 def told() -> None:

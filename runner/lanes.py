@@ -178,6 +178,7 @@ class RunLane:
         self._ready: dict = {}  # kernel -> seconds to get it ready, once asked
         self._empty: bool | None = None
         self._cold = 0.0  # table seconds of compiling the kernels called so far, once asked
+        self._needed: set = set()  # the kernels to get ready then
         if self.may_switch and (bursts_past_compiling(scenario) or big_and_stored(scenario)):
             self.compiled = self.started_compiled = True
             self.may_switch = False
@@ -219,7 +220,8 @@ class RunLane:
             return  # measure longer before paying more than has been measured
         if saved > SWITCH_MARGIN * cost:
             self.compiled, self.may_switch = True, False
-            compiling.expect(self._cold)  # for the compile notice (runner.command.compilenotice)
+            # for the compile notice (runner.command.compilenotice)
+            compiling.expect(self._cold, {compilecost.name(k) for k in self._needed})
 
     def share(self, spent: float) -> float:
         """The share of a core this run's ticks have had (its CPU time over its wall time): a
@@ -241,6 +243,7 @@ class RunLane:
         for entry, under in self.called.entries.items():
             needed |= {entry} if self._ready[entry][1] == 0.0 else under
         load = sum(self._ready[k][0] for k in needed)
+        self._needed = needed
         cold = self._cold = sum(self._ready[k][1] for k in needed)
         scaled = cold * compilecost.speed_factor() if cold else 0.0
         return compilecost.start_seconds(share) + (load + scaled) / share

@@ -18,6 +18,8 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 
 pytestmark = pytest.mark.slow
+# A wheel built already from this checkout (CI's release), used instead of building one here.
+BUILT_WHEEL = "COLLIDE2D_TEST_WHEEL"
 
 
 def run(args, cwd, env=None) -> subprocess.CompletedProcess:
@@ -30,19 +32,21 @@ def run(args, cwd, env=None) -> subprocess.CompletedProcess:
 
 @pytest.fixture(scope="module")
 def bin_dir(tmp_path_factory) -> Path:
-    """collide2d's wheel, built from a copy of the checkout (the build leaves nothing in it) and
-    installed with the test extra into a fresh virtualenv: its bin folder (one for the module's
-    tests)."""
+    """collide2d's wheel, built from a copy of the checkout (the build leaves nothing in it), or
+    the one BUILT_WHEEL names, installed with the test extra into a fresh virtualenv: its bin
+    folder (one for the module's tests)."""
     tmp_path = tmp_path_factory.mktemp("wheel")
-    source = tmp_path / "source"
-    ignore = shutil.ignore_patterns("__pycache__", "*.egg-info", "build")
-    for part in ("collide2d", "engine", "runner"):
-        shutil.copytree(ROOT / part, source / part, ignore=ignore)
-    for part in ("pyproject.toml", "README.md"):
-        shutil.copy(ROOT / part, source / part)
-    pip = [sys.executable, "-m", "pip"]
-    run([*pip, "wheel", "--no-deps", "-q", "-w", tmp_path / "w", source], tmp_path)
-    (wheel,) = (tmp_path / "w").glob("collide2d-*.whl")
+    wheel = os.environ.get(BUILT_WHEEL) or None
+    if wheel is None:
+        source = tmp_path / "source"
+        ignore = shutil.ignore_patterns("__pycache__", "*.egg-info", "build")
+        for part in ("collide2d", "engine", "runner"):
+            shutil.copytree(ROOT / part, source / part, ignore=ignore)
+        for part in ("pyproject.toml", "README.md"):
+            shutil.copy(ROOT / part, source / part)
+        pip = [sys.executable, "-m", "pip"]
+        run([*pip, "wheel", "--no-deps", "-q", "-w", tmp_path / "w", source], tmp_path)
+        (wheel,) = (tmp_path / "w").glob("collide2d-*.whl")
     env_dir = tmp_path / "venv"
     venv.create(env_dir, with_pip=True)
     bin_dir = env_dir / "bin"

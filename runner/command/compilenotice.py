@@ -41,7 +41,7 @@ class CompileNotice:
 
     def begin(self, kernel: str) -> None:
         what, cold = compilecost.burst(kernel)
-        known = compiling.expected()  # a run's lane knows the kernels it called
+        known = compiling.expected(kernel)  # a run's lane knows the kernels it called
         cold = cold if known is None or not kernel else known
         if what not in self.said:
             self.said.add(what)

@@ -125,6 +125,7 @@ def cold_table(monkeypatch):
     """compilecost as on the table's machine, with no kernel in the wheel's store."""
     monkeypatch.setattr(compilecost, "speed_factor", lambda: 1.0)
     monkeypatch.setattr(compilecost.kernelstore, "holds", lambda name: False)
+    monkeypatch.setitem(compiling._state, "expected", None)  # a lane's, of an earlier test
     return compilecost.table()["kernels"]
 
 
@@ -147,11 +148,18 @@ def test_the_notice_says_once_what_compiles_and_about_how_long(capsys, cold_tabl
         f"compiling the drawing kernels, first run only: about {drawing:.0f} s "
         "(numba caches them for later runs) …",
     ]
-    compiling.expect(12.4)  # a run's lane switching to compiled kernels knows which it called
+    run = "collide2d.engine.models.stepped.step.run"
+    compiling.expect(12.4, {run})  # a run's lane switching to compiled knows what it called
     lane = CompileNotice()
-    lane.begin("collide2d.engine.models.stepped.step.run")
+    lane.begin(run)
     lane.end()
     assert "stepped model's kernels, first run only: about 12 s" in capsys.readouterr().err
+    compiling.expect(0.0, {run})  # a lane whose kernels were all cached: not of this burst
+    lane = CompileNotice()
+    lane.begin("collide2d.engine.models.stepped.settle.run")
+    lane.end()
+    assert f"stepped model's kernels, first run only: about {expected:.0f} s" in (
+        capsys.readouterr().err)
     CompileNotice().begin("")  # another process's (a sweep's worker), or a plugin's kernels
     assert capsys.readouterr().err == (
         "compiling kernels, first run only (numba caches them for later runs) …\n"
