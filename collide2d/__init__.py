@@ -73,11 +73,8 @@ def __getattr__(name: str):
         return value
     if name != "__version__":
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    from importlib import metadata
+    from collide2d.runner.command.version import version as installed
 
-    try:
-        version = metadata.version("collide2d")
-    except metadata.PackageNotFoundError:  # pragma: no cover - a tree that is not installed
-        version = "0+unknown"
+    version = installed()
     globals()["__version__"] = version
     return version

@@ -218,7 +218,10 @@ def run(
     arguments.with_out(out, {name: (given[name], checked[name]) for name in given})
     scenario = _scenario(scenario, model, limits)
     if out is not None:
-        options = _write_options(scenario, events, png, gif, viewer, overlay, scale, quiet)
+        options = runner.RunOptions.asked(
+            scenario, events=events, png=png, gif=gif, viewer=viewer, overlay=overlay,
+            scale=scale, quiet=quiet,
+        )  # fmt: skip
         folder, done = runner.write_run(scenario, out, options, limits)
         return _result(done, folder)
     keep = _frames(scenario, frames)
@@ -266,22 +269,6 @@ def _frames(scenario, frames):
     if bad:
         raise ValueError(f"frame {bad[0]} is not one of the run's frames 0 to {ticks}")
     return FrameRule.of(numbers, ticks)
-
-
-def _write_options(scenario, events, png, gif, viewer, overlay, scale, quiet):
-    """The RunOptions of `run(..., out=...)`: what was asked, else what the scenario says."""
-    from collide2d.runner.run import RunOptions
-
-    said = scenario.output
-    return RunOptions(
-        png=bool(said.frames) if png is None else png,
-        gif=said.gif if gif is None else gif,
-        events=events,
-        scale=scale,
-        quiet=quiet,
-        viewer=said.viewer if viewer is None else viewer,
-        overlay=said.overlay if overlay is None else tuple(overlay),
-    )
 
 
 def _result(done, folder) -> Result:
@@ -414,7 +401,7 @@ def check(
     if report_dir is not None:
         check_target(report_dir, [scenario.name for _, scenario in loaded])
     done = [
-        check_scenario(scenario, goldens, path=path, bless=bless, report=report_dir)
+        _checked(scenario, goldens, path, bless, report_dir)
         for path, scenario in loaded
     ]
     return CheckResult(tuple(done))
@@ -431,36 +418,19 @@ def _loaded(item, project) -> tuple[Path | None, Scenario]:
     return None, item
 
 
-def check_scenario(
-    scenario: Scenario,
-    store: Any,
-    *,
-    path: str | os.PathLike[str] | None = None,
-    bless: bool = False,
-    report: Path | None = None,
-    simulate: Any = None,
-    run: Any = None,
-    viewer: Any = None,
-    progress: bool = False,
-) -> ScenarioCheck:
-    """Check (or bless) one Scenario against `store` (a `runner.golden.store.GoldenStore`): the
-    step `check` and the `collide2d check` / `bless` commands share. `simulate` stands in for
-    the runner's in-memory run, `run()` gives the golden run done elsewhere (on a cluster);
-    `viewer` makes a failing check's viewer page; `progress` shows a bar on the terminal."""
-    from collide2d.runner.golden import cli, session
+def _checked(scenario: Scenario, store: Any, path: str | os.PathLike[str] | None, bless: bool,
+             report: Path | None) -> ScenarioCheck:
+    """Check (or bless) one Scenario against `store` (a `runner.golden.store.GoldenStore`), the
+    step the `collide2d check` and `bless` commands take (runner.golden.cli.check_one), as a
+    ScenarioCheck."""
+    from collide2d.runner.golden.cli import check_one
 
-    simulate = simulate or cli.default_simulate
-    if run is not None:
-        result = run()
-    else:
-        result = cli.run_scenario(scenario, simulate, progress=progress)
+    outcome = check_one(scenario, store, path=path, bless=bless, report=report)
     if bless:
-        done = session.bless_run(scenario, result, store)
         shown = str(path or scenario.path or scenario.name)
-        return ScenarioCheck(done.name, shown, done.status, True, (), done.line(), None, done)
-    outcome = session.check_run(
-        scenario, result, store, path=path, report_dir=report, viewer=viewer
-    )
+        return ScenarioCheck(
+            outcome.name, shown, outcome.status, True, (), outcome.line(), None, outcome
+        )
     problems = tuple(p if isinstance(p, str) else p.message for p in outcome.problems)
     return ScenarioCheck(
         outcome.name,

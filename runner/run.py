@@ -370,6 +370,23 @@ class RunOptions:
     viewer: bool = False  # viewer.html beside the GIF (runner.output.viewerdata)
     overlay: tuple = ()  # overlays drawn into the PNG and GIF frames (runner.output.overlay)
 
+    @classmethod
+    def asked(
+        cls, scenario: Scenario, *, events, png, gif, viewer, overlay, scale, quiet
+    ) -> RunOptions:
+        """What a run was asked to write (`collide2d run`'s options, `collide2d.run`'s arguments),
+        else, where None, what the scenario's `output` says."""
+        said = scenario.output
+        return cls(
+            png=bool(said.frames) if png is None else png,
+            gif=said.gif if gif is None else gif,
+            events=events,
+            scale=scale,
+            quiet=quiet,
+            viewer=said.viewer if viewer is None else viewer,
+            overlay=said.overlay if overlay is None else tuple(overlay),
+        )
+
 
 def output_dir(out_root: str | os.PathLike, scenario: Scenario) -> Path:
     """OUT/NAME, refusing a path that would lead outside OUT (a link in the way)."""

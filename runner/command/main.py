@@ -163,7 +163,6 @@ def overlay_names(text: str) -> tuple[str, ...]:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    import collide2d
     from collide2d.runner.command import settings as config
     from collide2d.runner.command.options import (
         apply_jit,
@@ -171,7 +170,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         limits_from_args,
         overrides_from_args,
     )
-    from collide2d.runner.run import RunInterrupted
+    from collide2d.runner.run import RunInterrupted, RunOptions, write_run
+    from collide2d.runner.scenario.load import load
 
     project = config.find()
     if args.out and (project.file or project.scenarios.is_dir()):
@@ -185,28 +185,30 @@ def cmd_run(args: argparse.Namespace) -> int:
     apply_jit(args, project)
     path = args.scenario or demo_path()
     limits = limits_from_args(args, project)
-    scenario = collide2d.load(
-        path, **overrides_from_args(args), limits=limits, defaults=project.model_defaults()
+    scenario = load(
+        path,
+        overrides=overrides_from_args(args),
+        limits=limits,
+        defaults=project.model_defaults(),
     )
     out_root = args.out or (project.folder("out") if project.file else "out")
+    options = RunOptions.asked(
+        scenario,
+        events=scenario.output.events if args.events is None else args.events,
+        png=args.png,
+        gif=args.gif,
+        viewer=args.viewer,
+        overlay=args.overlay,
+        scale=args.scale,
+        quiet=args.quiet,
+    )
     try:
-        result = collide2d.run(
-            scenario,
-            events=scenario.output.events if args.events is None else args.events,
-            out=out_root,
-            png=args.png,
-            gif=args.gif,
-            viewer=args.viewer,
-            overlay=args.overlay,
-            scale=args.scale,
-            quiet=args.quiet,
-            limits=limits,
-        )
+        folder, done = write_run(scenario, out_root, options, limits)
     except RunInterrupted as stop:  # Ctrl-C: the run so far is written (docs/outputs.md)
         _ran(args, scenario, stop.folder, stop.summary)
         interrupt.told(f"collide2d: {stop}")
         return EXIT_INTERRUPTED
-    _ran(args, scenario, result.folder, result.summary)
+    _ran(args, scenario, folder, done.summary)
     return EXIT_OK
 
 
@@ -252,9 +254,9 @@ class _Version(argparse.Action):
         super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, help=help)
 
     def __call__(self, parser, namespace, values, option_string=None):
-        from collide2d import __version__
+        from collide2d.runner.command.version import version
 
-        print(f"collide2d {__version__}")
+        print(f"collide2d {version()}")
         parser.exit()
 
 

@@ -16,8 +16,8 @@ checked, named by its path in the JUnit file and the JSON summaries); `bless` re
 anything runs.
 
 `register(subparsers)` adds both commands to the `collide2d` parser; each sets `func(args) -> int`.
-Each scenario is checked or blessed by `collide2d.api.check_scenario`, the step the public
-`collide2d.check` takes too. The scenario loader and the simulator can be handed in (tests use
+Each scenario is checked or blessed by `check_one`, the step the public `collide2d.check` takes
+too. The scenario loader and the simulator can be handed in (tests use
 synthetic ones); by default they are `runner.scenario.load.load` and `runner.run.simulate`.
 """
 
@@ -30,7 +30,6 @@ import traceback
 from functools import partial
 from pathlib import Path
 
-from collide2d.api import check_scenario
 from collide2d.runner.command.exitcodes import (
     EXIT_BAD_INPUT,
     EXIT_DIFFERENCE,
@@ -89,6 +88,31 @@ def viewer_of(simulate):
     from collide2d.runner.golden import replay
 
     return replay.viewer_page if simulate is default_simulate else None
+
+
+def check_one(
+    scenario,
+    store,
+    *,
+    path=None,
+    bless: bool = False,
+    report=None,
+    simulate=None,
+    run=None,
+    viewer=None,
+    progress: bool = False,
+):
+    """Check (or bless) one Scenario against `store` (a `store.GoldenStore`): the session's
+    outcome (`session.CheckOutcome`, or what `session.bless_run` gives). `simulate` stands in
+    for the runner's in-memory run, `run()` gives the golden run done elsewhere (on a cluster);
+    `viewer` makes a failing check's viewer page; `progress` shows a bar on the terminal."""
+    from collide2d.runner.golden import session
+
+    simulate = simulate or default_simulate
+    result = run() if run is not None else run_scenario(scenario, simulate, progress=progress)
+    if bless:
+        return session.bless_run(scenario, result, store)
+    return session.check_run(scenario, result, store, path=path, report_dir=report, viewer=viewer)
 
 
 def run_scenario(scenario, simulate, *, progress=False, jit=None):
@@ -238,7 +262,7 @@ def _check_all(args, load, simulate):
     for i, (path, scn) in enumerate(scenarios, start=1):
         _progress(args, f"[{i}/{len(scenarios)}] checking {scn.name}")
         try:
-            outcome = check_scenario(
+            outcome = check_one(
                 scn,
                 store,
                 path=path,
@@ -247,7 +271,7 @@ def _check_all(args, load, simulate):
                 run=runs[i - 1] if runs is not None else None,  # on Dask (--workers, --scheduler)
                 viewer=viewer_of(simulate),
                 progress=_show_progress(args),
-            )._record
+            )
         except KeyboardInterrupt:
             raise
         except BaseException as exc:  # whatever stops one scenario, never the others
@@ -355,9 +379,9 @@ def bless_command(args, *, load=default_load, simulate=default_simulate) -> int:
     for i, (path, scn) in enumerate(scenarios, start=1):
         _progress(args, f"[{i}/{len(scenarios)}] running {scn.name}")
         try:
-            line = check_scenario(
+            line = check_one(
                 scn, store, path=path, bless=True, simulate=simulate, progress=_show_progress(args)
-            ).message
+            ).line()
         except KeyboardInterrupt:
             raise
         except BaseException as exc:  # whatever stops one scenario, never the others

@@ -36,8 +36,8 @@ import zlib
 import numpy as np
 from PIL import Image, UnidentifiedImageError
 
-from collide2d import __version__
 from collide2d.engine.events import event_dict, format_event
+from collide2d.runner.command.version import version
 from collide2d.runner.output.files import encode_png, final_csv_text
 
 # The golden folder's layout version; a reader refuses other versions with a clear message.
@@ -357,7 +357,7 @@ def manifest(scenario, events: bytes, final: bytes, frames: dict[int, np.ndarray
         "ticks": int(scenario.ticks),
         # why a check fails: was the scenario edited, or did another collide2d bless it
         "scenario_sha256": getattr(scenario, "text_sha256", None),
-        "collide2d_version": __version__,
+        "collide2d_version": version(),
         "events": {
             "file": EVENTS_FILE,
             "count": events.count(b"\n"),

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from collide2d import __version__
+from collide2d.runner.command.version import version as installed
 
 # The kinds of cause, for tools (summary.json, --format json).
 SCENARIO_EDITED = "scenario-edited"
@@ -30,8 +30,10 @@ class Cause:
         return {"kind": self.kind, "text": self.text}
 
 
-def cause(scenario, manifest: dict, version: str = __version__) -> Cause:
-    """What changed between the bless recorded in `manifest` and the check of `scenario` now."""
+def cause(scenario, manifest: dict, version: str | None = None) -> Cause:
+    """What changed between the bless recorded in `manifest` and the check of `scenario` now (by
+    collide2d `version`, else the one installed)."""
+    version = installed() if version is None else version
     then_hash = manifest.get("scenario_sha256")
     then_version = manifest.get("collide2d_version")
     now_hash = getattr(scenario, "text_sha256", None)
