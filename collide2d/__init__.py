@@ -73,8 +73,8 @@ def __getattr__(name: str):
         return value
     if name != "__version__":
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    from collide2d.runner.command.version import version as installed
+    from collide2d.runner.command import version as distribution
 
-    version = installed()
+    version = distribution.version()
     globals()["__version__"] = version
     return version

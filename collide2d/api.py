@@ -446,13 +446,13 @@ def _checked(scenario: Scenario, store: Any, path: str | os.PathLike[str] | None
 
 def _project(root):
     """The project (runner.command.settings.Config) at `root`, else found upward from here."""
-    from collide2d.runner.command import settings as config
+    from collide2d.runner.command import settings
     from collide2d.runner.golden.store import find_root
 
     if root is not None:
-        return config.at(root)
-    project = config.find()
-    return project if project.file is not None else config.at(find_root())
+        return settings.at(root)
+    project = settings.find()
+    return project if project.file is not None else settings.at(find_root())
 
 
 def _resolve(item, project) -> Path:

@@ -48,10 +48,16 @@ from collide2d.engine.events import empty_events
 from collide2d.engine.invariants import energies, momentum
 from collide2d.engine.picture.raster import Renderer
 from collide2d.runner import compiling, interrupt, lanes
-from collide2d.runner.output import budget
-from collide2d.runner.output import files as outputs
-from collide2d.runner.output import folder as rundir
-from collide2d.runner.output import viewerdata as viewer
+from collide2d.runner.output import budget, files, viewerdata
+from collide2d.runner.output.folder import (
+    OutputBusy,
+    OutputRefused,
+    RunLock,
+    check_replaceable,
+    clean_leftovers,
+    new_stage,
+    swap_in,
+)
 from collide2d.runner.output.overlay import Overlay
 from collide2d.runner.output.progress import Progress
 from collide2d.runner.scenario.frames import FrameRule
@@ -392,8 +398,8 @@ def output_dir(out_root: str | os.PathLike, scenario: Scenario) -> Path:
     """OUT/NAME, refusing a path that would lead outside OUT (a link in the way)."""
     target = Path(out_root) / scenario.name
     try:
-        rundir.check_replaceable(target)
-    except rundir.OutputRefused as exc:
+        check_replaceable(target)
+    except OutputRefused as exc:
         raise ScenarioError(scenario.path or "<scenario>", 1, 1, str(exc)) from None
     return target
 
@@ -429,21 +435,21 @@ def write_run(
     )
     root = Path(out_root)
     target = output_dir(root, scenario)
-    outputs.make_folder(root)
+    files.make_folder(root)
     try:
-        with rundir.RunLock(root, scenario.name):
-            rundir.clean_leftovers(root, scenario.name)
+        with RunLock(root, scenario.name):
+            clean_leftovers(root, scenario.name)
             output_dir(root, scenario)  # again, now that no other run can change it
-            stage = rundir.new_stage(root, scenario.name)
+            stage = new_stage(root, scenario.name)
             try:
                 result = _write_run(scenario, stage, options, plan)
-                rundir.swap_in(stage, target)
+                swap_in(stage, target)
             except BaseException as exc:
                 shutil.rmtree(stage, ignore_errors=True)
                 if isinstance(exc, OSError) and exc.filename:
                     exc.filename = _shown(exc.filename, stage, target)
                 raise
-    except rundir.OutputBusy as exc:
+    except OutputBusy as exc:
         raise ScenarioError(scenario.path or "<scenario>", 1, 1, str(exc)) from None
     summary = result.summary
     if "interrupted_at_tick" in summary:  # Ctrl-C: the run so far is written, then the caller's
@@ -469,7 +475,7 @@ def _shown(filename, stage: Path, target: Path) -> str:
         inside = path.relative_to(stage)
     except ValueError:
         return str(path)
-    final = inside.with_name(outputs.final_name(inside.name))
+    final = inside.with_name(files.final_name(inside.name))
     return str(target / final)
 
 
@@ -487,7 +493,7 @@ def _write_files(scenario: Scenario, folder: Path, options: RunOptions, plan) ->
     palette = layer.palette if layer is not None else scenario.palette
     gif = None
     if plan.gif:
-        gif = outputs.GifWriter(
+        gif = files.GifWriter(
             folder / "animation.gif",
             palette,
             scenario.world.width,
@@ -500,9 +506,9 @@ def _write_files(scenario: Scenario, folder: Path, options: RunOptions, plan) ->
             print(f"{scenario.name}: {gif.note}", file=sys.stderr)
     log = None
     if options.events:  # within what the frames leave of --max-output-bytes (runner.output.budget)
-        log = outputs.EventsWriter(folder / "events.jsonl", scenario.names, plan.log_room)
+        log = files.EventsWriter(folder / "events.jsonl", scenario.names, plan.log_room)
     # the viewer refuses a run too long to view
-    recorder = viewer.Recorder(scenario, layer) if options.viewer else None
+    recorder = viewerdata.Recorder(scenario, layer) if options.viewer else None
     digits = max(6, len(str(scenario.ticks)))
 
     def on_frame(k: int, idx: np.ndarray) -> None:
@@ -511,7 +517,7 @@ def _write_files(scenario: Scenario, folder: Path, options: RunOptions, plan) ->
         if k in plan.png:
             frames_dir.mkdir(exist_ok=True)
             name = f"frame_{k:0{digits}d}.png"
-            outputs.write_png(frames_dir / name, palette[idx], scale=options.scale)
+            files.write_png(frames_dir / name, palette[idx], scale=options.scale)
 
     progress = None if options.quiet else Progress.for_terminal(scenario.ticks, scenario.name)
     writers = [w for w in (gif, log) if w is not None]
@@ -536,15 +542,15 @@ def _write_files(scenario: Scenario, folder: Path, options: RunOptions, plan) ->
     except BaseException as exc:
         for writer in writers:
             writer.abort()
-        if isinstance(exc, outputs.LogFull):
+        if isinstance(exc, files.LogFull):
             raise _log_full(scenario, exc, plan) from None
         raise
-    outputs.write_final_csv(
+    files.write_final_csv(
         folder / "final.csv", model.positions(), model.velocities(), scenario.names
     )
     if recorder is not None and not part:
-        outputs.atomic_write_bytes(folder / viewer.VIEWER_FILE, recorder.page())
-    outputs.write_json(folder / "summary.json", summary)
+        files.atomic_write_bytes(folder / viewerdata.VIEWER_FILE, recorder.page())
+    files.write_json(folder / "summary.json", summary)
     return RunResult(scenario, empty_events(), model.positions(), model.velocities(), {}, summary)
 
 

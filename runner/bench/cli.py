@@ -32,7 +32,7 @@ REPORT_DIR = "bench"
 def cmd_bench(args: argparse.Namespace) -> int:
     from collide2d.runner import lanes
     from collide2d.runner.bench import plots, report, scaling, scenes, timing
-    from collide2d.runner.output import files as outputs
+    from collide2d.runner.output import files
 
     lanes.set_mode("on")  # every run the bench times is compiled (runner.lanes)
     parts = tuple(dict.fromkeys(args.part)) if args.part else DEFAULT_PARTS
@@ -62,10 +62,10 @@ def cmd_bench(args: argparse.Namespace) -> int:
         rows, seconds = _run_parts(args, parts, ns, models_, quick, in_process, folder, echo)
     finally:
         echo.close()
-    outputs.make_folder(target)
+    files.make_folder(target)
     args_line = "collide2d bench " + " ".join(sys.argv[2:]) if len(sys.argv) > 1 else "bench"
-    outputs.atomic_write_text(target / "bench.csv", report.csv_text(rows))
-    outputs.atomic_write_text(target / "bench.md", report.markdown(rows, args_line, seconds))
+    files.atomic_write_text(target / "bench.csv", report.csv_text(rows))
+    files.atomic_write_text(target / "bench.md", report.markdown(rows, args_line, seconds))
     written = ["bench.csv", "bench.md"] + plots.plots(rows, target)
     headline = report.headline(rows)
     if not args.quiet:

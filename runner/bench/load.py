@@ -33,7 +33,7 @@ COLORS = ("red", "white", "blue", "green")
 _CHILD = """
 import json, resource, sys, time
 from collide2d.runner.scenario import load as scenario
-from collide2d.runner.scenario import fastlane as yamlfast
+from collide2d.runner.scenario import fastlane
 def peak_kb():
     # this process's own high-water mark (ru_maxrss may carry the parent's across exec)
     try:
@@ -45,7 +45,7 @@ def peak_kb():
         pass
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
 if sys.argv[2] == "general":
-    yamlfast.split = lambda text: None
+    fastlane.split = lambda text: None
 scenario.loads("version: 1\\nobjects: []\\n")
 before = peak_kb()
 began = time.perf_counter()

@@ -63,7 +63,7 @@ def _frames_per_second(renderer, path: np.ndarray, full: bool, repeats: int) -> 
 def raster(quick: bool, echo, folder: Path = PROJECT_SCENARIOS) -> list[dict]:
     """One row per measure (the demo is read from `folder`)."""
     from collide2d.engine.picture.raster import Renderer, to_rgb
-    from collide2d.runner.output import files as outputs
+    from collide2d.runner.output import files
     from collide2d.runner.scenario.load import load
 
     frames = QUICK_RASTER_FRAMES if quick else RASTER_FRAMES
@@ -99,7 +99,7 @@ def raster(quick: bool, echo, folder: Path = PROJECT_SCENARIOS) -> list[dict]:
         for _ in range(repeats + 1):  # the first run warms up
             began = time.perf_counter()
             renderer = Renderer(world, bodies)
-            with outputs.GifWriter(
+            with files.GifWriter(
                 gif, demo.palette, world.width, world.height, world.fps, len(gif_frames)
             ) as writer:
                 for pos in gif_frames:
@@ -107,11 +107,11 @@ def raster(quick: bool, echo, folder: Path = PROJECT_SCENARIOS) -> list[dict]:
             times.append(time.perf_counter() - began)
         row(median(times[1:]), f"GIF of {len(gif_frames)} frames (render and stream), s")
         rgb = to_rgb(Renderer(world, bodies).draw(moving[0]), demo.palette)
-        outputs.write_png(Path(tmp) / "warm.png", rgb)
+        files.write_png(Path(tmp) / "warm.png", rgb)
         times = []
         for k in range(1 if quick else PNG_REPEATS):
             began = time.perf_counter()
-            outputs.write_png(Path(tmp) / f"frame_{k:06d}.png", rgb)
+            files.write_png(Path(tmp) / f"frame_{k:06d}.png", rgb)
             times.append(time.perf_counter() - began)
         row(1e3 * median(times), "one PNG frame (encode and atomic write), ms")
     return rows

@@ -163,7 +163,7 @@ def overlay_names(text: str) -> tuple[str, ...]:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    from collide2d.runner.command import settings as config
+    from collide2d.runner.command import settings
     from collide2d.runner.command.options import (
         apply_jit,
         apply_threads,
@@ -173,12 +173,12 @@ def cmd_run(args: argparse.Namespace) -> int:
     from collide2d.runner.run import RunInterrupted, RunOptions, write_run
     from collide2d.runner.scenario.load import load
 
-    project = config.find()
+    project = settings.find()
     if args.out and (project.file or project.scenarios.is_dir()):
         # a folder of its own, apart from the project's other folders (runner.command.settings)
         try:
             project.apart("out", args.out, "--out")
-        except config.FolderClash as exc:
+        except settings.FolderClash as exc:
             print(f"collide2d: error: {exc}", file=sys.stderr)
             return EXIT_BAD_INPUT
     apply_threads(args, project)

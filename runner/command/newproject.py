@@ -91,7 +91,7 @@ def run_init(args: argparse.Namespace) -> int:
 def init(root: Path) -> list[str]:
     """Make `root` a project; returns one line per file: what was done to it. Every file is read
     and every refusal made before anything is written, and the writes are all or nothing."""
-    from collide2d.runner.command import settings as config
+    from collide2d.runner.command import settings
 
     project = root.resolve()
     batch = FileBatch()
@@ -103,17 +103,17 @@ def init(root: Path) -> list[str]:
         data = (resources.files("collide2d.runner") / "data" / EXAMPLE).read_bytes()
         batch.add(_target(example, project), data, None)
         said.append(f"created   {example}")
-    pyproject = root / config.PYPROJECT
+    pyproject = root / settings.PYPROJECT
     old = _read(pyproject)
     if old is None:
         batch.add(_target(pyproject, project), TABLE_TEXT.encode("utf-8"), None)
         said.append(f"created   {pyproject}")
     else:
         text = _toml_text(pyproject, old)
-        data = config.parse(text, pyproject)
+        data = settings.parse(text, pyproject)
         tool = data.get("tool")
         if isinstance(tool, dict) and "collide2d" in tool:
-            config._table(pyproject)  # refuse a [tool.collide2d] that is not a table
+            settings._table(pyproject)  # refuse a [tool.collide2d] that is not a table
             said.append(f"kept      {pyproject} (it has a [tool.collide2d] table)")
         else:
             new = _with_table(pyproject, text, data).encode("utf-8")

@@ -31,10 +31,10 @@ def register(subparsers) -> None:
 
 
 def run_config(args: argparse.Namespace) -> int:
-    from collide2d.runner.command import settings as config
+    from collide2d.runner.command import settings
     from collide2d.runner.scenario.limits import Limits
 
-    project = config.at(args.root) if args.root else config.find()
+    project = settings.at(args.root) if args.root else settings.find()
     for key in Limits.__dataclass_fields__:
         project.override(f"limits.{key}", getattr(args, key, None))
     project.override("model.max_events_per_tick", args.max_events_per_tick)

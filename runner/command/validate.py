@@ -30,10 +30,10 @@ from collide2d.runner.scenario.schema import json_schema
 
 def run_validate(args: argparse.Namespace) -> int:
     """Check every file of args.scenarios; print one line per file; 2 if any is bad, else 0."""
-    from collide2d.runner.command import settings as config
+    from collide2d.runner.command import settings
     from collide2d.runner.command.main import plural
 
-    project = config.find()
+    project = settings.find()
     limits = limits_from_args(args, project)
     overrides = overrides_from_args(args)
     paths = args.scenarios or project_files(project)

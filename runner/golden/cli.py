@@ -438,18 +438,18 @@ def _project(args):
     """The project (runner.command.settings.Config) of --root, else found upward from here: the
     nearest folder with a [tool.collide2d] table or a scenarios/ folder; _Usage when there is none
     or its table is refused. Kept on `args` for the goldens folder."""
-    from collide2d.runner.command import settings as config
+    from collide2d.runner.command import settings
 
     try:
         if args.root:
-            project = config.at(args.root)
+            project = settings.at(args.root)
         else:
-            project = config.find()
+            project = settings.find()
             if project.file is None:
-                project = config.at(find_root())
+                project = settings.at(find_root())
     except GoldenError as exc:
         raise _Usage(str(exc)) from None
-    except config.ConfigError as exc:
+    except settings.ConfigError as exc:
         raise _Usage(str(exc), located=True) from None
     args.project = project
     return project

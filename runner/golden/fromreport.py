@@ -18,8 +18,7 @@ import sys
 from pathlib import Path
 
 from collide2d.runner.command.exitcodes import EXIT_BAD_INPUT, EXIT_OK
-from collide2d.runner.golden import report
-from collide2d.runner.golden import serialize as ser
+from collide2d.runner.golden import report, serialize
 from collide2d.runner.golden.session import CREATED, UNCHANGED, UPDATED
 from collide2d.runner.golden.store import (
     DEFAULT_MAX_FRAME_PIXELS,
@@ -64,7 +63,7 @@ def runs_in(report_dir: Path) -> list[str]:
     if _is_link(summary) or not summary.is_file():
         return sorted(held)
     try:
-        data = ser.load_json(summary.read_bytes()[: 64 * 1024 * 1024])
+        data = serialize.load_json(summary.read_bytes()[: 64 * 1024 * 1024])
         failed = {s["name"] for s in data["scenarios"] if s["status"] != report.STATUS_PASSED}
     except (ValueError, KeyError, TypeError):
         return sorted(held)

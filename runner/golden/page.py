@@ -30,8 +30,7 @@ from urllib.parse import quote
 
 import numpy as np
 
-from collide2d.runner.golden import eventdiff
-from collide2d.runner.golden import serialize as ser
+from collide2d.runner.golden import eventdiff, serialize
 from collide2d.runner.output.escape import visible
 from collide2d.runner.output.files import encode_png
 from collide2d.runner.output.viewerdata import VIEWER_FILE as VIEWER
@@ -201,7 +200,7 @@ def _event_table(o, links: str = "") -> str:
     if exp_bytes is None or act_bytes is None or o.first_event is None:
         return ""
     try:
-        exp, act = ser.parse_events(exp_bytes), ser.parse_events(act_bytes)
+        exp, act = serialize.parse_events(exp_bytes), serialize.parse_events(act_bytes)
     except ValueError:
         return ""
     caption = _html(

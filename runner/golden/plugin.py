@@ -101,14 +101,14 @@ def _check_report_option(config) -> None:
 def _project(config):
     """The project's runner.command.settings.Config: --golden-root's, else the nearest one upward
     with a [tool.collide2d] table or a scenarios/ folder (GoldenError when there is neither)."""
-    from collide2d.runner.command import settings as cfg
+    from collide2d.runner.command import settings
     from collide2d.runner.golden.store import find_root
 
     given = config.getoption("golden_root")
     if given:
-        return cfg.at(given)
-    found = cfg.find(config.invocation_params.dir)
-    return found if found.file else cfg.at(find_root(config.invocation_params.dir))
+        return settings.at(given)
+    found = settings.find(config.invocation_params.dir)
+    return found if found.file else settings.at(find_root(config.invocation_params.dir))
 
 
 def _root(config) -> Path:
@@ -126,11 +126,11 @@ def pytest_collect_file(file_path, parent):
     golden test."""
     if file_path.suffix not in (".yaml", ".yml"):
         return None
-    from collide2d.runner.command import settings as cfg
+    from collide2d.runner.command import settings
 
     try:
-        project = cfg.find(file_path.parent)
-    except cfg.ConfigError:
+        project = settings.find(file_path.parent)
+    except settings.ConfigError:
         return None
     if project.file is None or file_path.parent != project.scenarios.resolve():
         return None

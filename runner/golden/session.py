@@ -16,8 +16,7 @@ import json
 import shlex
 from dataclasses import dataclass
 
-from collide2d.runner.golden import compare, report, why
-from collide2d.runner.golden import serialize as ser
+from collide2d.runner.golden import compare, report, serialize, why
 from collide2d.runner.golden.store import (
     DEFAULT_MAX_FRAME_PIXELS,
     GoldenMissing,
@@ -100,7 +99,7 @@ def _run_files(scenario, result) -> dict:
 
 def _setting_notes(scenario, manifest) -> list[str]:
     """Notes on what the scenario changed since its golden was blessed (model, world, ticks)."""
-    now = ser.manifest(scenario, b"", b"", {})
+    now = serialize.manifest(scenario, b"", b"", {})
     return [
         f"note: the golden was blessed with {key} {json.dumps(manifest.get(key))}, "
         f"the scenario now has {json.dumps(now[key])}"
@@ -112,13 +111,13 @@ def _setting_notes(scenario, manifest) -> list[str]:
 def _compare(scenario, result, golden, run_frames, outcome) -> None:
     g = scenario.golden
     tol = float(g.time_tolerance)
-    events = ser.event_dicts(result.events)
+    events = serialize.event_dicts(result.events)
     mismatch = compare.compare_events(golden.events, events, tol)
     if mismatch is not None:
         outcome.problems.append(mismatch.message())
         outcome.first_event = mismatch.index
-        outcome.texts["events_expected.jsonl"] = golden.files[ser.EVENTS_FILE]
-        outcome.texts["events_actual.jsonl"] = ser.events_jsonl(result.events)
+        outcome.texts["events_expected.jsonl"] = golden.files[serialize.EVENTS_FILE]
+        outcome.texts["events_actual.jsonl"] = serialize.events_jsonl(result.events)
     hashes = {int(e["frame"]): e["pixels_sha256"] for e in golden.manifest["frames"]}
     for k in sorted(set(golden.frames) | set(golden_frames(scenario))):
         exp, act = golden.frames.get(k), run_frames.get(k)
@@ -143,12 +142,12 @@ def _compare(scenario, result, golden, run_frames, outcome) -> None:
         )
         if not diff.passed:
             outcome.problems.append(report.FrameReport(k, diff.message(), exp, act, diff))
-    final = ser.final_state(result.final_pos, result.final_vel)
+    final = serialize.final_state(result.final_pos, result.final_vel)
     fm = compare.compare_final(golden.final, final, tol)
     if fm is not None:
         outcome.problems.append(fm.message())
-        outcome.texts["final_expected.csv"] = golden.files[ser.FINAL_FILE]
-        outcome.texts["final_actual.csv"] = ser.final_csv(result.final_pos, result.final_vel)
+        outcome.texts["final_expected.csv"] = golden.files[serialize.FINAL_FILE]
+        outcome.texts["final_actual.csv"] = serialize.final_csv(result.final_pos, result.final_vel)
 
 
 @dataclass(frozen=True)
@@ -173,18 +172,18 @@ def golden_files(scenario, result, old=None) -> dict:
     missing = [k for k in golden_frames(scenario) if k not in result.frames]
     if missing:
         raise ValueError(f"the run of {scenario.name} did not keep golden frames {missing}")
-    events = ser.events_jsonl(result.events)
-    final = ser.final_csv(result.final_pos, result.final_vel)
-    manifest = ser.manifest(scenario, events, final, frames)
-    files = {ser.EVENTS_FILE: events, ser.FINAL_FILE: final}
+    events = serialize.events_jsonl(result.events)
+    final = serialize.final_csv(result.final_pos, result.final_vel)
+    manifest = serialize.manifest(scenario, events, final, frames)
+    files = {serialize.EVENTS_FILE: events, serialize.FINAL_FILE: final}
     old_hashes = {}
     if old is not None:
         old_hashes = {e["file"]: e["pixels_sha256"] for e in old.manifest["frames"]}
     for entry in manifest["frames"]:
         rel = entry["file"]
         same = old_hashes.get(rel) == entry["pixels_sha256"]
-        files[rel] = old.files[rel] if same else ser.png_bytes(frames[entry["frame"]])
-    files[ser.MANIFEST_FILE] = ser.manifest_bytes(manifest)
+        files[rel] = old.files[rel] if same else serialize.png_bytes(frames[entry["frame"]])
+    files[serialize.MANIFEST_FILE] = serialize.manifest_bytes(manifest)
     return files
 
 
@@ -212,8 +211,8 @@ def bless_run(scenario, result, store: GoldenStore) -> Blessed:
 
 
 def _contents(result, files) -> str:
-    n_frames = sum(1 for rel in files if rel.startswith(ser.FRAMES_DIR + "/"))
-    n_obj = ser.final_state(result.final_pos, result.final_vel).shape[0]
+    n_frames = sum(1 for rel in files if rel.startswith(serialize.FRAMES_DIR + "/"))
+    n_obj = serialize.final_state(result.final_pos, result.final_vel).shape[0]
     counts = ((len(result.events), "event"), (n_frames, "frame"), (n_obj, "object"))
     return ", ".join(f"{n} {word}{'' if n == 1 else 's'}" for n, word in counts)
 
@@ -221,7 +220,7 @@ def _contents(result, files) -> str:
 def _changes(scenario, result, old, changed) -> str:
     """One line naming what differs between the old golden and `result`, exactly."""
     parts = []
-    events = ser.event_dicts(result.events)
+    events = serialize.event_dicts(result.events)
     em = compare.compare_events(old.events, events, 0.0)
     if em is not None:
         ref = em.expected if em.expected is not None else em.actual
@@ -246,7 +245,8 @@ def _changes(scenario, result, old, changed) -> str:
         parts.append("frames added " + ", ".join(map(str, added)))
     if removed:
         parts.append("frames removed " + ", ".join(map(str, removed)))
-    fm = compare.compare_final(old.final, ser.final_state(result.final_pos, result.final_vel), 0.0)
+    final = serialize.final_state(result.final_pos, result.final_vel)
+    fm = compare.compare_final(old.final, final, 0.0)
     if fm is not None:
         if fm.n_expected != fm.n_actual:
             parts.append(f"final state ({fm.n_expected} -> {fm.n_actual} objects)")

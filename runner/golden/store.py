@@ -36,8 +36,8 @@ from pathlib import Path
 
 import numpy as np
 
-from collide2d.runner.golden import serialize as ser
-from collide2d.runner.output import swap as swapdir
+from collide2d.runner.golden import serialize
+from collide2d.runner.output import swap
 from collide2d.runner.scenario.load import NAME_PATTERN
 
 GOLDENS_DIR = "goldens"
@@ -45,7 +45,7 @@ SCENARIOS_DIR = "scenarios"
 SCENARIO_SUFFIXES = (".yaml", ".yml")
 # The kinds of a write's temporary folders next to goldens/NAME: `.NAME.PID.HEX.new.tmp` (the new
 # golden being built) and `.NAME.PID.HEX.old.tmp` (the old golden moved aside during the swap).
-NEW, OLD = "new", swapdir.OLD
+NEW, OLD = "new", swap.OLD
 # A golden folder's name: a scenario name that cannot leave goldens/ or hide as a dot-folder.
 _NAME_RE = re.compile(NAME_PATTERN)
 # Values of CI that mean "not in CI".
@@ -213,7 +213,7 @@ class GoldenStore:
         st = _lstat(folder)
         if st is None:
             # A write killed between its two renames left the old golden whole, aside.
-            aside = swapdir.newest_aside(self._leftovers(name))
+            aside = swap.newest_aside(self._leftovers(name))
             if aside is None:
                 raise GoldenMissing(f"no golden for {name}: {shown_path(folder)} does not exist")
             folder = aside
@@ -234,10 +234,10 @@ class GoldenStore:
         """
         if ci_active():
             raise WritesRefused(_ci_message())
-        if ser.MANIFEST_FILE not in files:
-            raise ValueError(f"a golden write needs {ser.MANIFEST_FILE}")
+        if serialize.MANIFEST_FILE not in files:
+            raise ValueError(f"a golden write needs {serialize.MANIFEST_FILE}")
         for rel in files:
-            ser.check_rel(rel)
+            serialize.check_rel(rel)
         folder = self.folder(name)
         self.check_dir()
         self.dir.mkdir(parents=True, exist_ok=True)
@@ -252,13 +252,13 @@ class GoldenStore:
         changed = sorted(rel for rel in files if old.get(rel) != files[rel])
         if not changed and not extra:
             return []
-        new = swapdir.make_temp(self.dir, name, NEW)
+        new = swap.make_temp(self.dir, name, NEW)
         try:
             _build(new, files)
         except BaseException:
-            swapdir.remove_tree(new)
+            swap.remove_tree(new)
             raise
-        swapdir.swap_in(new, folder)  # two renames: a kill between them is what `read` handles
+        swap.swap_in(new, folder)  # two renames: a kill between them is what `read` handles
         return changed
 
     def remove(self, name: str) -> None:
@@ -276,12 +276,12 @@ class GoldenStore:
             raise GoldenError(f"{shown_path(folder)} is not a folder; remove it by hand")
         if not is_golden(folder):
             raise GoldenError(
-                f"{shown_path(folder)} holds no golden's {ser.MANIFEST_FILE}; it is not a golden, "
-                "and is left alone"
+                f"{shown_path(folder)} holds no golden's {serialize.MANIFEST_FILE}; it is not a "
+                "golden, and is left alone"
             )
-        aside = swapdir.temp_path(self.dir, name, OLD)
+        aside = swap.temp_path(self.dir, name, OLD)
         os.rename(folder, aside)
-        swapdir.remove_tree(aside)
+        swap.remove_tree(aside)
 
     def recover(self, name: str) -> None:
         """Tidy what interrupted writes of golden `name` left: put an old golden moved aside back
@@ -291,13 +291,13 @@ class GoldenStore:
             return
         self.check_dir()
         folder = self.folder(name)
-        ours = [x for x in self._leftovers(name) if x[1] == os.getpid() or not swapdir.alive(x[1])]
-        swapdir.recover(folder, ours)
+        ours = [x for x in self._leftovers(name) if x[1] == os.getpid() or not swap.alive(x[1])]
+        swap.recover(folder, ours)
 
     def _leftovers(self, name: str) -> list[tuple[Path, int, str]]:
         """(path, pid, kind) of the temporary folders of golden `name` in goldens/, real folders
         only."""
-        return swapdir.leftovers(self.dir, check_name(name), (NEW, OLD))
+        return swap.leftovers(self.dir, check_name(name), (NEW, OLD))
 
 
 def is_golden(folder: Path) -> bool:
@@ -305,7 +305,7 @@ def is_golden(folder: Path) -> bool:
     JSON object names a format and a scenario. Only such folders are goldens that `unused` lists
     and `remove` deletes; any other folder is left alone."""
     try:
-        manifest = ser.load_json(_read_regular(folder / ser.MANIFEST_FILE, folder.name))
+        manifest = serialize.load_json(_read_regular(folder / serialize.MANIFEST_FILE, folder.name))
     except (GoldenError, ValueError):
         return False
     return isinstance(manifest, dict) and "format" in manifest and "scenario" in manifest
@@ -320,8 +320,8 @@ def _ci_message() -> str:
 
 def _torn(name: str, path: Path) -> str:
     return (
-        f"golden {name}: {shown_path(path)} does not match {ser.MANIFEST_FILE} (edited by hand "
-        "or an interrupted bless); bless it again"
+        f"golden {name}: {shown_path(path)} does not match {serialize.MANIFEST_FILE} (edited by "
+        "hand or an interrupted bless); bless it again"
     )
 
 
@@ -395,10 +395,10 @@ def _read_regular(path: Path, name: str, limit: int = MAX_FILE_BYTES) -> bytes:
 
 
 def _read_folder(name: str, folder: Path, max_frame_pixels: int) -> Golden:
-    mpath = folder / ser.MANIFEST_FILE
+    mpath = folder / serialize.MANIFEST_FILE
     if _lstat(mpath) is None:
         raise GoldenMissing(
-            f"no golden for {name}: {shown_path(folder)} has no {ser.MANIFEST_FILE} "
+            f"no golden for {name}: {shown_path(folder)} has no {serialize.MANIFEST_FILE} "
             "(an interrupted first bless?)"
         )
     files = {}
@@ -409,7 +409,7 @@ def _read_folder(name: str, folder: Path, max_frame_pixels: int) -> Golden:
 
     def checked(entry: dict) -> bytes:
         data = load(entry["file"])
-        if ser.sha256_bytes(data) != entry["sha256"]:
+        if serialize.sha256_bytes(data) != entry["sha256"]:
             raise GoldenUnreadable(_torn(name, folder / entry["file"]))
         return data
 
@@ -417,39 +417,39 @@ def _read_folder(name: str, folder: Path, max_frame_pixels: int) -> Golden:
         return GoldenUnreadable(f"golden {name}: {shown_path(folder / rel)}: {exc}; bless it again")
 
     try:
-        manifest = ser.load_json(load(ser.MANIFEST_FILE))
+        manifest = serialize.load_json(load(serialize.MANIFEST_FILE))
     except ValueError as exc:
-        raise unreadable(ser.MANIFEST_FILE, exc) from None
+        raise unreadable(serialize.MANIFEST_FILE, exc) from None
     fmt = manifest.get("format") if isinstance(manifest, dict) else None
-    if fmt != ser.FORMAT_VERSION or isinstance(fmt, bool):
+    if fmt != serialize.FORMAT_VERSION or isinstance(fmt, bool):
         raise GoldenUnreadable(
             f"golden {name} has format {json.dumps(fmt)[:40]}; this collide2d reads format "
-            f"{ser.FORMAT_VERSION}: bless it again"
+            f"{serialize.FORMAT_VERSION}: bless it again"
         )
     try:
-        ser.check_manifest(manifest)
+        serialize.check_manifest(manifest)
     except ValueError as exc:
-        raise unreadable(ser.MANIFEST_FILE, exc) from None
+        raise unreadable(serialize.MANIFEST_FILE, exc) from None
     try:
-        events = ser.parse_events(checked(manifest["events"]))
+        events = serialize.parse_events(checked(manifest["events"]))
     except ValueError as exc:
-        raise unreadable(ser.EVENTS_FILE, exc) from None
+        raise unreadable(serialize.EVENTS_FILE, exc) from None
     try:
-        final = ser.parse_final(checked(manifest["final"]))
+        final = serialize.parse_final(checked(manifest["final"]))
     except ValueError as exc:
-        raise unreadable(ser.FINAL_FILE, exc) from None
+        raise unreadable(serialize.FINAL_FILE, exc) from None
     frames = {}
     for entry in manifest["frames"]:
         rel = entry["file"]
         try:
-            rgb = ser.decode_png(
+            rgb = serialize.decode_png(
                 load(rel),
                 size=(entry["width"], entry["height"]),
                 max_pixels=max_frame_pixels,
             )
         except ValueError as exc:
             raise unreadable(rel, exc) from None
-        if ser.pixel_sha256(rgb) != entry["pixels_sha256"]:
+        if serialize.pixel_sha256(rgb) != entry["pixels_sha256"]:
             raise GoldenUnreadable(_torn(name, folder / rel))
         frames[entry["frame"]] = rgb
     return Golden(name, folder, manifest, events, final, frames, files)
@@ -485,7 +485,7 @@ def _build(folder: Path, files: dict) -> None:
             dirs.add(path.parent)
         _write_new(path, files[rel])
     for d in sorted(dirs, key=lambda p: -len(p.parts)):
-        swapdir.fsync_dir(d)
+        swap.fsync_dir(d)
 
 
 def _write_new(path: Path, data: bytes) -> None:

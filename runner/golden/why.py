@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from collide2d.runner.command.version import version as installed
+from collide2d.runner.command import version
 
 # The kinds of cause, for tools (summary.json, --format json).
 SCENARIO_EDITED = "scenario-edited"
@@ -30,10 +30,10 @@ class Cause:
         return {"kind": self.kind, "text": self.text}
 
 
-def cause(scenario, manifest: dict, version: str | None = None) -> Cause:
+def cause(scenario, manifest: dict) -> Cause:
     """What changed between the bless recorded in `manifest` and the check of `scenario` now (by
-    collide2d `version`, else the one installed)."""
-    version = installed() if version is None else version
+    the collide2d installed)."""
+    now = version.version()
     then_hash = manifest.get("scenario_sha256")
     then_version = manifest.get("collide2d_version")
     now_hash = getattr(scenario, "text_sha256", None)
@@ -44,21 +44,21 @@ def cause(scenario, manifest: dict, version: str | None = None) -> Cause:
             "(bless it again to record it)",
         )
     engine = (
-        f"blessed by collide2d {then_version}, checked by collide2d {version}"
+        f"blessed by collide2d {then_version}, checked by collide2d {now}"
         if then_version is not None
-        else f"blessed by an unrecorded collide2d version, checked by collide2d {version}"
+        else f"blessed by an unrecorded collide2d version, checked by collide2d {now}"
     )
     if then_hash != now_hash:
-        same = then_version == version
+        same = then_version == now
         return Cause(
             SCENARIO_EDITED,
             f"the scenario was edited since bless (SHA-256 {then_hash[:12]}… then, "
             f"{now_hash[:12]}… now)" + ("" if same else f"; also {engine}"),
         )
-    if then_version != version:
+    if then_version != now:
         return Cause(ENGINE_CHANGED, f"same scenario, different engine: {engine}")
     return Cause(
         SAME_VERSION,
-        f"same scenario, same collide2d version ({version}): the engine's code changed without "
+        f"same scenario, same collide2d version ({now}): the engine's code changed without "
         "a new version, or the run depends on the machine",
     )

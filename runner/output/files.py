@@ -28,8 +28,7 @@ import numpy as np
 from PIL import GifImagePlugin, Image
 
 from collide2d.engine.events import event_dict, format_event, format_number
-from collide2d.runner.output import escape
-from collide2d.runner.output import swap as swapdir
+from collide2d.runner.output import escape, swap
 
 # zlib level of every PNG (0-9): fixed so that the same pixels give the same bytes.
 PNG_COMPRESS_LEVEL = 6
@@ -61,7 +60,7 @@ def _open_temp(path: Path) -> tuple[Path, int]:
     """
     flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0)
     while True:
-        tmp = swapdir.temp_beside(path)
+        tmp = swap.temp_beside(path)
         try:
             return tmp, os.open(tmp, flags, 0o666)
         except FileExistsError:

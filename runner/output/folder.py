@@ -27,7 +27,7 @@ import re
 import stat
 from pathlib import Path
 
-from collide2d.runner.output import swap as swapdir
+from collide2d.runner.output import swap
 
 try:
     import fcntl
@@ -140,14 +140,14 @@ def clean_leftovers(root: Path, name: str) -> None:
     Staging folders are removed. An old folder moved aside is put back when OUT/NAME is missing
     (the run was cut between its two renames), and removed otherwise.
     """
-    swapdir.recover(Path(root) / name, swapdir.leftovers(root, name, (STAGE, swapdir.OLD)))
+    swap.recover(Path(root) / name, swap.leftovers(root, name, (STAGE, swap.OLD)))
 
 
 def abandon() -> list[Path]:
     """Undo the writes this process has not finished, as it is about to end: its staging folders
     and temporary files removed, its locks' files unlinked (the kernel drops the locks with the
     process). Returns the output folders whose new run was removed, as they were before it."""
-    undone = swapdir.abandon()
+    undone = swap.abandon()
     for path in list(_held):
         with contextlib.suppress(OSError):
             os.unlink(path)
@@ -156,9 +156,9 @@ def abandon() -> list[Path]:
 
 def new_stage(root: Path, name: str) -> Path:
     """A new empty staging folder for NAME in OUT."""
-    return swapdir.make_temp(root, name, STAGE)
+    return swap.make_temp(root, name, STAGE)
 
 
 def swap_in(stage: Path, target: Path) -> None:
     """Put the complete staging folder at `target`, replacing the old run, and remove the old."""
-    swapdir.swap_in(stage, target, atomic=True)
+    swap.swap_in(stage, target, atomic=True)

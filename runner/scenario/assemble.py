@@ -18,8 +18,7 @@ from collide2d.engine.models import MODEL_NAMES, options_of, shapes_of
 from collide2d.engine.noroom import no_room, no_room_message
 from collide2d.engine.world import KIND_NAMES, Bodies, Looks, WorldSpec
 from collide2d.runner import lanes
-from collide2d.runner.scenario import generate as gen
-from collide2d.runner.scenario import rules
+from collide2d.runner.scenario import generate, rules
 from collide2d.runner.scenario.nodes import Nodes
 from collide2d.runner.scenario.objects import Block, Listed, fault_error
 from collide2d.runner.scenario.parse import ScenarioError
@@ -78,7 +77,7 @@ def bodies(
         listed_colors = [color_index(o.color, o.color_node or o.node) for o in listed]
     block_colors = [color_index(b.color, b.color_node or b.node) for b in blocks]
 
-    if blocks and geometry == "exact" and (pair := gen.first_overlap(pos, size)) is not None:
+    if blocks and geometry == "exact" and (pair := generate.first_overlap(pos, size)) is not None:
         raise reader.error(
             blocks[0].node,
             f"generate places objects around the listed objects' boxes, which must not overlap "
@@ -88,8 +87,8 @@ def bodies(
         )
     try:
         specs = [b.spec for b in blocks]
-        drawn = gen.generate(world.width, world.height, pos, size, specs) if blocks else []
-    except gen.PlacementError as exc:
+        drawn = generate.generate(world.width, world.height, pos, size, specs) if blocks else []
+    except generate.PlacementError as exc:
         raise reader.error(blocks[exc.block].node, f"generate[{exc.block}]: {exc}") from None
 
     counts = [b.spec.count for b in blocks]

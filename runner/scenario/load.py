@@ -70,10 +70,7 @@ import yaml
 
 from collide2d.engine.shapes import GEOMETRIES
 from collide2d.engine.world import Bodies, WorldSpec
-from collide2d.runner.scenario import assemble
-from collide2d.runner.scenario import fastlane as yamlfast
-from collide2d.runner.scenario import parse as ys
-from collide2d.runner.scenario import table as tables
+from collide2d.runner.scenario import assemble, fastlane, parse
 from collide2d.runner.scenario.assemble import PALETTE_SIZE
 from collide2d.runner.scenario.limits import Limits
 from collide2d.runner.scenario.nodes import FAILED, MAX_INTEGER, Errors, fmt, is_number
@@ -121,6 +118,7 @@ from collide2d.runner.scenario.sections import (
     Output,
     OutputReader,
 )
+from collide2d.runner.scenario.table import checked, table_of, with_table
 
 __all__ = [
     "BLOCK_KEYS",
@@ -256,7 +254,7 @@ def load(
     sweep's dotted keys, `runner.sweep.matrix`); the result is checked like the file itself."""
     shown = os.fspath(path)
     limits = limits if limits is not None else Limits()
-    text, digest = ys.read_file(path, limits)
+    text, digest = parse.read_file(path, limits)
     return _Reader(shown, shown, overrides, limits, defaults).scenario(text, digest, edit)
 
 
@@ -268,7 +266,7 @@ def loads(
     Without a `name`, text read under the default path is named NAME_FOR_TEXT.
     """
     limits = limits if limits is not None else Limits()
-    ys.check_length(len(text), path, limits)  # characters: never more than the UTF-8 bytes
+    parse.check_length(len(text), path, limits)  # characters: never more than the UTF-8 bytes
     digest = hashlib.sha256(text.encode("utf-8", "surrogatepass")).hexdigest()
     return _Reader(path, None, overrides, limits, defaults).scenario(text, digest)
 
@@ -299,11 +297,11 @@ class _Reader(ModelReader):
         long object list one flow mapping per line takes the fast lane (runner.scenario.fastlane)
         when nothing is edited, and anything it declines or any error it meets is read again through
         the general path, which alone decides what a file means or why it is refused."""
-        fast = yamlfast.split(text) if edit is None else None
-        if fast is not None and yamlfast.bound(fast) <= self.limits.max_yaml_nodes:
+        fast = fastlane.split(text) if edit is None else None
+        if fast is not None and fastlane.bound(fast) <= self.limits.max_yaml_nodes:
             try:
                 return self._scenario(fast.rest, digest, fast)
-            except (yamlfast.FallBack, ScenarioError):
+            except (fastlane.FallBack, ScenarioError):
                 self.model_from = self.fps_from = self.ticks_from = None
         return self._scenario(text, digest, None, edit)
 
@@ -313,7 +311,7 @@ class _Reader(ModelReader):
         from another; the objects are read whatever the world and model, their rules wait for
         both); raise them all, or return the Scenario. `fast`: the fast lane's object rows
         (runner.scenario.fastlane), read in place of the empty list the text then holds."""
-        root = ys.compose(text, self.path, self.limits)
+        root = parse.compose(text, self.path, self.limits)
         if edit is not None:
             root = edit(root)
         self.root = root
@@ -360,7 +358,7 @@ class _Reader(ModelReader):
             self, listed, blocks, world, background, geometry, table
         )
         if table is not None and table.sha256 is not None:
-            digest = tables.with_table(digest, table.sha256)
+            digest = with_table(digest, table.sha256)
         assemble.check_plugin(self, model, geometry, bodies, lines, top)  # engine.models.protocol
         if model == "exact":
             assemble.check_room(self, world, bodies, geometry, names, listed, lines, table)
@@ -403,7 +401,7 @@ class _Reader(ModelReader):
             raise self.error(
                 node,
                 f"version must be {FORMAT_VERSION} (the only format version "
-                f"this collide2d reads), not {ys.describe(node)}",
+                f"this collide2d reads), not {parse.describe(node)}",
             )
 
     def name(self, top: dict) -> str:
@@ -473,20 +471,20 @@ class _Reader(ModelReader):
         lane's rows, taken by `checked`) None once the text's object list is the empty list the
         lane left, else the lane declines."""
         if fast is None:
-            return tables.table_of(self, top, self.file_path, self.limits)
+            return table_of(self, top, self.file_path, self.limits)
         node = top["objects"][1] if "objects" in top else None
         empty = isinstance(node, yaml.SequenceNode) and not node.value
         if not empty or node.start_mark.line + 1 != fast.first_line:
-            raise yamlfast.FallBack
+            raise fastlane.FallBack
         return None
 
     def checked(self, table, fast, world, rules):
         """The fast lane's rows, or the table read by `table` (or None), every rule held that
         the world and the model (None when refused) allow to check."""
         if fast is not None and world is not None and rules is not None:
-            return yamlfast.table(fast, world, rules, self.limits.max_objects)
+            return fastlane.table(fast, world, rules, self.limits.max_objects)
         if table is not None:
-            table = tables.checked(table, world, rules.paper_rates if rules else False)
+            table = checked(table, world, rules.paper_rates if rules else False)
         return table
 
     def ticks(self, top: dict, fps: int) -> int:

@@ -18,8 +18,7 @@ import math
 import numpy as np
 import yaml
 
-from collide2d.runner.scenario import colors
-from collide2d.runner.scenario import parse as ys
+from collide2d.runner.scenario import colors, parse
 from collide2d.runner.scenario.parse import ScenarioError
 
 MAX_INTEGER = 2**63 - 1  # the largest whole number a field takes unless it has its own bound
@@ -103,7 +102,7 @@ class Errors:
         self.stopped: ScenarioError | None = None  # raised once MAX_ERRORS were found
 
     def add(self, exc: ScenarioError) -> None:
-        self.found.extend(exc.errors if isinstance(exc, ys.ScenarioErrors) else [exc])
+        self.found.extend(exc.errors if isinstance(exc, parse.ScenarioErrors) else [exc])
 
     def full(self) -> bool:
         return len(self.found) >= MAX_ERRORS
@@ -113,7 +112,7 @@ class Errors:
         if not self.found:
             return None
         found = sorted(self.found, key=lambda e: (e.line, e.col))[:MAX_ERRORS]
-        return found[0] if len(found) == 1 else ys.ScenarioErrors(found)
+        return found[0] if len(found) == 1 else parse.ScenarioErrors(found)
 
 
 FAILED = object()  # what `Nodes.attempt` returns for a part that was refused
@@ -136,9 +135,9 @@ class Nodes:
 
     def error(self, node, message: str) -> ScenarioError:
         if node is None and message.startswith("--"):  # caused by a command-line option
-            return ys.OptionError(self.path, message)
+            return parse.OptionError(self.path, message)
         mark = node.start_mark if node is not None else None
-        return ys.mark_error(self.path, mark, message)
+        return parse.mark_error(self.path, mark, message)
 
     def attempt(self, read, *args):
         """read(*args), or FAILED after recording its error when collecting errors (raising all
@@ -172,17 +171,18 @@ class Nodes:
         them at once (`go_on`, when collecting errors: recorded, and the other keys read)."""
         if not isinstance(node, yaml.MappingNode):
             raise self.error(
-                node, f"{where} must be a mapping of keys to values, not {ys.describe(node)}"
+                node, f"{where} must be a mapping of keys to values, not {parse.describe(node)}"
             )
         out: dict[str, tuple] = {}
         merged = []
         refused = Errors()
         for knode, vnode in node.value:
-            if isinstance(knode, yaml.ScalarNode) and knode.tag == ys.CORE_TAG + "merge":
+            if isinstance(knode, yaml.ScalarNode) and knode.tag == parse.CORE_TAG + "merge":
                 merged.append(vnode)
                 continue
-            if not isinstance(knode, yaml.ScalarNode) or not isinstance(ys.value(knode), str):
-                raise self.error(knode, f"keys in {where} must be names, not {ys.describe(knode)}")
+            if not isinstance(knode, yaml.ScalarNode) or not isinstance(parse.value(knode), str):
+                shown = parse.describe(knode)
+                raise self.error(knode, f"keys in {where} must be names, not {shown}")
             key = knode.value
             if key in out:
                 first = out[key][0].start_mark.line + 1
@@ -209,33 +209,33 @@ class Nodes:
 
     def seq(self, node, what: str, min_len: int = 0) -> list:
         if not isinstance(node, yaml.SequenceNode):
-            raise self.error(node, f"{what} must be a list, not {ys.describe(node)}")
+            raise self.error(node, f"{what} must be a list, not {parse.describe(node)}")
         if len(node.value) < min_len:
             raise self.error(node, f"{what} needs at least {min_len} items, not {len(node.value)}")
         return node.value
 
     def scalar(self, node, what: str):
         if not isinstance(node, yaml.ScalarNode):
-            raise self.error(node, f"{what} must be a single value, not {ys.describe(node)}")
-        return ys.value(node)
+            raise self.error(node, f"{what} must be a single value, not {parse.describe(node)}")
+        return parse.value(node)
 
     def string(self, node, what: str) -> str:
         v = self.scalar(node, what)
         if not isinstance(v, str):
-            raise self.error(node, f"{what} must be text, not {ys.describe(node)} (quote it)")
+            raise self.error(node, f"{what} must be text, not {parse.describe(node)} (quote it)")
         return v
 
     def boolean(self, node, what: str) -> bool:
         v = self.scalar(node, what)
         if not isinstance(v, bool):
-            raise self.error(node, f"{what} must be true or false, not {ys.describe(node)}")
+            raise self.error(node, f"{what} must be true or false, not {parse.describe(node)}")
         return v
 
     def number(self, node, what: str, *, lo=None, hi=None, lo_open=False, unit=""):
         """A finite int or float (ints kept exact) in [lo, hi] (or (lo, hi] with lo_open)."""
         v = self.scalar(node, what)
         if not is_number(v):
-            raise self.error(node, f"{what} must be a number, not {ys.describe(node)}")
+            raise self.error(node, f"{what} must be a number, not {parse.describe(node)}")
         if isinstance(v, float) and not math.isfinite(v):
             raise self.error(node, f"{what} must be a finite number, not {node.value}")
         if isinstance(v, int) and abs(v) > 1e300:
@@ -260,7 +260,7 @@ class Nodes:
         if isinstance(v, float) and math.isfinite(v) and v.is_integer():
             v = int(v)
         if not is_number(v) or not isinstance(v, int):
-            raise self.error(node, f"{what} must be a whole number{of}, not {ys.describe(node)}")
+            raise self.error(node, f"{what} must be a whole number{of}, not {parse.describe(node)}")
         lo = -MAX_INTEGER if lo is None else lo
         hi = MAX_INTEGER if hi is None else hi
         shown = str(v) if len(str(v)) <= 24 else node.value  # 1e300 rather than its 301 digits
@@ -283,7 +283,8 @@ class Nodes:
         v = self.scalar(node, what)
         if not isinstance(v, str):
             raise self.error(
-                node, f"{what} must be a colour name, #rrggbb or [r, g, b], not {ys.describe(node)}"
+                node,
+                f"{what} must be a colour name, #rrggbb or [r, g, b], not {parse.describe(node)}",
             )
         try:
             return colors.parse_color_text(v)
@@ -301,7 +302,7 @@ class Nodes:
     def choice(self, node, what: str, options: tuple[str, ...], origin=None) -> str:
         v = self.scalar(node, what)
         if not isinstance(v, str) or v not in options:
-            shown = f"'{v}'" if isinstance(v, str) else ys.describe(node)
+            shown = f"'{v}'" if isinstance(v, str) else parse.describe(node)
             near = difflib.get_close_matches(v, options, n=1) if isinstance(v, str) else []
             hint = f"did you mean '{near[0]}'?" if near else "expected " + " | ".join(options)
             raise self.error(node, f"{self.prefix(origin)}unknown {what} {shown}; {hint}")

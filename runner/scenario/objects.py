@@ -26,9 +26,7 @@ import numpy as np
 import yaml
 
 from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, WorldSpec
-from collide2d.runner.scenario import generate as gen
-from collide2d.runner.scenario import parse as ys
-from collide2d.runner.scenario import rules as rule
+from collide2d.runner.scenario import generate, parse, rules
 from collide2d.runner.scenario.limits import Limits
 from collide2d.runner.scenario.nodes import FAILED, Nodes, _raise, fmt, is_number
 from collide2d.runner.scenario.rules import DEFAULT_MASS, NameRefused, object_names
@@ -160,7 +158,7 @@ class Listed:
 class Block:
     """One generate block, read; its rules are checked by column (`ObjectReader.check_blocks`)."""
 
-    spec: gen.BlockSpec
+    spec: generate.BlockSpec
     kind: int
     mass: float
     static: bool
@@ -183,10 +181,10 @@ class Block:
         return self.spec.speed_range or self.spec.velocity_range
 
 
-def _columns(items, pos, vel) -> rule.Columns:
+def _columns(items, pos, vel) -> rules.Columns:
     """The Columns of listed objects or blocks (`pos`, `vel`: (n, 2) arrays of their values)."""
     n = len(items)
-    return rule.Columns(
+    return rules.Columns(
         size=np.array(
             [o.spec.size if isinstance(o, Block) else o.size for o in items], np.float64
         ).reshape(n, 2),
@@ -213,7 +211,7 @@ class ObjectReader(Nodes):
         v = self.scalar(node, what)
         if not is_number(v) or (isinstance(v, float) and not math.isfinite(v)):
             raise self.error(
-                node, f"{what} must be a whole number of pixels, not {ys.describe(node)}"
+                node, f"{what} must be a whole number of pixels, not {parse.describe(node)}"
             )
         return float(v) + 0.0  # a number is at most MAX_NUMBER_CHARS long, so within float range
 
@@ -388,12 +386,12 @@ class ObjectReader(Nodes):
         cols = _columns(listed, [o.written for o in listed], [o.vel for o in listed])
         cols.corner = np.array([o.pos for o in listed], np.float64).reshape(-1, 2)
         fps, bounds = (world.fps, (world.width, world.height)) if world else (None, None)
-        found = rule.faults(cols, model.paper_rates, fps, bounds)
-        for f in rule.first_per_row(found):
+        found = rules.faults(cols, model.paper_rates, fps, bounds)
+        for f in rules.first_per_row(found):
             if f.row not in refused:
                 self.attempt(_raise, self.fault(listed, f, model, fps_from, "objects"))
 
-    def fault(self, items, f: rule.Fault, model: ModelRules, fps_from, kind: str):
+    def fault(self, items, f: rules.Fault, model: ModelRules, fps_from, kind: str):
         return fault_error(self, items, f, kind, model.origin, fps_from)
 
     def blocks(self, top: dict, n_listed: int) -> list[Block]:
@@ -459,7 +457,7 @@ class ObjectReader(Nodes):
             )
         if static:
             speed = speed_range = velocity_range = None
-        spec = gen.BlockSpec(
+        spec = generate.BlockSpec(
             count=count,
             size=(int(size[0]), int(size[1])) if all(map(float.is_integer, size)) else size,
             seed=seed,
@@ -477,7 +475,7 @@ class ObjectReader(Nodes):
             raise self.error(
                 vnode,
                 f"{what}.velocity must be {{min: [vx, vy], max: [vx, vy]}}"
-                f", not {ys.describe(vnode)}",
+                f", not {parse.describe(vnode)}",
             )
         r = self.mapping(vnode, "velocity", RANGE_KEYS)
         ends = []
@@ -520,17 +518,17 @@ class ObjectReader(Nodes):
             b.spec = dataclasses.replace(b.spec, whole=model.whole_velocities)
         speed = [(b.spec.speed or 0.0,) * 2 for b in blocks]
         cols = _columns(blocks, np.zeros((len(blocks), 2)), speed)
-        found = rule.first_per_row(rule.faults(cols, model.paper_rates, fps, None))
+        found = rules.first_per_row(rules.faults(cols, model.paper_rates, fps, None))
         refused = {f.row for f in found}
         for f in found:
             self.attempt(_raise, self.fault(blocks, f, model, fps_from, "generate"))
         ends = [_End(b, key) for b in blocks for key in ("min", "max") if b.ends is not None]
         n = len(ends)
-        cols = rule.Columns(
+        cols = rules.Columns(
             np.ones((n, 2)), np.zeros((n, 2)), np.array([e.vel for e in ends]).reshape(n, 2),
             np.full(n, np.nan), np.zeros(n, bool),
         )  # fmt: skip
-        for f in rule.first_per_row(rule.faults(cols, False, fps)):
+        for f in rules.first_per_row(rules.faults(cols, False, fps)):
             if ends[f.row].index not in refused:
                 refused.add(ends[f.row].index)
                 self.attempt(_raise, self.fault(ends, f, model, fps_from, "generate"))
@@ -566,7 +564,7 @@ class _End:
         self.at = {("velocity", a): block.at[(f"velocity {key}", a)] for a in (0, 1)}
 
 
-def fault_error(reader: Nodes, items, f: rule.Fault, kind: str, origin=None, fps_from=None):
+def fault_error(reader: Nodes, items, f: rules.Fault, kind: str, origin=None, fps_from=None):
     """The ScenarioError of Fault `f` of `items` (listed objects or blocks, `kind` "objects" or
     "generate"), at the node of the value it is about: `--model M: objects[3].size w must be
     ...`; a fault of the whole object (its box) is at the object, and an object it overlaps is
@@ -590,5 +588,5 @@ def fault_error(reader: Nodes, items, f: rule.Fault, kind: str, origin=None, fps
 def _named(m: dict) -> str:
     """" (NAME)" of an object mapping whose `name` is plain text, for its messages; else ""."""
     node = m["name"][1] if "name" in m else None
-    text = ys.value(node) if isinstance(node, yaml.ScalarNode) else None
+    text = parse.value(node) if isinstance(node, yaml.ScalarNode) else None
     return f" ({text.strip()})" if isinstance(text, str) and text.strip() else ""

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import yaml
 
-from collide2d.runner.scenario import parse as ys
+from collide2d.runner.scenario import parse
 from collide2d.runner.scenario.frames import FrameRule
 from collide2d.runner.scenario.limits import Limits
 from collide2d.runner.scenario.nodes import Nodes
@@ -96,7 +96,7 @@ class OutputReader(Nodes):
             raise self.error(
                 node,
                 f"{what} must be all, none, last, a list of frame numbers or "
-                f"{{every: k}}, not {ys.describe(node)}{hint}",
+                f"{{every: k}}, not {parse.describe(node)}{hint}",
             )
         rule = {"all": FrameRule.all, "last": FrameRule.last, "none": FrameRule.none}[v](ticks)
         if len(rule) > self.limits.max_frames:

@@ -50,8 +50,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from collide2d.engine.world import KIND_BOX, KIND_CIRCLE
-from collide2d.runner.scenario import colors
-from collide2d.runner.scenario import rules as rule
+from collide2d.runner.scenario import colors, rules
 from collide2d.runner.scenario.limits import Limits
 from collide2d.runner.scenario.parse import read_regular
 from collide2d.runner.scenario.rules import DEFAULT_MASS, NameRefused, object_names
@@ -288,14 +287,14 @@ def checked(table: Table, world, paper: bool) -> Table:
     first fault of a cell, in row order and then the file's
     column order, raised at its cell; else the table, static objects still and of infinite
     mass."""
-    cols = rule.Columns(
+    cols = rules.Columns(
         table.size, table.pos, table.vel, table.mass, table.static,
         restitution=table.restitution, friction=table.friction,
     )  # fmt: skip
     problems = list(table.problems)
     header = table.where.header
     fps, bounds = (world.fps, (world.width, world.height)) if world is not None else (None, None)
-    for f in rule.faults(cols, paper, fps, bounds):
+    for f in rules.faults(cols, paper, fps, bounds):
         column = _COLUMN_OF[f.field][f.axis]
         problems.append((f.row, header.index(column), len(problems), column, f.text))
     if problems:

@@ -16,7 +16,7 @@ from collide2d.runner.command.exitcodes import EXIT_BAD_INPUT, EXIT_DIFFERENCE, 
 
 
 def cmd_stress(args: argparse.Namespace) -> int:
-    from collide2d.runner.output import files as outputs
+    from collide2d.runner.output import files
     from collide2d.runner.stress.cases import VERDICT_FAIL, run_suite
     from collide2d.runner.stress.falling import every_scene
     from collide2d.runner.stress.report import (
@@ -52,8 +52,8 @@ def cmd_stress(args: argparse.Namespace) -> int:
     began = time.perf_counter()
     results = run_suite(args.quick, args.scene or (), args.model or (), on_case)
     total = time.perf_counter() - began
-    outputs.atomic_write_text(target / "report.md", report_markdown(results, args.quick, total))
-    outputs.write_json(target / "report.json", report_json(results, args.quick, total))
+    files.atomic_write_text(target / "report.md", report_markdown(results, args.quick, total))
+    files.write_json(target / "report.json", report_json(results, args.quick, total))
     broken = [r for r in results if r.verdict == VERDICT_FAIL]
     for r in broken:
         for p in r.problems:

@@ -151,10 +151,10 @@ def finished(total: int, keys: list[str], quiet: bool):
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
-    from collide2d.runner.command import settings as config
+    from collide2d.runner.command import settings
     from collide2d.runner.sweep import cluster, driver, folder, matrix, plan, results
 
-    project = config.find()
+    project = settings.find()
     out_root = args.out or (project.folder("out") if project.file else "out")
 
     def checking(total: int):  # the combinations of settings, each loaded in full

@@ -19,9 +19,7 @@ import os
 import stat
 from pathlib import Path
 
-from collide2d.runner.output import files as outputs
-from collide2d.runner.output import folder as rundir
-from collide2d.runner.output import swap as swapdir
+from collide2d.runner.output import files, folder, swap
 
 NAME = "sweep"
 SWEEP_FILES = ("results.csv", "results.md", "sweep.json", "runtime_vs_error.png")
@@ -63,22 +61,22 @@ def staged(root):
     root = Path(root)
     check_replaceable(root)
     made = not os.path.lexists(root)
-    outputs.make_folder(root)
+    files.make_folder(root)
     try:
-        lock = rundir.RunLock(root, NAME).__enter__()
-    except rundir.OutputBusy as exc:
+        lock = folder.RunLock(root, NAME).__enter__()
+    except folder.OutputBusy as exc:
         raise FolderRefused(str(exc)) from None
     swapped = False
     try:
-        rundir.clean_leftovers(root, NAME)
+        folder.clean_leftovers(root, NAME)
         target = check_replaceable(root)  # again, now that no other sweep can change it
-        stage = rundir.new_stage(root, NAME)
+        stage = folder.new_stage(root, NAME)
         try:
             yield stage
-            rundir.swap_in(stage, target)
+            folder.swap_in(stage, target)
             swapped = True
         except BaseException:
-            swapdir.remove_tree(stage)
+            swap.remove_tree(stage)
             raise
     finally:
         lock.__exit__(None, None, None)

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import yaml
 
 from collide2d.engine.models import names, names_for, options_of
-from collide2d.runner.scenario import parse as ys
+from collide2d.runner.scenario import parse
 from collide2d.runner.scenario.limits import Limits
 from collide2d.runner.scenario.load import Scenario, ScenarioError, load
 from collide2d.runner.scenario.objects import MAX_SEED
@@ -36,9 +36,9 @@ from collide2d.runner.scenario.objects import MAX_SEED
 RUN_KEYS = ("model", "fps", "ticks", "substeps", "geometry")
 MAX_RUNS = 1_000_000  # runs in one sweep
 _SEGMENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*|[0-9]+")
-_MAP = ys.CORE_TAG + "map"
-_STR = ys.CORE_TAG + "str"
-_INT = ys.CORE_TAG + "int"
+_MAP = parse.CORE_TAG + "map"
+_STR = parse.CORE_TAG + "str"
+_INT = parse.CORE_TAG + "int"
 
 
 class SweepError(Exception):
@@ -111,7 +111,7 @@ def value_node(text: str, origin: str, limits: Limits):
     if text == "":
         raise SweepError(f"{origin}: an empty value")
     try:
-        node = ys.compose(text, origin, limits)
+        node = parse.compose(text, origin, limits)
     except ScenarioError as exc:
         raise SweepError(f"{origin}: {text!r} is not a YAML value: {exc.message}") from None
     return node
@@ -247,7 +247,7 @@ def _edit(values: dict, seed: int | None, shown: str):
                 set_path(root, key.split("."), node, f"{shown} {key}")
         if "model" in values:
             settings = {k: values[k] for k in ("substeps", "geometry") if k in values}
-            _model_node(root, ys.value(values["model"]), settings)
+            _model_node(root, parse.value(values["model"]), settings)
         if seed is not None:
             i = _find(root, "generate")
             blocks = root.value[i][1] if i is not None else None
@@ -300,8 +300,8 @@ def check_axes(scenarios: list[str], axes: list[Axis], seeds) -> int:
             raise SweepError(f"{axis.origin}: a value is given twice")
         if axis.key == "model":
             for node, text in zip(axis.nodes, axis.texts, strict=True):
-                known = names_for(ys.value(node)) if isinstance(node, yaml.ScalarNode) else ()
-                if not isinstance(node, yaml.ScalarNode) or ys.value(node) not in known:
+                known = names_for(parse.value(node)) if isinstance(node, yaml.ScalarNode) else ()
+                if not isinstance(node, yaml.ScalarNode) or parse.value(node) not in known:
                     raise SweepError(
                         f"{axis.origin}: unknown model {text!r}; expected {' | '.join(names())}"
                     )
@@ -320,7 +320,7 @@ def choices(path: str, axes: list[Axis], seed: int | None, limits: Limits):
     base_model = _file_model(path, seed, limits)
     for combo in itertools.product(*(range(len(a.texts)) for a in axes)):
         chosen = {a.key: (a.nodes[i], a.texts[i]) for a, i in zip(axes, combo, strict=True)}
-        model = ys.value(chosen["model"][0]) if "model" in chosen else base_model
+        model = parse.value(chosen["model"][0]) if "model" in chosen else base_model
         for key in ("substeps", "geometry"):
             if key in chosen and key not in options_of(model):
                 del chosen[key]  # this model does not take it: the runs count once
@@ -372,7 +372,7 @@ def combo_of(path, chosen, model, dotted, seed, limits) -> tuple[Combo, Scenario
     overrides = {}
     for key in ("fps", "ticks"):
         if key in values:
-            v = ys.value(values[key]) if isinstance(values[key], yaml.ScalarNode) else None
+            v = parse.value(values[key]) if isinstance(values[key], yaml.ScalarNode) else None
             overrides[key] = v if isinstance(v, int) and not isinstance(v, bool) else chosen[key][1]
     shown = tuple(f"{k}={t}" for k, (_n, t) in chosen.items())
     draft = Combo(path, values, overrides, shown, {}, (), (), ())

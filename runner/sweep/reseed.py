@@ -21,7 +21,7 @@ import numpy as np
 
 from collide2d.engine.noroom import no_room, no_room_message
 from collide2d.runner import lanes
-from collide2d.runner.scenario import generate as gen
+from collide2d.runner.scenario import generate
 
 
 class Reseeded(Exception):
@@ -38,8 +38,8 @@ def reseed(scenario, seed: int):
     pos, size = bodies.pos[:fixed], bodies.size[:fixed]
     world = scenario.world
     try:
-        drawn = gen.generate(world.width, world.height, pos, size, specs)
-    except gen.PlacementError as exc:
+        drawn = generate.generate(world.width, world.height, pos, size, specs)
+    except generate.PlacementError as exc:
         raise Reseeded(f"generate[{exc.block}]: {exc}") from None
     bodies = dataclasses.replace(
         bodies,

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import yaml
 
-from collide2d.runner.scenario import parse as ys
+from collide2d.runner.scenario import parse
 from collide2d.runner.scenario.limits import Limits
 from collide2d.runner.scenario.nodes import Nodes
 from collide2d.runner.sweep.matrix import Axis, SweepError, check_key, parse_seeds
@@ -32,9 +32,9 @@ KEYS = ("sweep", "scenarios", "set", "seeds")
 def is_sweep_file(path: str, limits: Limits | None = None) -> bool:
     """True when the file's top level is a mapping with a `sweep` key (else it is a scenario)."""
     try:
-        text, _digest = ys.read_file(path, limits or Limits())
-        root = ys.compose(text, path, limits or Limits())
-    except ys.ScenarioError:
+        text, _digest = parse.read_file(path, limits or Limits())
+        root = parse.compose(text, path, limits or Limits())
+    except parse.ScenarioError:
         return False
     return isinstance(root, yaml.MappingNode) and any(
         isinstance(k, yaml.ScalarNode) and k.value == "sweep" for k, _v in root.value
@@ -53,7 +53,8 @@ def _shown(node) -> str:
 def _pairs(nodes: Nodes, node) -> list:
     """[(key, key node, value node)] of the `set` mapping: names, each once."""
     if not isinstance(node, yaml.MappingNode):
-        raise nodes.error(node, f"set must be a mapping of keys to values, not {ys.describe(node)}")
+        shown = parse.describe(node)
+        raise nodes.error(node, f"set must be a mapping of keys to values, not {shown}")
     out, seen = [], set()
     for knode, vnode in node.value:
         key = nodes.string(knode, "a key of set")
@@ -67,8 +68,8 @@ def _pairs(nodes: Nodes, node) -> list:
 def read(path: str, limits: Limits | None = None):
     """(scenario paths, [Axis], seeds or None) of the sweep file at `path`."""
     limits = limits or Limits()
-    text, _digest = ys.read_file(path, limits)
-    root = ys.compose(text, path, limits)
+    text, _digest = parse.read_file(path, limits)
+    root = parse.compose(text, path, limits)
     nodes = Nodes(path)
     top = nodes.mapping(root, "the sweep file", KEYS)
     version = nodes.scalar(top["sweep"][1], "sweep")

@@ -13,7 +13,7 @@ import pytest
 from PIL import Image
 
 from collide2d.engine.picture.raster import round_positions
-from collide2d.runner.command import main as cli
+from collide2d.runner.command import main
 from collide2d.runner.run import drive
 from collide2d.runner.scenario.load import load
 
@@ -30,7 +30,7 @@ def viewer_run(tmp_path_factory):
     text = text.replace("output: {frames: {every: 10}", "output: {frames: all")
     (tmp / "showcase.yaml").write_text(text)
     argv = ["run", str(tmp / "showcase.yaml"), "--out", str(tmp / "out"), "--model", "exact"]
-    assert cli.main([*argv, "--viewer", "--png", "--no-gif", "--quiet"]) == 0
+    assert main.main([*argv, "--viewer", "--png", "--no-gif", "--quiet"]) == 0
     folder = tmp / "out" / "showcase"
     return folder, (folder / "viewer.html").as_uri()
 
@@ -157,7 +157,7 @@ def test_overlays_draw_over_the_frame_and_go_away(clean_page, viewer_run):
 def test_paper_overlap_before_the_undo_is_shown_at_its_tick(clean_page, tmp_path):
     out = tmp_path / "out"
     path = ROOT / "scenarios" / "fig2_case1.yaml"  # asks for the overlap overlay
-    assert cli.main(["run", str(path), "--out", str(out), "--viewer", "--no-gif", "--quiet"]) == 0
+    assert main.main(["run", str(path), "--out", str(out), "--viewer", "--no-gif", "--quiet"]) == 0
     canvas = _open(clean_page, (out / "fig2_case1" / "viewer.html").as_uri())
     assert clean_page.locator("#ov-overlap").is_checked()
     for k, area in ((0, 0), (1, 16 * 1), (2, 0)):  # xdiff 16, ydiff 1 at tick 1
@@ -182,7 +182,7 @@ def test_a_name_that_opens_a_comment_or_a_script_leaves_the_viewer_working(clean
     path = tmp_path / "names.yaml"
     path.write_text(f"version: 1\nworld: {{width: 40, height: 20}}\nticks: 5\nobjects:\n{objects}")
     argv = ["run", str(path), "--out", str(tmp_path / "out"), "--viewer", "--no-gif", "--quiet"]
-    assert cli.main(argv) == 0
+    assert main.main(argv) == 0
     _open(clean_page, (tmp_path / "out" / "names" / "viewer.html").as_uri())
     assert clean_page.locator("#status").text_content() == "6 frames"
     assert clean_page.locator("body").get_attribute("data-pwned") is None
@@ -198,7 +198,7 @@ def test_a_run_drawing_rests_opens_with_its_other_overlays_checked(clean_page, t
     out = tmp_path / "out"
     path = ROOT / "scenarios" / "exact_ledges.yaml"
     argv = ["run", str(path), "--out", str(out), "--viewer", "--no-gif", "--quiet"]
-    assert cli.main([*argv, "--ticks", "20", "--overlay", "rests,boxes"]) == 0
+    assert main.main([*argv, "--ticks", "20", "--overlay", "rests,boxes"]) == 0
     _open(clean_page, (out / "exact_ledges" / "viewer.html").as_uri())
     assert clean_page.locator("#ov-boxes").is_checked()
     assert not clean_page.locator("#ov-velocity").is_checked()

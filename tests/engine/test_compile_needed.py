@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from numba import njit
 
-from collide2d.engine import broadphase as bp
+from collide2d.engine import broadphase
 from collide2d.engine.picture.pixels import shapes_marker
 from collide2d.engine.picture.raster import Renderer
 from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON
@@ -22,26 +22,28 @@ from collide2d.runner.scenario.load import loads
 
 @njit
 def _via_marker(marker, lo, hi, movable, cell, order, out, ws):
-    return bp.find(marker, lo, hi, movable, cell, order, out, ws)
+    return broadphase.find(marker, lo, hi, movable, cell, order, out, ws)
 
 
-@pytest.mark.parametrize("method", [bp.METHOD_SWEEP, bp.METHOD_GRID, bp.METHOD_CELLS])
+@pytest.mark.parametrize(
+    "method", [broadphase.METHOD_SWEEP, broadphase.METHOD_GRID, broadphase.METHOD_CELLS]
+)
 def test_the_marker_finds_the_pairs_its_method_finds(method):
     rng = np.random.default_rng(method)
     n = 300
     lo = rng.uniform(0, 400, (n, 2))
     hi = lo + rng.uniform(2, 14, (n, 2))
     movable = rng.random(n) < 0.8
-    expected = bp.sweep_pairs(lo, hi, ~movable)  # the reference answer
-    ws = bp.workspace(n, lo.dtype)
+    expected = broadphase.sweep_pairs(lo, hi, ~movable)  # the reference answer
+    ws = broadphase.workspace(n, lo.dtype)
     order = np.argsort(lo[:, 0], kind="stable").astype(np.int64)
     out = np.empty(4 * n, np.int64)
-    k = _via_marker(bp.marker(method), lo, hi, movable, 20.0, order, out, ws)
+    k = _via_marker(broadphase.marker(method), lo, hi, movable, 20.0, order, out, ws)
     assert len(expected) > 10
-    np.testing.assert_array_equal(bp.keys_to_pairs(out[:k]), expected)
+    np.testing.assert_array_equal(broadphase.keys_to_pairs(out[:k]), expected)
     if os.environ.get("NUMBA_DISABLE_JIT") != "1":  # compiled: one specialisation per marker
         marker_type = _via_marker.signatures[-1][0]
-        assert str(marker_type.dtype) == str(np.dtype(bp.marker(method).dtype))
+        assert str(marker_type.dtype) == str(np.dtype(broadphase.marker(method).dtype))
 
 
 @pytest.mark.parametrize(
@@ -154,7 +156,7 @@ FINDERS = (
     + """
 import numpy as np
 from numba import njit
-from collide2d.engine import broadphase as bp
+from collide2d.engine import broadphase
 
 
 @njit

@@ -14,8 +14,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from collide2d.engine.picture import pixels as draw
-from collide2d.engine.picture import raster
+from collide2d.engine.picture import pixels, raster
 from collide2d.engine.world import KIND_BOX, KIND_CIRCLE, KIND_POLYGON, Bodies, Looks, WorldSpec
 
 FAST = settings(max_examples=30, deadline=None)
@@ -80,7 +79,7 @@ def pixel_set(frame: np.ndarray, value=None) -> set[tuple[int, int]]:
 def draw_line(w, h, x0, y0, x1, y1, clip=None):
     buf = np.zeros((h, w), np.uint8)
     cx0, cy0, cx1, cy1 = clip or (0, 0, w - 1, h - 1)
-    draw._line(buf, x0, y0, x1, y1, np.uint8(1), cx0, cy0, cx1, cy1)
+    pixels._line(buf, x0, y0, x1, y1, np.uint8(1), cx0, cy0, cx1, cy1)
     return buf
 
 
@@ -140,21 +139,21 @@ coord = st.integers(-40, 40)
 @FAST
 @given(coord, coord, coord, coord)
 def test_dda_matches_exact_rational_reference(x0, y0, x1, y1):
-    got = draw.dda_line(x0, y0, x1, y1).tolist()
+    got = pixels.dda_line(x0, y0, x1, y1).tolist()
     assert [tuple(p) for p in got] == ref_dda(x0, y0, x1, y1)
 
 
 @FAST
 @given(st.integers(-(10**9), 10**9), st.integers(-(10**9), 10**9), coord, coord)
 def test_dda_far_from_origin_matches_reference(x0, y0, dx, dy):
-    got = draw.dda_line(x0, y0, x0 + dx, y0 + dy).tolist()
+    got = pixels.dda_line(x0, y0, x0 + dx, y0 + dy).tolist()
     assert [tuple(p) for p in got] == ref_dda(x0, y0, x0 + dx, y0 + dy)
 
 
 @FAST
 @given(coord, coord, coord, coord)
 def test_dda_endpoints_and_steps(x0, y0, x1, y1):
-    pts = draw.dda_line(x0, y0, x1, y1)
+    pts = pixels.dda_line(x0, y0, x1, y1)
     n = max(abs(x1 - x0), abs(y1 - y0))
     assert pts.shape == (n + 1, 2)
     assert pts[0].tolist() == [x0, y0]
@@ -221,7 +220,7 @@ def test_box_fill_covers_its_box():
 @pytest.mark.parametrize("r", list(range(0, 50)))
 def test_odd_circle_is_the_classic_midpoint_circle(r):
     d = 2 * r + 1
-    got = {(x - r, y - r) for x, y in draw.midpoint_circle(d).tolist()}
+    got = {(x - r, y - r) for x, y in pixels.midpoint_circle(d).tolist()}
     assert got == ref_classic_circle(r)
 
 
@@ -251,13 +250,13 @@ def ref_doubled_circle(d):
 
 @pytest.mark.parametrize("d", list(range(1, 60)))
 def test_circle_matches_closed_form_for_every_diameter(d):
-    got = {tuple(p) for p in draw.midpoint_circle(d).tolist()}
+    got = {tuple(p) for p in pixels.midpoint_circle(d).tolist()}
     assert got == ref_doubled_circle(d)
 
 
 @pytest.mark.parametrize("d", list(range(1, 70)))
 def test_circle_fits_its_box_touches_all_sides_and_is_symmetric(d):
-    pts = draw.midpoint_circle(d)
+    pts = pixels.midpoint_circle(d)
     assert pts.min() == 0 and pts.max() == d - 1
     assert set(pts[:, 0].tolist()) >= {0, d - 1} and set(pts[:, 1].tolist()) >= {0, d - 1}
     s = {tuple(p) for p in pts.tolist()}
@@ -280,8 +279,8 @@ def test_circle_fits_its_box_touches_all_sides_and_is_symmetric(d):
 
 
 def test_small_circles():
-    assert draw.midpoint_circle(1).tolist() == [[0, 0]]
-    assert {tuple(p) for p in draw.midpoint_circle(2).tolist()} == {
+    assert pixels.midpoint_circle(1).tolist() == [[0, 0]]
+    assert {tuple(p) for p in pixels.midpoint_circle(2).tolist()} == {
         (0, 0),
         (1, 0),
         (0, 1),
@@ -291,8 +290,8 @@ def test_small_circles():
 
 @pytest.mark.parametrize("d", list(range(1, 40)))
 def test_circle_fill_spans_rows_between_outline_extremes(d):
-    outline = draw.midpoint_circle(d)
-    filled = {tuple(p) for p in draw.midpoint_circle(d, fill=True).tolist()}
+    outline = pixels.midpoint_circle(d)
+    filled = {tuple(p) for p in pixels.midpoint_circle(d, fill=True).tolist()}
     expect = set()
     for y in range(d):
         xs = outline[outline[:, 1] == y, 0]
@@ -304,7 +303,7 @@ def test_circle_fill_spans_rows_between_outline_extremes(d):
 def test_circle_drawn_in_a_frame_sits_in_its_box():
     bodies = make_bodies([KIND_CIRCLE], [[4, 3]], [[7, 7]], [2], [False])
     frame = raster.render(WorldSpec(20, 15, 10), bodies, bodies.pos)
-    expect = {(x + 4, y + 3) for x, y in draw.midpoint_circle(7).tolist()}
+    expect = {(x + 4, y + 3) for x, y in pixels.midpoint_circle(7).tolist()}
     assert pixel_set(frame, 2) == expect
 
 

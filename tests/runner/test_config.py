@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from collide2d.runner.command import settings as config
+from collide2d.runner.command import settings
 from collide2d.runner.command.main import main
 from collide2d.runner.scenario.limits import Limits
 from collide2d.runner.scenario.load import ScenarioError, loads
@@ -29,13 +29,13 @@ def test_the_table_sets_folders_limits_and_model_defaults_with_their_source(tmp_
     )
     deep = root / "a" / "b"
     deep.mkdir(parents=True)
-    found = config.find(deep)
+    found = settings.find(deep)
     assert found.root == root.resolve() and found.file == root.resolve() / "pyproject.toml"
     assert found.scenarios == root.resolve() / "cases"
     assert found.goldens == root.resolve() / "expected"
     assert found.folder("report") == root.resolve() / "report"
     assert found.settings["scenarios"].source.endswith("pyproject.toml [tool.collide2d]")
-    assert found.settings["report"].source == config.DEFAULT
+    assert found.settings["report"].source == settings.DEFAULT
     assert found.limits() == Limits(max_objects=7)
     assert found.limits({"max_objects": 9}).max_objects == 9  # the command line wins
     assert found.model_defaults() == {"kind": "stepped", "substeps": 4}
@@ -44,10 +44,10 @@ def test_the_table_sets_folders_limits_and_model_defaults_with_their_source(tmp_
 def test_a_project_without_the_table_keeps_the_defaults(tmp_path):
     (tmp_path / "pyproject.toml").write_text('[project]\nname = "x"\n')
     (tmp_path / "scenarios").mkdir()
-    found = config.find(tmp_path)
+    found = settings.find(tmp_path)
     assert found.file is None and found.root == tmp_path.resolve()
     assert found.value("goldens") == "goldens" and found.load_options() == {}
-    assert not config.has_table(tmp_path / "pyproject.toml")
+    assert not settings.has_table(tmp_path / "pyproject.toml")
 
 
 @pytest.mark.parametrize(
@@ -75,8 +75,8 @@ def test_a_project_without_the_table_keeps_the_defaults(tmp_path):
 )
 def test_a_bad_table_is_refused_at_its_line(tmp_path, table, line, says):
     project(tmp_path, table)
-    with pytest.raises(config.ConfigError) as info:
-        config.find(tmp_path)
+    with pytest.raises(settings.ConfigError) as info:
+        settings.find(tmp_path)
     text = str(info.value)
     assert text.startswith(f"{tmp_path / 'pyproject.toml'}:{line}:") and says in text
 
@@ -127,7 +127,7 @@ def test_the_tables_threads_are_put_in_force_unless_the_command_line_names_some(
     from collide2d.engine import jit, threads
     from collide2d.runner.command.options import apply_threads
 
-    found = config.find(project(tmp_path, "[tool.collide2d]\nthreads = 1\n"))
+    found = settings.find(project(tmp_path, "[tool.collide2d]\nthreads = 1\n"))
     jit.numba_module()  # the count is put in force once numba is loaded: load it first
     try:
         apply_threads(argparse.Namespace(threads=None), found)
@@ -154,8 +154,8 @@ def test_the_tables_threads_are_put_in_force_unless_the_command_line_names_some(
 )
 def test_the_tables_folders_are_apart_from_the_project_and_each_other(tmp_path, table, line, says):
     project(tmp_path, "[tool.collide2d]\n" + table)
-    with pytest.raises(config.ConfigError) as info:
-        config.find(tmp_path)
+    with pytest.raises(settings.ConfigError) as info:
+        settings.find(tmp_path)
     text = str(info.value)
     assert text.startswith(f"{tmp_path / 'pyproject.toml'}:{line}:1: error: ") and says in text
     assert "need a folder of their own" in text
@@ -165,7 +165,7 @@ def test_a_folder_named_on_the_command_line_is_apart_too(tmp_path, monkeypatch, 
     (tmp_path / "p").mkdir()
     root = project(tmp_path / "p", '[tool.collide2d]\nout = "runs"\n')
     (root / "s.yaml").write_text(SCENARIO)
-    found = config.find(root)
+    found = settings.find(root)
     for given, says in (
         (root, "is the project folder"),
         (tmp_path, "holds the project folder"),
@@ -173,7 +173,7 @@ def test_a_folder_named_on_the_command_line_is_apart_too(tmp_path, monkeypatch, 
         (root / "goldens", "is the goldens folder goldens/"),
         (root / "report", "is the report folder report/"),
     ):
-        with pytest.raises(config.FolderClash, match=says):
+        with pytest.raises(settings.FolderClash, match=says):
             found.apart("out", given, "--out")
     assert found.apart("out", root / "runs", "--out") == root / "runs"  # its own setting's folder
     assert found.apart("report", tmp_path / "elsewhere", "--report") == tmp_path / "elsewhere"
@@ -185,8 +185,8 @@ def test_a_folder_named_on_the_command_line_is_apart_too(tmp_path, monkeypatch, 
 
 def test_a_control_character_in_a_folder_setting_is_refused_at_its_line(tmp_path, monkeypatch):
     project(tmp_path, '[tool.collide2d]\nout = "runs"\ngoldens = "g\\u0000old"\n')
-    with pytest.raises(config.ConfigError) as info:
-        config.find(tmp_path)
+    with pytest.raises(settings.ConfigError) as info:
+        settings.find(tmp_path)
     text = str(info.value)
     assert text.startswith(f"{tmp_path / 'pyproject.toml'}:6:1: error: goldens = ")
     assert "holds a control character" in text
@@ -227,7 +227,7 @@ def test_the_tables_model_settings_at_their_bounds_are_taken(tmp_path):
         "[tool.collide2d]\n[tool.collide2d.model]\n"
         "substeps = 10000\nmax_events_per_tick = 9007199254740992\n",
     )
-    assert config.find(tmp_path).model_defaults() == {
+    assert settings.find(tmp_path).model_defaults() == {
         "substeps": 10000,
         "max_events_per_tick": 2**53,
     }

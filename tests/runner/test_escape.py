@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from collide2d.runner.bench import report
-from collide2d.runner.command import main as cli
-from collide2d.runner.output import files as outputs
+from collide2d.runner.command import main
+from collide2d.runner.output import files
 from collide2d.runner.output.escape import VisibleStream, visible_streams
 from collide2d.runner.output.progress import Progress
 from collide2d.runner.sweep import results
@@ -40,7 +40,7 @@ def test_control_characters_never_reach_the_terminal_raw(tmp_path, monkeypatch, 
     monkeypatch.chdir(tmp_path)
     with open(raw, "w") as f:
         f.write(SCENE)  # refused: its stem cannot be a name
-    assert cli.main(["validate", os.fsdecode(raw)]) == 2
+    assert main.main(["validate", os.fsdecode(raw)]) == 2
     err = capsys.readouterr().err
     assert err.startswith("x\\x1b[2J\\rfake\\x9b\\x07\\xff.yaml:1:1: error: ")
     assert not re.search("[\x00-\x08\x0b-\x1f\x7f-\x9f\ud800-\udfff]", err)
@@ -67,7 +67,7 @@ def test_a_text_cell_never_starts_a_formula_and_numbers_stay_numbers(tmp_path):
     names = texts + [None]
     n = len(names)
     pos = np.column_stack([np.arange(n) - 5.0, np.zeros(n)])  # negative numbers too
-    rows = _cells(outputs.final_csv_text(pos, -pos, names))
+    rows = _cells(files.final_csv_text(pos, -pos, names))
     assert rows[0] == ["id", "x", "y", "vx", "vy", "name"]
     assert [r[5] for r in rows[1:]] == [*want, ""]
     assert [r[1] for r in rows[1:6]] == ["-5", "-4", "-3", "-2", "-1"]

@@ -14,7 +14,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from scenario_text import any_overlap
 
-from collide2d.runner.scenario import generate as gen
+from collide2d.runner.scenario import generate
 
 EMPTY = np.zeros((0, 2))
 
@@ -47,7 +47,7 @@ def test_first_overlap_matches_all_pairs(data):
     size = np.array(data.draw(st.lists(side, min_size=n, max_size=n)), float).reshape(-1, 2)
     if data.draw(st.booleans()):  # half pixels, as float positions under stepped/exact
         pos = pos / 2.0
-    assert gen.first_overlap(pos, size) == brute_first_overlap(pos, size)
+    assert generate.first_overlap(pos, size) == brute_first_overlap(pos, size)
 
 
 def test_first_overlap_with_mixed_sizes_matches_all_pairs():
@@ -57,7 +57,7 @@ def test_first_overlap_with_mixed_sizes_matches_all_pairs():
         pos = rng.integers(0, 2000, size=(n, 2)).astype(float)
         size = rng.integers(1, 4, size=(n, 2)).astype(float)
         size[rng.integers(0, n, 3)] = [[900, 5], [4, 700], [300, 300]]  # a few long or large ones
-        assert gen.first_overlap(pos, size) == brute_first_overlap(pos, size)
+        assert generate.first_overlap(pos, size) == brute_first_overlap(pos, size)
 
 
 @settings(max_examples=40, deadline=None)
@@ -71,7 +71,7 @@ def test_the_numpy_check_says_apart_only_when_no_two_overlap(data):
     size = np.array(data.draw(st.lists(side, min_size=n, max_size=n)), float)
     nudge = data.draw(st.sampled_from([0.0, 1e-9, -1e-9, 0.5]))
     pos[1:] += nudge * (np.arange(n - 1) % 2)[:, None]
-    if gen._apart(pos, size):
+    if generate._apart(pos, size):
         assert brute_first_overlap(pos, size) is None
 
 
@@ -79,18 +79,18 @@ def test_the_numpy_check_decides_a_spaced_lattice_and_finds_one_overlap():
     ys, xs = np.mgrid[0:300, 0:300]
     pos = np.stack([xs.ravel(), ys.ravel()], 1) * 12.0
     size = np.full_like(pos, 12.0)  # every box touches its neighbours
-    assert gen._apart(pos, size)
-    assert gen.first_overlap(pos, size) is None
+    assert generate._apart(pos, size)
+    assert generate.first_overlap(pos, size) is None
     pos[77_777] += [0.0, 1e-6]  # now overlaps the box below it, 300 ids on
-    assert not gen._apart(pos, size)
-    assert gen.first_overlap(pos, size) == (77_777, 78_077)
+    assert not generate._apart(pos, size)
+    assert generate.first_overlap(pos, size) == (77_777, 78_077)
 
 
 def test_touching_is_not_overlapping():
     pos = np.array([[0, 0], [10, 0], [0, 10], [10, 10], [20, 0]], float)
-    assert gen.first_overlap(pos, np.full((5, 2), 10.0)) is None
-    assert gen.first_overlap(pos[:1], np.full((1, 2), 10.0)) is None
-    assert gen.first_overlap(EMPTY, EMPTY) is None
+    assert generate.first_overlap(pos, np.full((5, 2), 10.0)) is None
+    assert generate.first_overlap(pos[:1], np.full((1, 2), 10.0)) is None
+    assert generate.first_overlap(EMPTY, EMPTY) is None
 
 
 def test_first_overlap_on_a_large_tiling():
@@ -99,21 +99,21 @@ def test_first_overlap_on_a_large_tiling():
     r, c = np.divmod(np.arange(side * side), side)
     pos = np.stack([3.0 * c, 3.0 * r], axis=1)
     size = np.full_like(pos, 3.0)
-    gen.first_overlap(pos[:10], size[:10])  # compile outside the timing
+    generate.first_overlap(pos[:10], size[:10])  # compile outside the timing
     start = time.perf_counter()
-    assert gen.first_overlap(pos, size) is None
+    assert generate.first_overlap(pos, size) is None
     elapsed = time.perf_counter() - start
     # box k = (row 10, column 10) moved right by 1 px overlaps only its right neighbour k + 1
     k = 10 * side + 10
     pos[k, 0] += 1.0
-    assert gen.first_overlap(pos, size) == (k, k + 1)
+    assert generate.first_overlap(pos, size) == (k, k + 1)
     assert elapsed < 2.0, f"{side * side} boxes took {elapsed:.2f} s"
 
 
 def test_first_overlap_with_one_box_inside_a_large_one():
     pos = np.array([[0, 0], [200, 200], [50, 50]], float)
     size = np.array([[100, 100], [5, 5], [1, 1]], float)
-    assert gen.first_overlap(pos, size) == (0, 2)
+    assert generate.first_overlap(pos, size) == (0, 2)
 
 
 # ----------------------------------------------------------------------------- the stream
@@ -124,7 +124,7 @@ def place_by_hand(width, height, fixed_pos, fixed_size, rng, count, w, h):
     placed_pos, placed_size = list(fixed_pos), list(fixed_size)
     out = []
     while len(out) < count:
-        cands = rng.integers(0, [width - w + 1, height - h + 1], size=(gen.POSITION_BATCH, 2))
+        cands = rng.integers(0, [width - w + 1, height - h + 1], size=(generate.POSITION_BATCH, 2))
         for x, y in cands:
             if len(out) == count:
                 break
@@ -142,8 +142,8 @@ def place_by_hand(width, height, fixed_pos, fixed_size, rng, count, w, h):
 def test_positions_then_speed_signs_follow_the_documented_stream():
     fixed_pos = np.array([[10, 10], [30, 5]], float)
     fixed_size = np.array([[12, 8], [6, 20]], float)
-    spec = gen.BlockSpec(count=25, size=(5, 4), seed=9, speed=7.0)
-    ((pos, vel),) = gen.generate(60, 40, fixed_pos, fixed_size, [spec])
+    spec = generate.BlockSpec(count=25, size=(5, 4), seed=9, speed=7.0)
+    ((pos, vel),) = generate.generate(60, 40, fixed_pos, fixed_size, [spec])
     rng = np.random.default_rng(9)
     expected = place_by_hand(60, 40, fixed_pos, fixed_size, rng, 25, 5, 4)
     signs = rng.integers(0, 2, size=(25, 2))
@@ -152,15 +152,19 @@ def test_positions_then_speed_signs_follow_the_documented_stream():
 
 
 def test_speed_range_follows_the_documented_stream():
-    spec = gen.BlockSpec(count=12, size=(3, 3), seed=4, speed_range=(2.0, 6.0))
-    ((pos, vel),) = gen.generate(50, 50, EMPTY, EMPTY, [spec])
+    spec = generate.BlockSpec(count=12, size=(3, 3), seed=4, speed_range=(2.0, 6.0))
+    ((pos, vel),) = generate.generate(50, 50, EMPTY, EMPTY, [spec])
     rng = np.random.default_rng(4)
     place_by_hand(50, 50, [], [], rng, 12, 3, 3)
     mag = rng.uniform(2.0, 6.0, size=12)
     ang = rng.uniform(0.0, 2 * np.pi, size=12)
     assert np.array_equal(vel, np.stack([mag * np.cos(ang), mag * np.sin(ang)], axis=1))
-    whole = gen.generate(
-        50, 50, EMPTY, EMPTY, [gen.BlockSpec(12, (3, 3), 4, speed_range=(2.0, 6.0), whole=True)]
+    whole = generate.generate(
+        50,
+        50,
+        EMPTY,
+        EMPTY,
+        [generate.BlockSpec(12, (3, 3), 4, speed_range=(2.0, 6.0), whole=True)],
     )[0][1]
     assert np.array_equal(whole, np.floor(vel + 0.5))
 
@@ -168,8 +172,8 @@ def test_speed_range_follows_the_documented_stream():
 def test_velocity_range_follows_the_documented_stream():
     lo, hi = (-3.0, 1.0), (2.0, 4.0)
     for whole in (False, True):
-        spec = gen.BlockSpec(20, (2, 2), 8, velocity_range=(lo, hi), whole=whole)
-        ((_, vel),) = gen.generate(40, 40, EMPTY, EMPTY, [spec])
+        spec = generate.BlockSpec(20, (2, 2), 8, velocity_range=(lo, hi), whole=whole)
+        ((_, vel),) = generate.generate(40, 40, EMPTY, EMPTY, [spec])
         rng = np.random.default_rng(8)
         place_by_hand(40, 40, [], [], rng, 20, 2, 2)
         if whole:
@@ -180,9 +184,9 @@ def test_velocity_range_follows_the_documented_stream():
 
 
 def test_each_block_has_its_own_generator_and_avoids_earlier_blocks():
-    a = gen.BlockSpec(30, (4, 4), seed=1)
-    b = gen.BlockSpec(30, (6, 2), seed=1)
-    (pa, va), (pb, vb) = gen.generate(80, 60, EMPTY, EMPTY, [a, b])
+    a = generate.BlockSpec(30, (4, 4), seed=1)
+    b = generate.BlockSpec(30, (6, 2), seed=1)
+    (pa, va), (pb, vb) = generate.generate(80, 60, EMPTY, EMPTY, [a, b])
     assert np.all(va == 0) and np.all(vb == 0)
     pos = np.concatenate([pa, pb])
     size = np.concatenate([np.full((30, 2), 4.0), np.tile([6.0, 2.0], (30, 1))])
@@ -209,8 +213,8 @@ def test_generated_boxes_are_inside_whole_and_apart(width, height, w, h, count, 
     fixed_size = np.array([[w + 2.5, h + 1.0]])
     # at 30 % coverage random placement is far from jamming (about 55 % for squares)
     assume((count + 1) * (w + 2.5) * (h + 1) <= 0.3 * width * height)
-    ((pos, vel),) = gen.generate(
-        width, height, fixed_pos, fixed_size, [gen.BlockSpec(count, (w, h), seed, speed=3.0)]
+    ((pos, vel),) = generate.generate(
+        width, height, fixed_pos, fixed_size, [generate.BlockSpec(count, (w, h), seed, speed=3.0)]
     )
     assert pos.shape == (count, 2) and vel.shape == (count, 2)
     assert np.all(pos == np.floor(pos))
@@ -222,23 +226,27 @@ def test_generated_boxes_are_inside_whole_and_apart(width, height, w, h, count, 
 
 
 def test_seeds():
-    spec = gen.BlockSpec(50, (3, 3), seed=21, speed=2.0)
-    one = gen.generate(100, 100, EMPTY, EMPTY, [spec])[0]
-    two = gen.generate(100, 100, EMPTY, EMPTY, [spec])[0]
-    other = gen.generate(100, 100, EMPTY, EMPTY, [gen.BlockSpec(50, (3, 3), 22, speed=2.0)])[0]
+    spec = generate.BlockSpec(50, (3, 3), seed=21, speed=2.0)
+    one = generate.generate(100, 100, EMPTY, EMPTY, [spec])[0]
+    two = generate.generate(100, 100, EMPTY, EMPTY, [spec])[0]
+    other = generate.generate(
+        100, 100, EMPTY, EMPTY, [generate.BlockSpec(50, (3, 3), 22, speed=2.0)]
+    )[0]
     assert np.array_equal(one[0], two[0]) and np.array_equal(one[1], two[1])
     assert not np.array_equal(one[0], other[0])
 
 
 def test_speed_gives_both_signs_on_both_axes():
-    ((_, vel),) = gen.generate(200, 200, EMPTY, EMPTY, [gen.BlockSpec(100, (2, 2), speed=5.0)])
+    ((_, vel),) = generate.generate(
+        200, 200, EMPTY, EMPTY, [generate.BlockSpec(100, (2, 2), speed=5.0)]
+    )
     for axis in (0, 1):
         assert set(np.unique(vel[:, axis])) == {-5.0, 5.0}
 
 
 def test_speed_range_magnitudes_and_directions():
-    spec = gen.BlockSpec(400, (2, 2), seed=3, speed_range=(4.0, 6.0))
-    ((_, vel),) = gen.generate(300, 300, EMPTY, EMPTY, [spec])
+    spec = generate.BlockSpec(400, (2, 2), seed=3, speed_range=(4.0, 6.0))
+    ((_, vel),) = generate.generate(300, 300, EMPTY, EMPTY, [spec])
     speed = np.hypot(vel[:, 0], vel[:, 1])
     assert np.all((speed >= 4.0 - 1e-12) & (speed <= 6.0 + 1e-12))
     quadrant = (vel[:, 0] > 0).astype(int) * 2 + (vel[:, 1] > 0)
@@ -246,8 +254,10 @@ def test_speed_range_magnitudes_and_directions():
 
 
 def test_whole_velocity_range_reaches_both_ends():
-    spec = gen.BlockSpec(300, (2, 2), seed=6, velocity_range=((-1.0, -1.0), (1.0, 1.0)), whole=True)
-    ((_, vel),) = gen.generate(300, 300, EMPTY, EMPTY, [spec])
+    spec = generate.BlockSpec(
+        300, (2, 2), seed=6, velocity_range=((-1.0, -1.0), (1.0, 1.0)), whole=True
+    )
+    ((_, vel),) = generate.generate(300, 300, EMPTY, EMPTY, [spec])
     for axis in (0, 1):
         assert set(np.unique(vel[:, axis])) == {-1.0, 0.0, 1.0}
 
@@ -257,8 +267,8 @@ def test_whole_velocity_range_reaches_both_ends():
 
 def test_more_area_than_the_world_is_refused_at_once():
     start = time.perf_counter()
-    with pytest.raises(gen.PlacementError) as info:
-        gen.generate(320, 240, EMPTY, EMPTY, [gen.BlockSpec(5000, (10, 10))])
+    with pytest.raises(generate.PlacementError) as info:
+        generate.generate(320, 240, EMPTY, EMPTY, [generate.BlockSpec(5000, (10, 10))])
     assert time.perf_counter() - start < 0.1
     err = info.value
     assert str(err).startswith("cannot place 5000 boxes of 10x10 without overlap in 320x240")
@@ -266,29 +276,35 @@ def test_more_area_than_the_world_is_refused_at_once():
 
 
 def test_a_jammed_world_is_refused_after_bounded_draws():
-    with pytest.raises(gen.PlacementError) as info:
-        gen.generate(
-            320, 240, EMPTY, EMPTY, [gen.BlockSpec(10, (2, 2)), gen.BlockSpec(700, (10, 10))]
+    with pytest.raises(generate.PlacementError) as info:
+        generate.generate(
+            320,
+            240,
+            EMPTY,
+            EMPTY,
+            [generate.BlockSpec(10, (2, 2)), generate.BlockSpec(700, (10, 10))],
         )
     err = info.value
     assert err.block == 1 and 0 < err.placed < 700
     assert str(err).startswith("cannot place 700 boxes of 10x10 without overlap in 320x240")
-    budget = gen.MAX_DRAWS_PER_OBJECT_AVERAGE * 700 + gen.MAX_DRAWS_PER_OBJECT
-    assert err.draws <= budget + gen.POSITION_BATCH
+    budget = generate.MAX_DRAWS_PER_OBJECT_AVERAGE * 700 + generate.MAX_DRAWS_PER_OBJECT
+    assert err.draws <= budget + generate.POSITION_BATCH
 
 
 def test_a_box_larger_than_the_world():
-    with pytest.raises(gen.PlacementError, match="larger than the world"):
-        gen.generate(10, 10, EMPTY, EMPTY, [gen.BlockSpec(1, (11, 2))])
+    with pytest.raises(generate.PlacementError, match="larger than the world"):
+        generate.generate(10, 10, EMPTY, EMPTY, [generate.BlockSpec(1, (11, 2))])
 
 
 def test_overlapping_fixed_boxes_are_refused():
     with pytest.raises(ValueError):
-        gen.generate(50, 50, np.array([[0, 0], [5, 5]], float), np.full((2, 2), 10.0), [])
+        generate.generate(50, 50, np.array([[0, 0], [5, 5]], float), np.full((2, 2), 10.0), [])
 
 
 def test_zero_count_block():
-    ((pos, vel),) = gen.generate(10, 10, EMPTY, EMPTY, [gen.BlockSpec(0, (2, 2), speed=1.0)])
+    ((pos, vel),) = generate.generate(
+        10, 10, EMPTY, EMPTY, [generate.BlockSpec(0, (2, 2), speed=1.0)]
+    )
     assert pos.shape == (0, 2) and vel.shape == (0, 2)
 
 
@@ -297,18 +313,22 @@ def test_zero_count_block():
 
 def test_100k_boxes_at_5_percent_coverage_are_fast():
     # 100,000 boxes of 5x5 px = 2.5e6 px^2, 5 % of a 7072 x 7072 world
-    gen.generate(50, 50, EMPTY, EMPTY, [gen.BlockSpec(5, (5, 5))])  # compile outside the timing
+    generate.generate(
+        50, 50, EMPTY, EMPTY, [generate.BlockSpec(5, (5, 5))]
+    )  # compile outside the timing
     start = time.perf_counter()
-    ((pos, _),) = gen.generate(7072, 7072, EMPTY, EMPTY, [gen.BlockSpec(100_000, (5, 5), seed=2)])
+    ((pos, _),) = generate.generate(
+        7072, 7072, EMPTY, EMPTY, [generate.BlockSpec(100_000, (5, 5), seed=2)]
+    )
     elapsed = time.perf_counter() - start
     assert pos.shape == (100_000, 2)
-    assert gen.first_overlap(pos, np.full_like(pos, 5.0)) is None
+    assert generate.first_overlap(pos, np.full_like(pos, 5.0)) is None
     assert elapsed < 2.0, f"100,000 boxes took {elapsed:.2f} s"
 
 
 SCRIPT = """
 import json, numpy as np
-from collide2d.runner.scenario import generate as gen
+from collide2d.runner.scenario import generate
 fixed = np.array([[3.5, 4.0], [20.0, 20.0]]); fsize = np.array([[6.0, 6.0], [9.0, 2.0]])
 blocks = [gen.BlockSpec(40, (3, 2), 5, speed_range=(1.0, 4.0), whole=True),
           gen.BlockSpec(20, (2, 2), 6, speed=2.5)]

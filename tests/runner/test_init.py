@@ -13,8 +13,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from collide2d.runner.command import newproject as init_module
-from collide2d.runner.command import settings as config
+from collide2d.runner.command import newproject, settings
 from collide2d.runner.command.main import main
 from collide2d.runner.golden.store import GoldenStore
 from collide2d.runner.scenario.load import load
@@ -50,7 +49,7 @@ def test_init_makes_a_project_and_prints_the_next_three_commands(tmp_path, capsy
                     "generate", "output", "golden"):  # fmt: skip
         assert f"\n{section}:" in "\n" + text, section
     assert text.count("#") >= 10  # commented
-    assert config.find(root).file == (root / "pyproject.toml").resolve()
+    assert settings.find(root).file == (root / "pyproject.toml").resolve()
     assert (root / ".gitignore").read_text() == "out/\nreport/\n"  # run's and check's folders
     commands = [line.split("#")[0].strip() for line in out.splitlines()[-3:]]
     assert commands == ["collide2d run scenarios/example.yaml", "pytest --update-goldens", "pytest"]
@@ -74,7 +73,7 @@ def test_init_extends_what_is_there_and_overwrites_nothing(tmp_path, capsys):
     assert main(["init", str(tmp_path)]) == 0
     assert (tmp_path / "scenarios" / "example.yaml").read_text() == "version: 1\n"
     assert (tmp_path / "pyproject.toml").read_text().startswith('[project]\nname = "mine"\n\n')
-    assert config.has_table(tmp_path / "pyproject.toml")
+    assert settings.has_table(tmp_path / "pyproject.toml")
     assert (tmp_path / ".gitignore").read_text() == "*.pyc\nout/\nreport/\n"
     before = {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()}
     assert main(["init", str(tmp_path)]) == 0  # again: everything kept
@@ -165,7 +164,7 @@ def _toml(path: Path) -> dict:
     return tomllib.loads(path.read_bytes().decode("utf-8"))
 
 
-TABLE = tomllib.loads(init_module.TABLE_TEXT)["tool"]["collide2d"]
+TABLE = tomllib.loads(newproject.TABLE_TEXT)["tool"]["collide2d"]
 
 
 @pytest.mark.parametrize(
@@ -198,7 +197,7 @@ def test_init_adds_its_table_keeping_what_the_pyproject_says(tmp_path, capsys, t
         assert data.count(b"\n") == data.count(b"\r\n")
     else:
         assert b"\r" not in data
-    assert config.find(tmp_path).file == pyproject.resolve()
+    assert settings.find(tmp_path).file == pyproject.resolve()
 
 
 @pytest.mark.parametrize(

@@ -28,10 +28,10 @@ from hypothesis import strategies as st
 
 from collide2d.engine.invariants import kinetic_energy, momentum
 from collide2d.engine.world import Bodies
-from collide2d.runner import run as run_module
+from collide2d.runner import run
 from collide2d.runner.command.main import main
 from collide2d.runner.run import RunStopped, simulate
-from collide2d.runner.scenario import parse as yamlsafe
+from collide2d.runner.scenario import parse
 from collide2d.runner.scenario.limits import Limits
 from collide2d.runner.scenario.load import (
     MAX_INTEGER,
@@ -122,7 +122,7 @@ def test_a_long_number_is_refused_at_its_place_in_linear_time(form):
 @pytest.mark.parametrize("form", ["decimal", "sexagesimal", "tagged sexagesimal", "exponent form"])
 def test_the_pure_python_parser_refuses_long_numbers_too(monkeypatch, form):
     """Without libyaml the text is scanned in Python, more slowly but still once."""
-    monkeypatch.setattr(yamlsafe, "_LOADER", yaml.SafeLoader)
+    monkeypatch.setattr(parse, "_LOADER", yaml.SafeLoader)
     text = with_mass(LONG[form])
     err, seconds, peak = measured(lambda: loads(text, "n.yaml"))
     assert isinstance(err, ScenarioError) and "characters long" in err.message
@@ -169,8 +169,8 @@ def test_long_text_is_text_and_costs_little():
 
 
 def test_a_number_of_exactly_the_limit_reads():
-    value = "0." + "0" * (yamlsafe.MAX_NUMBER_CHARS - 3) + "5"
-    assert len(value) == yamlsafe.MAX_NUMBER_CHARS
+    value = "0." + "0" * (parse.MAX_NUMBER_CHARS - 3) + "5"
+    assert len(value) == parse.MAX_NUMBER_CHARS
     text = "version: 1\ngolden: {time_tolerance: %s}\n"
     assert loads(text % value).golden.time_tolerance == float(value) > 0
     err = refused(text % (value + "1"))
@@ -315,7 +315,7 @@ def check_summary(summary: dict) -> None:
 
 def test_a_run_whose_model_breaks_the_bounds_stops_instead_of_writing_inf(monkeypatch):
     sc = loads(with_mass("2"))
-    real = run_module.models.make
+    real = run.models.make
 
     class Diverging:
         """The real model, whose velocities turn infinite at the end of the run."""
@@ -332,7 +332,7 @@ def test_a_run_whose_model_breaks_the_bounds_stops_instead_of_writing_inf(monkey
                 v[:] = np.inf
             return v
 
-    monkeypatch.setattr(run_module.models, "make", Diverging)
+    monkeypatch.setattr(run.models, "make", Diverging)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         with pytest.raises(RunStopped, match="not a finite number"):
@@ -552,7 +552,7 @@ values_past_range = st.one_of(
     st.builds(int_text, INTEGERS, st.sampled_from(FORMS)),
     st.floats(allow_nan=True, allow_infinity=True).map(float_text),
     st.sampled_from(SPECIAL),
-    st.integers(yamlsafe.MAX_NUMBER_CHARS - 2, 70_000).map(lambda k: "8" * k),
+    st.integers(parse.MAX_NUMBER_CHARS - 2, 70_000).map(lambda k: "8" * k),
 )
 LIMITS = Limits(max_objects=5_000, max_ticks=10**6, max_frames=10_000)
 

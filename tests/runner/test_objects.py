@@ -269,10 +269,10 @@ def _names_in_each_lane(tmp_path, monkeypatch, written: str) -> dict:
     """{lane: the first object's name, or the refusal's message} for an object named `written`
     in a YAML list (general path), a long list (the fast lane, when the name is a plain word), a
     CSV table and a .npy table; a second object is named "other"."""
-    from collide2d.runner.scenario import fastlane as yamlfast
+    from collide2d.runner.scenario import fastlane
     from collide2d.runner.scenario.load import ScenarioError, load
 
-    monkeypatch.setattr(yamlfast, "FAST_MIN_OBJECTS", 2)
+    monkeypatch.setattr(fastlane, "FAST_MIN_OBJECTS", 2)
     quoted = "'" + written.replace("'", "''") + "'"
     head = "version: 1\nworld: {width: 100, height: 80, fps: 10}\nmodel: stepped\n"
     texts = {
@@ -296,8 +296,8 @@ def _names_in_each_lane(tmp_path, monkeypatch, written: str) -> dict:
     rec["name"] = [written, "other"]
     np.save(tmp_path / "t.npy", rec)
     taken = []
-    real = yamlfast.table
-    monkeypatch.setattr(yamlfast, "table", lambda *a, **k: taken.append(1) or real(*a, **k))
+    real = fastlane.table
+    monkeypatch.setattr(fastlane, "table", lambda *a, **k: taken.append(1) or real(*a, **k))
     out = {}
     for lane, text in texts.items():
         (tmp_path / "s.yaml").write_text(text)

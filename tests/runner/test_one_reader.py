@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from collide2d.runner.scenario import fastlane as yamlfast
+from collide2d.runner.scenario import fastlane
 from collide2d.runner.scenario.load import ScenarioError, load
 
 N = 1000  # objects: as many as the fast lane takes by default
@@ -103,17 +103,17 @@ def lane(monkeypatch):
     """read(form, path): the scenario, or its ScenarioError, with the fast lane on only for the
     "fast lane" form; `taken` counts the lists the lane gave objects for."""
     taken = []
-    real = yamlfast.table
+    real = fastlane.table
 
     def table(*args, **kw):
         result = real(*args, **kw)
         taken.append(result.n)
         return result
 
-    monkeypatch.setattr(yamlfast, "table", table)
+    monkeypatch.setattr(fastlane, "table", table)
 
     def read(form, path):
-        monkeypatch.setattr(yamlfast, "FAST_MIN_OBJECTS", 1000 if form == "fast lane" else 10**9)
+        monkeypatch.setattr(fastlane, "FAST_MIN_OBJECTS", 1000 if form == "fast lane" else 10**9)
         try:
             return load(path)
         except ScenarioError as err:

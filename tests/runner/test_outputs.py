@@ -29,7 +29,7 @@ from collide2d.engine.events import (
     empty_events,
     format_event,
 )
-from collide2d.runner.output import files as outputs
+from collide2d.runner.output import files
 
 PALETTE = np.array(
     [[0, 0, 0], [255, 0, 0], [0, 255, 0], [1, 2, 3], [250, 128, 7]],
@@ -48,7 +48,7 @@ def random_frames(n, h, w, k=None, seed=0) -> np.ndarray:
 
 def write_gif(path, frames, fps, palette=PALETTE, scale=1):
     n, h, w = frames.shape
-    with outputs.GifWriter(path, palette, w, h, fps, n, scale=scale) as gif:
+    with files.GifWriter(path, palette, w, h, fps, n, scale=scale) as gif:
         for f in frames:
             gif.add(f)
     return gif
@@ -64,7 +64,7 @@ def round_half_up(x: Fraction) -> int:
 def test_atomic_path_replaces_on_success(tmp_path):
     target = tmp_path / "out.txt"
     target.write_text("old")
-    with outputs.atomic_path(target) as tmp:
+    with files.atomic_path(target) as tmp:
         assert tmp.parent == tmp_path and tmp != target
         tmp.write_text("new")
         assert target.read_text() == "old"  # nothing visible before the block ends
@@ -75,7 +75,7 @@ def test_atomic_path_replaces_on_success(tmp_path):
 def test_atomic_path_keeps_old_file_on_error(tmp_path):
     target = tmp_path / "out.txt"
     target.write_text("old")
-    with pytest.raises(RuntimeError, match="boom"), outputs.atomic_path(target) as tmp:
+    with pytest.raises(RuntimeError, match="boom"), files.atomic_path(target) as tmp:
         tmp.write_text("half of the new")
         raise RuntimeError("boom")
     assert target.read_text() == "old"
@@ -84,14 +84,14 @@ def test_atomic_path_keeps_old_file_on_error(tmp_path):
 
 def test_atomic_file_gets_ordinary_permissions(tmp_path):
     (tmp_path / "plain").write_text("x")
-    outputs.atomic_write_text(tmp_path / "atomic", "x")
+    files.atomic_write_text(tmp_path / "atomic", "x")
     mode = os.stat(tmp_path / "atomic").st_mode & 0o777
     assert mode == os.stat(tmp_path / "plain").st_mode & 0o777
 
 
 def test_atomic_write_bytes_and_text(tmp_path):
-    outputs.atomic_write_bytes(tmp_path / "b", b"\x00\x01")
-    outputs.atomic_write_text(tmp_path / "t", "é\nz\n")
+    files.atomic_write_bytes(tmp_path / "b", b"\x00\x01")
+    files.atomic_write_text(tmp_path / "t", "é\nz\n")
     assert (tmp_path / "b").read_bytes() == b"\x00\x01"
     assert (tmp_path / "t").read_bytes() == "é\nz\n".encode()
 
@@ -103,7 +103,7 @@ def test_killed_gif_writer_leaves_old_gif_whole(tmp_path):
     script = textwrap.dedent(
         f"""
         import os, signal, numpy as np
-        from collide2d.runner.output import files as outputs
+        from collide2d.runner.output import files
         pal = np.array({PALETTE.tolist()}, np.uint8)
         g = outputs.GifWriter({str(target)!r}, pal, 8, 6, 10, 50)
         for i in range(20):
@@ -116,7 +116,7 @@ def test_killed_gif_writer_leaves_old_gif_whole(tmp_path):
     assert target.read_bytes() == old
     leftovers = [n for n in listing(tmp_path) if n != "animation.gif"]
     assert len(leftovers) == 1 and os.path.getsize(tmp_path / leftovers[0]) > len(old) // 2
-    assert outputs.final_name(leftovers[0]) == "animation.gif"  # clearly a temporary of it
+    assert files.final_name(leftovers[0]) == "animation.gif"  # clearly a temporary of it
 
 
 # ------------------------------------------------------------------ PNG
@@ -139,33 +139,33 @@ def png_chunks(data: bytes) -> list[bytes]:
 @given(st.integers(1, 9), st.integers(1, 9), st.integers(1, 3), st.integers(0, 2**31))
 def test_png_decodes_to_the_same_pixels(h, w, scale, seed):
     rgb = np.random.default_rng(seed).integers(0, 256, size=(h, w, 3)).astype(np.uint8)
-    data = outputs.encode_png(rgb, scale=scale)
+    data = files.encode_png(rgb, scale=scale)
     img = Image.open(io.BytesIO(data))
     assert img.mode == "RGB"
     got = np.asarray(img)
     assert got.shape == (h * scale, w * scale, 3)
     ys, xs = np.mgrid[0 : h * scale, 0 : w * scale]
     assert np.array_equal(got, rgb[ys // scale, xs // scale])
-    assert data == outputs.encode_png(rgb.copy(), scale=scale)
+    assert data == files.encode_png(rgb.copy(), scale=scale)
 
 
 def test_png_has_no_metadata():
     rgb = np.zeros((3, 4, 3), np.uint8)
-    assert png_chunks(outputs.encode_png(rgb)) == [b"IHDR", b"IDAT", b"IEND"]
+    assert png_chunks(files.encode_png(rgb)) == [b"IHDR", b"IDAT", b"IEND"]
 
 
 def test_png_rejects_bad_input():
     with pytest.raises(ValueError):
-        outputs.encode_png(np.zeros((3, 4), np.uint8))
+        files.encode_png(np.zeros((3, 4), np.uint8))
     with pytest.raises(ValueError):
-        outputs.encode_png(np.zeros((3, 4, 3), np.float64))
+        files.encode_png(np.zeros((3, 4, 3), np.float64))
     with pytest.raises(ValueError):
-        outputs.encode_png(np.zeros((3, 4, 3), np.uint8), scale=0)
+        files.encode_png(np.zeros((3, 4, 3), np.uint8), scale=0)
 
 
 def test_write_png(tmp_path):
     rgb = PALETTE[random_frames(1, 5, 7)[0]]
-    outputs.write_png(tmp_path / "f.png", rgb, scale=2)
+    files.write_png(tmp_path / "f.png", rgb, scale=2)
     assert np.array_equal(iio.imread(tmp_path / "f.png")[::2, ::2], rgb)
     assert listing(tmp_path) == ["f.png"]
 
@@ -178,7 +178,7 @@ N_TABLE = (1, 2, 3, 10, 49, 61, 62, 145, 1000, 1_000_003)
 
 def gif_schedule(n_frames: int, fps: int):
     """`outputs.GifSchedule` written out: (kept frames, delays in cs, note)."""
-    sched = outputs.GifSchedule(n_frames, fps)
+    sched = files.GifSchedule(n_frames, fps)
     kept = np.array([sched.kept(j) for j in range(sched.count)], dtype=np.int64)
     delays = np.array([sched.delay_cs(j) for j in range(sched.count)], dtype=np.int64)
     return kept, delays, sched.note
@@ -303,7 +303,7 @@ def test_gif_keeps_exact_colours_of_any_palette(tmp_path, palette):
 def test_gif_streams_to_disk(tmp_path):
     n, h, w = 12, 20, 30
     frames = random_frames(n, h, w, seed=6)
-    gif = outputs.GifWriter(tmp_path / "s.gif", PALETTE, w, h, 10, n)
+    gif = files.GifWriter(tmp_path / "s.gif", PALETTE, w, h, 10, n)
     sizes = []
     for f in frames:
         gif.add(f)
@@ -321,7 +321,7 @@ def test_gif_aborted_midway_leaves_old_gif(tmp_path):
     write_gif(path, random_frames(5, 6, 8, seed=7), 10)
     old = path.read_bytes()
     with pytest.raises(KeyError):
-        with outputs.GifWriter(path, PALETTE, 8, 6, 10, 40) as gif:
+        with files.GifWriter(path, PALETTE, 8, 6, 10, 40) as gif:
             for f in random_frames(10, 6, 8, seed=8):
                 gif.add(f)
             raise KeyError("interrupted")
@@ -332,19 +332,19 @@ def test_gif_aborted_midway_leaves_old_gif(tmp_path):
 def test_gif_refuses_missing_extra_and_bad_frames(tmp_path):
     path = tmp_path / "g.gif"
     path.write_bytes(b"old")
-    gif = outputs.GifWriter(path, PALETTE, 4, 3, 10, 3)
+    gif = files.GifWriter(path, PALETTE, 4, 3, 10, 3)
     gif.add(np.zeros((3, 4), np.uint8))
     with pytest.raises(ValueError, match="announced"):
         gif.close()
     assert path.read_bytes() == b"old" and listing(tmp_path) == ["g.gif"]
 
-    gif = outputs.GifWriter(path, PALETTE, 4, 3, 10, 1)
+    gif = files.GifWriter(path, PALETTE, 4, 3, 10, 1)
     with pytest.raises(ValueError, match="palette"):
         gif.add(np.full((3, 4), len(PALETTE), np.uint8))
     with pytest.raises(ValueError):
         gif.add(np.zeros((4, 3), np.uint8))
     gif.abort()
-    gif = outputs.GifWriter(path, PALETTE, 4, 3, 10, 1)
+    gif = files.GifWriter(path, PALETTE, 4, 3, 10, 1)
     gif.add(np.zeros((3, 4), np.uint8))
     with pytest.raises(ValueError, match="more than"):
         gif.add(np.zeros((3, 4), np.uint8))
@@ -365,7 +365,7 @@ def pair_and_wall_events() -> np.ndarray:
 def test_events_lines_are_the_spec_lines(tmp_path):
     path = tmp_path / "events.jsonl"
     ev = pair_and_wall_events()
-    with outputs.EventsWriter(path) as log:
+    with files.EventsWriter(path) as log:
         log.write(ev[:1])
         log.write(empty_events(0))
         assert not path.exists()
@@ -382,7 +382,7 @@ def test_events_lines_are_the_spec_lines(tmp_path):
 def test_events_writer_abort_keeps_old_log(tmp_path):
     path = tmp_path / "events.jsonl"
     path.write_text("old\n")
-    with pytest.raises(RuntimeError), outputs.EventsWriter(path) as log:
+    with pytest.raises(RuntimeError), files.EventsWriter(path) as log:
         log.write(pair_and_wall_events())
         raise RuntimeError
     assert path.read_text() == "old\n"
@@ -394,12 +394,12 @@ def test_events_writer_never_passes_its_bound(tmp_path):
     path.write_text("old\n")
     ev = pair_and_wall_events()
     whole = sum(len(format_event(r)) + 1 for r in ev)
-    with outputs.EventsWriter(path, max_bytes=whole) as log:
+    with files.EventsWriter(path, max_bytes=whole) as log:
         log.write(ev)
     assert log.bytes == whole == len(path.read_bytes())
     path.write_text("old\n")
-    log = outputs.EventsWriter(path, max_bytes=whole - 1)
-    with pytest.raises(outputs.LogFull) as caught, log:
+    log = files.EventsWriter(path, max_bytes=whole - 1)
+    with pytest.raises(files.LogFull) as caught, log:
         log.write(ev[:1])
         log.write(ev[1:])
     assert (caught.value.tick, caught.value.limit) == (9, whole - 1)  # the wall event's tick
@@ -409,7 +409,7 @@ def test_events_writer_never_passes_its_bound(tmp_path):
 
 
 def test_empty_events_log_is_an_empty_file(tmp_path):
-    with outputs.EventsWriter(tmp_path / "e.jsonl"):
+    with files.EventsWriter(tmp_path / "e.jsonl"):
         pass
     assert (tmp_path / "e.jsonl").read_bytes() == b""
 
@@ -417,18 +417,18 @@ def test_empty_events_log_is_an_empty_file(tmp_path):
 def test_final_csv(tmp_path):
     pos = np.array([[1.0, 2.5], [300.0, -0.125]])
     vel = np.array([[-3.0, 0.1], [0.0, 1e-20]])
-    outputs.write_final_csv(tmp_path / "final.csv", pos, vel)
+    files.write_final_csv(tmp_path / "final.csv", pos, vel)
     assert (tmp_path / "final.csv").read_text() == (
         "id,x,y,vx,vy\n0,1,2.5,-3,0.1\n1,300,-0.125,0,1e-20\n"
     )
     with pytest.raises(ValueError):
-        outputs.final_csv_text(pos, vel[:1])
+        files.final_csv_text(pos, vel[:1])
 
 
 def test_write_json_keeps_key_order(tmp_path):
     path = tmp_path / "summary.json"
     obj = {"name": "demo", "b": [1, 2], "a": {"z": 1.5, "y": None}}
-    outputs.write_json(path, obj)
+    files.write_json(path, obj)
     text = path.read_text()
     assert text == json.dumps(obj, indent=2) + "\n"
     assert text.index('"name"') < text.index('"b"') < text.index('"a"')
@@ -440,6 +440,6 @@ def test_write_json_refuses_nan_and_keeps_old_file(tmp_path):
     path = tmp_path / "summary.json"
     path.write_text("{}\n")
     with pytest.raises(ValueError):
-        outputs.write_json(path, {"energy": float("nan")})
+        files.write_json(path, {"energy": float("nan")})
     assert path.read_text() == "{}\n"
     assert listing(tmp_path) == ["summary.json"]

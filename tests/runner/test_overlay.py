@@ -11,7 +11,7 @@ import pytest
 from PIL import Image
 
 from collide2d.engine import models
-from collide2d.runner.command import main as cli
+from collide2d.runner.command import main
 from collide2d.runner.output.overlay import COLORS, LABEL_MAX_PX, Overlay, Staged, labels
 from collide2d.runner.run import drive, simulate
 from collide2d.runner.scenario.load import ScenarioError, load, loads
@@ -137,14 +137,14 @@ def test_overlay_names_are_checked(tmp_path, capsys):
         "labels",
     )
     with pytest.raises(SystemExit):
-        cli.main(["run", str(ROOT / "scenarios" / "fig2_case1.yaml"), "--overlay", "arrows"])
+        main.main(["run", str(ROOT / "scenarios" / "fig2_case1.yaml"), "--overlay", "arrows"])
     assert "unknown overlay arrows" in capsys.readouterr().err
 
 
 def test_run_overlay_reaches_png_and_gif_but_never_goldens(tmp_path):
     path = ROOT / "scenarios" / "wall_bounces.yaml"
     argv = ["run", str(path), "--out", str(tmp_path), "--png", "--quiet", "--ticks", "20"]
-    assert cli.main([*argv, "--overlay", "velocity"]) == 0
+    assert main.main([*argv, "--overlay", "velocity"]) == 0
     folder = tmp_path / "wall_bounces"
     drawn = np.array(Image.open(folder / "frames" / "frame_000000.png").convert("RGB"))
     with Image.open(folder / "animation.gif") as gif:
@@ -155,6 +155,6 @@ def test_run_overlay_reaches_png_and_gif_but_never_goldens(tmp_path):
     frame = simulate(scn, keep_frames=(0,)).frames[0]
     arrows = (drawn != frame).any(axis=2)
     assert arrows.any() and (drawn[arrows] == COLORS["velocity"]).all()
-    assert cli.main([*argv, "--overlay", "none"]) == 0
+    assert main.main([*argv, "--overlay", "none"]) == 0
     png = np.array(Image.open(folder / "frames" / "frame_000000.png").convert("RGB"))
     assert np.array_equal(png, frame)

@@ -15,7 +15,7 @@ from PIL import Image
 
 from collide2d.engine.picture.pixels import dda_line
 from collide2d.engine.picture.raster import round_positions
-from collide2d.runner.command import main as cli
+from collide2d.runner.command import main
 from collide2d.runner.output.overlay import COLORS, MARK_PX, Overlay
 from collide2d.runner.output.rests import Rests
 from collide2d.runner.run import drive, make_model
@@ -303,7 +303,7 @@ def test_the_schema_and_the_loader_take_rests_and_refuse_a_near_name_at_its_plac
 
 def test_run_overlay_rests_draws_into_the_png_and_refuses_an_unknown_name(tmp_path, capsys):
     argv = ["run", str(LEDGES), "--out", str(tmp_path), "--png", "--quiet", "--ticks", "50"]
-    assert cli.main([*argv, "--no-gif", "--overlay", "rests"]) == 0
+    assert main.main([*argv, "--no-gif", "--overlay", "rests"]) == 0
     folder = tmp_path / "exact_ledges" / "frames"
 
     def green(k):
@@ -312,6 +312,6 @@ def test_run_overlay_rests_draws_into_the_png_and_refuses_an_unknown_name(tmp_pa
     assert green(50)[170, 272:279].all()  # the ball's mark on the lower ledge
     assert not green(0).any()
     with pytest.raises(SystemExit):
-        cli.main([*argv, "--overlay", "rests,rest"])
+        main.main([*argv, "--overlay", "rests,rest"])
     err = capsys.readouterr().err
     assert "unknown overlay rest;" in err and "overlap, rests or none" in err

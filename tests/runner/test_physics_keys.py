@@ -15,7 +15,7 @@ from scenario_text import check_refused, refused
 from collide2d.engine import models
 from collide2d.engine.events import EV_REST, EV_WALL
 from collide2d.runner.run import make_model
-from collide2d.runner.scenario import fastlane as yamlfast
+from collide2d.runner.scenario import fastlane
 from collide2d.runner.scenario.load import load, loads
 
 HEAD = "version: 1\nworld: {width: 200, height: 100, fps: 10, WORLD}\nmodel: MODEL\n"
@@ -113,16 +113,16 @@ def long_list(extra: str, n: int = 30) -> str:
 
 @pytest.mark.parametrize("model", ["stepped", "exact"])
 def test_the_fast_lane_reads_them_as_the_general_path_does(monkeypatch, model):
-    monkeypatch.setattr(yamlfast, "FAST_MIN_OBJECTS", 3)
+    monkeypatch.setattr(fastlane, "FAST_MIN_OBJECTS", 3)
     taken = []
-    real = yamlfast.table
-    monkeypatch.setattr(yamlfast, "table", lambda *a: taken.append(1) or real(*a))
+    real = fastlane.table
+    monkeypatch.setattr(fastlane, "table", lambda *a: taken.append(1) or real(*a))
     e = "0.5" if model == "stepped" else "1"
     text = scene(long_list(f"restitution: {e}, friction: 0") + long_list("velocity: [1, 0]")[:0])
     text = text.replace("gravity: 980", "gravity: 0")
     fast = loads(text.replace("MODEL", model).replace("model: stepped", f"model: {model}"))
     assert taken == [1]  # the lane took the list
-    monkeypatch.setattr(yamlfast, "split", lambda text: None)
+    monkeypatch.setattr(fastlane, "split", lambda text: None)
     general = loads(text.replace("model: stepped", f"model: {model}"))
     for field in ("restitution", "friction", "pos", "size"):
         a, b = getattr(fast.bodies, field), getattr(general.bodies, field)
@@ -131,7 +131,7 @@ def test_the_fast_lane_reads_them_as_the_general_path_does(monkeypatch, model):
 
 
 def test_the_fast_lane_leaves_a_refusal_to_the_general_path(monkeypatch):
-    monkeypatch.setattr(yamlfast, "FAST_MIN_OBJECTS", 3)
+    monkeypatch.setattr(fastlane, "FAST_MIN_OBJECTS", 3)
     text = scene(long_list("restitution: 1") + long_list("friction: 2")[:0]).replace(
         "  - {shape: box, size: 4, position: [12, 0], restitution: 1}",
         "  - {shape: box, size: 4, position: [12, 0], restitution: 1.5}",

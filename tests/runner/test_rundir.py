@@ -20,7 +20,7 @@ import pytest
 from collide2d.runner.command.main import main
 from collide2d.runner.output import files as outputs
 from collide2d.runner.output import folder as rundir
-from collide2d.runner.output import swap as swapdir
+from collide2d.runner.output import swap
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENE = """version: 1
@@ -172,7 +172,7 @@ def test_a_full_disk_at_any_write_keeps_the_old_run_and_names_the_file(first, ca
 def test_a_swap_cut_between_its_renames_is_finished_by_the_next_run(first, monkeypatch):
     short, long, out = first
     before = files(out / "busy")
-    monkeypatch.setattr(swapdir, "exchange", lambda a, b: False)  # no atomic exchange here
+    monkeypatch.setattr(swap, "exchange", lambda a, b: False)  # no atomic exchange here
     renames = [0]
     real_rename = os.rename
 
@@ -200,7 +200,7 @@ def test_the_atomic_exchange_replaces_the_old_run_in_one_step(first, monkeypatch
     monkeypatch.setattr(os, "rename", lambda a, b: renames.append((a, b)))
     stage = rundir.new_stage(out, "busy")
     (stage / "final.csv").write_text("new\n")
-    if not swapdir.exchange(stage, out / "busy"):
+    if not swap.exchange(stage, out / "busy"):
         pytest.skip("this system has no atomic exchange of names")
     assert (out / "busy" / "final.csv").read_text() == "new\n"
     assert (stage / "summary.json").exists()  # the old run, now under the staging name

@@ -15,8 +15,8 @@ import pytest
 
 from collide2d.engine.picture.raster import render, round_positions
 from collide2d.engine.picture.sprites import paint, sprites
-from collide2d.runner.command import main as cli
-from collide2d.runner.output import viewerdata as viewer
+from collide2d.runner.command import main
+from collide2d.runner.output import viewerdata
 from collide2d.runner.run import drive
 from collide2d.runner.scenario.load import ScenarioError, load, loads
 
@@ -56,7 +56,7 @@ def test_sprites_paint_the_frames_the_renderer_draws(name):
 
 def test_viewer_data_is_every_ticks_rounded_state():
     scn = load(ROOT / "scenarios" / "unequal_masses.yaml", overrides={"ticks": 40})
-    rec = viewer.Recorder(scn)
+    rec = viewerdata.Recorder(scn)
     seen_pos, seen_vel = [], []
 
     def both(model):
@@ -93,8 +93,8 @@ def test_a_run_too_long_to_view_is_refused_before_it_starts(tmp_path):
     path.write_text(text)
     argv = ["run", str(path), "--out", str(tmp_path / "out"), "--viewer", "--no-gif", "--quiet"]
     with pytest.raises(ScenarioError, match="past its limit of 20,000,000"):
-        viewer.Recorder(load(path, overrides={"ticks": 1_000_000}))
-    assert cli.main([*argv, "--ticks", "1000000"]) == 2
+        viewerdata.Recorder(load(path, overrides={"ticks": 1_000_000}))
+    assert main.main([*argv, "--ticks", "1000000"]) == 2
     assert not (tmp_path / "out" / "long").exists()
 
 
@@ -106,18 +106,18 @@ def test_output_viewer_in_the_scenario_and_the_flag(tmp_path):
     assert loads(text).output.viewer and not loads(base).output.viewer
     path = tmp_path / "v.yaml"
     path.write_text(text)
-    assert cli.main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    assert main.main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 0
     assert sorted(p.name for p in (tmp_path / "out" / "v").iterdir()) == [
         "final.csv",
         "summary.json",
         "viewer.html",
     ]
     first = (tmp_path / "out" / "v" / "viewer.html").read_bytes()
-    assert cli.main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    assert main.main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 0
     assert (tmp_path / "out" / "v" / "viewer.html").read_bytes() == first  # same bytes
     assert "http" not in first.decode().replace("http-equiv", "")  # nothing from the network
     assert (
-        cli.main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet", "--no-viewer"]) == 0
+        main.main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet", "--no-viewer"]) == 0
     )
     assert not (tmp_path / "out" / "v" / "viewer.html").exists()
 
@@ -134,7 +134,7 @@ def test_no_name_can_end_or_comment_out_the_viewers_data(tmp_path):
     path = tmp_path / "v.yaml"
     path.write_text(f"version: 1\nworld: {{width: 40, height: 20}}\nticks: 3\nobjects:\n{objects}")
     out = tmp_path / "out"
-    assert cli.main(["run", str(path), "--out", str(out), "--quiet", "--viewer", "--no-gif"]) == 0
+    assert main.main(["run", str(path), "--out", str(out), "--quiet", "--viewer", "--no-gif"]) == 0
     page = (out / "v" / "viewer.html").read_text()
     head = '<script id="data" type="application/json">'
     data = page[page.index(head) + len(head) :]
@@ -157,7 +157,7 @@ def test_ten_thousand_frames_of_fifty_objects_stay_small(tmp_path):
         "--no-events",
         "--quiet",
     ]
-    assert cli.main(argv) == 0
+    assert main.main(argv) == 0
     page = tmp_path / "paper_fifty_boxes" / "viewer.html"
     data = _page_data(page.read_text())
     assert data["frames"] == 10_001 and len(data["names"]) == 50
@@ -166,9 +166,9 @@ def test_ten_thousand_frames_of_fifty_objects_stay_small(tmp_path):
 
 def test_paper_viewer_keeps_each_pair_overlap_before_the_undo(tmp_path):
     path = ROOT / "scenarios" / "fig2_case1.yaml"
-    assert cli.main(["run", str(path), "--out", str(tmp_path), "--viewer", "--quiet"]) == 0
+    assert main.main(["run", str(path), "--out", str(tmp_path), "--viewer", "--quiet"]) == 0
     data = _page_data((tmp_path / "fig2_case1" / "viewer.html").read_text())
-    rows = _unpack(data["overlaps"], np.int32).reshape(-1, viewer.OVERLAP_COLUMNS)
+    rows = _unpack(data["overlaps"], np.int32).reshape(-1, viewerdata.OVERLAP_COLUMNS)
     # tick 1: blue (0) moved down to y 101, green (1) up to y 110: 16 x 1 px overlap
     assert rows.tolist() == [[1, 0, 1, 16, 1, 104, 110, 120, 111, 100, 101, 104, 110]]
     assert data["paper"] and data["overlay"] == ["overlap"]
@@ -179,9 +179,9 @@ def test_the_viewer_opens_with_the_overlays_of_the_command_line(tmp_path):
     not only the scenario's; `--overlay none` opens with none, even where the scenario asks."""
     path = ROOT / "scenarios" / "fig2_case1.yaml"  # its scenario asks for overlap
     argv = ["run", str(path), "--out", str(tmp_path), "--viewer", "--no-gif", "--quiet"]
-    assert cli.main([*argv, "--overlay", "contacts,velocity"]) == 0
+    assert main.main([*argv, "--overlay", "contacts,velocity"]) == 0
     data = _page_data((tmp_path / "fig2_case1" / "viewer.html").read_text())
     assert data["overlay"] == ["velocity", "contacts"]
-    assert cli.main([*argv, "--overlay", "none"]) == 0
+    assert main.main([*argv, "--overlay", "none"]) == 0
     data = _page_data((tmp_path / "fig2_case1" / "viewer.html").read_text())
     assert data["overlay"] == []

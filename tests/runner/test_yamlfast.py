@@ -9,8 +9,7 @@ import re
 import numpy as np
 import pytest
 
-from collide2d.runner.scenario import fastlane as yamlfast
-from collide2d.runner.scenario import load as scenario_module
+from collide2d.runner.scenario import fastlane, load
 from collide2d.runner.scenario.limits import Limits
 from collide2d.runner.scenario.load import ScenarioError, loads
 
@@ -65,27 +64,27 @@ def text(items: list[str], model: str = "stepped") -> str:
 @pytest.fixture
 def small_lane(monkeypatch):
     """The lane for lists of 3 objects or more, counting the lists it takes."""
-    monkeypatch.setattr(yamlfast, "FAST_MIN_OBJECTS", 3)
+    monkeypatch.setattr(fastlane, "FAST_MIN_OBJECTS", 3)
     taken = []
-    real = yamlfast.table
+    real = fastlane.table
 
     def table(*args, **kw):
         result = real(*args, **kw)
         taken.append(result.n)
         return result
 
-    monkeypatch.setattr(yamlfast, "table", table)
+    monkeypatch.setattr(fastlane, "table", table)
     return taken
 
 
 def general(source: str, **kw):
     """The same text through the general path alone."""
-    real = yamlfast.split
-    yamlfast.split = lambda text: None
+    real = fastlane.split
+    fastlane.split = lambda text: None
     try:
         return loads(source, **kw)
     finally:
-        yamlfast.split = real
+        fastlane.split = real
 
 
 def same(a, b):
@@ -202,7 +201,7 @@ def test_a_list_inside_a_text_is_not_taken_for_objects(small_lane):
     )
     same(loads(source), general(source))
     assert small_lane == []
-    assert scenario_module.loads(source).bodies.n == 3
+    assert load.loads(source).bodies.n == 3
 
 
 def one_form(kind: int, n: int = 30) -> list[str]:
@@ -214,7 +213,7 @@ def one_form(kind: int, n: int = 30) -> list[str]:
 @pytest.mark.parametrize("kind", [0, 1, 2, 3, 4])
 def test_a_list_of_one_form_gives_the_scenario_of_the_general_path(small_lane, kind):
     items = one_form(kind)
-    assert yamlfast.split(text(items)).same is not None
+    assert fastlane.split(text(items)).same is not None
     source = text(items)
     same(loads(source), general(source))
     assert small_lane == [len(items)]
@@ -274,7 +273,7 @@ def test_a_block_style_list_gives_the_scenario_of_the_general_path(
 @pytest.mark.parametrize("kind", [0, 2, 3])
 def test_a_block_style_list_of_one_form_is_taken_whole(small_lane, kind):
     source = text(block(one_form(kind)))
-    assert yamlfast.split(source).same is not None
+    assert fastlane.split(source).same is not None
     same(loads(source), general(source))
     assert small_lane == [30]
 

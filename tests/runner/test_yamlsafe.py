@@ -8,7 +8,7 @@ import pytest
 import yaml
 from scenario_text import BASE, DATA, at, check_refused, objects, refused
 
-from collide2d.runner.scenario import parse as ys
+from collide2d.runner.scenario import parse
 from collide2d.runner.scenario.limits import Limits
 from collide2d.runner.scenario.load import ScenarioError, load, loads
 
@@ -82,7 +82,7 @@ PARSERS = [yaml.SafeLoader] + ([yaml.CSafeLoader] if hasattr(yaml, "CSafeLoader"
 @pytest.fixture(params=PARSERS, ids=lambda loader: loader.__name__)
 def parser(request, monkeypatch):
     """Each YAML parser PyYAML offers here: pure Python always, libyaml's when it is built in."""
-    monkeypatch.setattr(ys, "_LOADER", request.param)
+    monkeypatch.setattr(parse, "_LOADER", request.param)
     return request.param
 
 
@@ -115,7 +115,7 @@ def test_invalid_yaml_is_reported_in_the_same_words_with_every_parser():
     seen = set()
     for loader in PARSERS:
         with pytest.MonkeyPatch.context() as mp:
-            mp.setattr(ys, "_LOADER", loader)
+            mp.setattr(parse, "_LOADER", loader)
             seen.add(str(refused(text)))
     assert len(seen) == 1, seen
     assert "invalid YAML" in seen.pop()

@@ -6,8 +6,7 @@ in the rows, the headline and bench.md."""
 from __future__ import annotations
 
 from collide2d.engine import kernelstore
-from collide2d.runner.bench import goals, report
-from collide2d.runner.bench import targets as coldstart
+from collide2d.runner.bench import goals, report, targets
 from collide2d.runner.bench.scenes import PROJECT_SCENARIOS
 
 
@@ -16,7 +15,7 @@ def quiet(_text):
 
 
 def test_the_scenes_span_the_bundled_ones_and_the_grid(tmp_path):
-    found = coldstart.scene_files(PROJECT_SCENARIOS, tmp_path, quick=False)
+    found = targets.scene_files(PROJECT_SCENARIOS, tmp_path, quick=False)
     names = [name for name, *_ in found]
     bundled = sorted(p.stem for p in PROJECT_SCENARIOS.glob("*.yaml"))
     assert names[-len(bundled) :] == bundled
@@ -33,9 +32,9 @@ def test_the_scenes_span_the_bundled_ones_and_the_grid(tmp_path):
 
 def test_a_cold_run_of_a_small_scene_is_interpreted(tmp_path):
     path = PROJECT_SCENARIOS / "tunnelling_1fps.yaml"
-    wall, kernels = coldstart.run_cold(path, "auto", tmp_path)
+    wall, kernels = targets.run_cold(path, "auto", tmp_path)
     assert kernels == "interpreted" and wall > 0
-    assert coldstart.run_cold(path, "off", tmp_path, limit=1e-3) == (1e-3, "stopped")
+    assert targets.run_cold(path, "off", tmp_path, limit=1e-3) == (1e-3, "stopped")
 
 
 def test_rows_compare_auto_with_the_faster_lane(monkeypatch, tmp_path):
@@ -45,15 +44,15 @@ def test_rows_compare_auto_with_the_faster_lane(monkeypatch, tmp_path):
         wall, lane = times[mode]
         return (limit, "stopped") if limit is not None and wall > limit else (wall, lane)
 
-    monkeypatch.setattr(coldstart, "run_cold", fake)
-    monkeypatch.setattr(coldstart, "compile_budgets", lambda quick, echo, tmp: [])
-    rows = coldstart.cold_start(True, quiet)
+    monkeypatch.setattr(targets, "run_cold", fake)
+    monkeypatch.setattr(targets, "compile_budgets", lambda quick, echo, tmp: [])
+    rows = targets.cold_start(True, quiet)
     # on stopped once past both others (3.0 + 1 s): it cannot be the faster
     assert rows and all(r["ratio"] == 3.0 / 2.5 and r["met"] for r in rows)
     assert all(r["on_stopped"] and r["on_s"] == 4.0 and not r["off_stopped"] for r in rows)
     times["off"] = (99.0, "interpreted")  # stopped past 3 x auto + 2 s: on is the faster
     times["auto"] = (16.0, "interpreted, then compiled")
-    rows = coldstart.cold_start(True, quiet)
+    rows = targets.cold_start(True, quiet)
     assert all(r["off_stopped"] and r["off_s"] == 50.0 and r["ratio"] == 1.6 for r in rows)
     assert not any(r["on_stopped"] for r in rows)
     assert not any(r["met"] for r in rows)
@@ -75,9 +74,9 @@ def test_each_model_is_held_to_its_compile_budget_or_to_none_where_the_wheel_shi
         ran.append((model, mode))
         return 1.0, {"compile_time_s": compiled[model], "kernels": "compiled"}
 
-    monkeypatch.setattr(coldstart, "_cold", fake)
+    monkeypatch.setattr(targets, "_cold", fake)
     monkeypatch.setattr(kernelstore, "holds_model", lambda model: model in stored)
-    rows = coldstart.compile_budgets(False, quiet, tmp_path)
+    rows = targets.compile_budgets(False, quiet, tmp_path)
     assert ran == [("paper", "on"), ("stepped", "on"), ("exact", "on")]
     got = {r["model"]: (r["value"], r["target"], r["met"]) for r in rows}
     assert got == {
@@ -90,4 +89,4 @@ def test_each_model_is_held_to_its_compile_budget_or_to_none_where_the_wheel_shi
     assert head[stepped] == ("47.0", "<= 8", "✗")
     assert "## Compiling each model's kernels" in report.markdown(rows, "bench", 1.0)
     compiled["exact"] = 0.4  # a kernel the store lacks compiled: the wheel's promise missed
-    assert [r["met"] for r in coldstart.compile_budgets(True, quiet, tmp_path)] == [False]
+    assert [r["met"] for r in targets.compile_budgets(True, quiet, tmp_path)] == [False]

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from collide2d.engine import events as ev
+from collide2d.engine import events
 from collide2d.runner.bench.gravity import closed, pile
 
 
@@ -86,7 +86,7 @@ def test_the_falling_balls_bounce_on_the_floor_and_each_other_and_stay_inside():
     world = WorldSpec(exact.SIDE, exact.SIDE, 60, gravity=(0.0, exact.BALLS_G))
     model = make("exact", world, bodies)
     found = model.advance(240)
-    floor = found[found["type"] == ev.EV_WALL]
-    assert (floor["code"] == ev.SIDE_BOTTOM).sum() > 200  # each ball's first bounces
-    assert (found["type"] == ev.EV_PAIR).sum() > 0
+    floor = found[found["type"] == events.EV_WALL]
+    assert (floor["code"] == events.SIDE_BOTTOM).sum() > 200  # each ball's first bounces
+    assert (found["type"] == events.EV_PAIR).sum() > 0
     assert (model.positions() <= exact.SIDE - exact.SIZE).all() and (model.positions() >= 0).all()

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collide2d.engine import threads
 from collide2d.runner.bench import load, peers, stages
-from collide2d.runner.scenario import fastlane as yamlfast
+from collide2d.runner.scenario import fastlane
 from collide2d.runner.scenario.load import load as load_scenario
 
 
@@ -40,7 +40,7 @@ def test_quick_load_part_loads_the_same_objects_four_ways(tmp_path):
     ]
     assert all(r["n"] == 300 and r["run_time_s"] > 0 and "peak memory" in r["note"] for r in rows)
     paths = load.write_scenes(tmp_path, 1000)
-    assert all(yamlfast.split(paths[k].read_text()) is not None for k in ("yaml", "block"))
+    assert all(fastlane.split(paths[k].read_text()) is not None for k in ("yaml", "block"))
     a, b, c = (load_scenario(paths[k]) for k in ("yaml", "csv", "block"))
     for other in (b, c):
         assert a.bodies.pos.tobytes() == other.bodies.pos.tobytes()

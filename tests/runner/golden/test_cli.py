@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from collide2d.runner.golden import cli
-from collide2d.runner.output import files as outputs
+from collide2d.runner.output import files
 
 from . import synthetic
 
@@ -292,7 +292,7 @@ def test_a_full_disk_during_check_report_is_an_io_error_naming_the_file(tree, ca
         f = real_open(file, mode, *args, **kwargs)
         return FullDisk(f) if "w" in mode and "rep" in Path(file).parts else f
 
-    monkeypatch.setattr(outputs, "open", full_disk_open, raising=False)
+    monkeypatch.setattr(files, "open", full_disk_open, raising=False)
     capsys.readouterr()
     assert _run("check", "--report", "rep") == 2
     out, err = capsys.readouterr()

@@ -18,8 +18,7 @@ import zlib
 
 import pytest
 
-from collide2d.runner.golden import cli
-from collide2d.runner.golden import serialize as ser
+from collide2d.runner.golden import cli, serialize
 
 from . import synthetic
 
@@ -98,7 +97,9 @@ def test_a_golden_folder_linked_elsewhere_is_refused(two, outside, capsys):
     assert golden.is_symlink() and stale.is_symlink()
 
 
-@pytest.mark.parametrize("rel", [ser.frame_file(4), ser.MANIFEST_FILE, ser.EVENTS_FILE])
+@pytest.mark.parametrize(
+    "rel", [serialize.frame_file(4), serialize.MANIFEST_FILE, serialize.EVENTS_FILE]
+)
 def test_a_file_linked_elsewhere_inside_a_golden_is_refused(two, outside, capsys, rel):
     target = two / "goldens" / "demo" / rel
     copy = outside / "copy"
@@ -170,7 +171,7 @@ def test_a_report_link_appearing_during_the_check_is_refused(two, outside, capsy
 
 
 def _manifest(tree, name="demo"):
-    return tree / "goldens" / name / ser.MANIFEST_FILE
+    return tree / "goldens" / name / serialize.MANIFEST_FILE
 
 
 def _edit_manifest(tree, change, name="demo"):
@@ -187,7 +188,7 @@ def _forge(tree, rel, data: bytes, name="demo"):
     def change(m):
         for key in ("events", "final"):
             if m[key]["file"] == rel:
-                m[key]["sha256"] = ser.sha256_bytes(data)
+                m[key]["sha256"] = serialize.sha256_bytes(data)
 
     _edit_manifest(tree, change, name)
 
@@ -230,7 +231,9 @@ def _png(width, height, *, bit_depth=8, color=2, idat=None) -> bytes:
         comp = zlib.compressobj(9)
         idat = b"".join(comp.compress(bytes(row)) for _ in range(height)) + comp.flush()
     ihdr = struct.pack(">IIBBBBB", width, height, bit_depth, color, 0, 0, 0)
-    return ser.PNG_SIGNATURE + chunk(b"IHDR", ihdr) + chunk(b"IDAT", idat) + chunk(b"IEND", b"")
+    return (
+        serialize.PNG_SIGNATURE + chunk(b"IHDR", ihdr) + chunk(b"IDAT", idat) + chunk(b"IEND", b"")
+    )
 
 
 def _set_frame_size(tree, w, h):
@@ -254,45 +257,47 @@ def _in_manifest(text):
 
 
 def _deep_event(tree):
-    _forge(tree, ser.EVENTS_FILE, b'{"tick": ' + b"[" * 50_000 + b"]" * 50_000 + b"}\n")
+    _forge(tree, serialize.EVENTS_FILE, b'{"tick": ' + b"[" * 50_000 + b"]" * 50_000 + b"}\n")
 
 
 def _inf_event(tree):
-    _forge(tree, ser.EVENTS_FILE, b'{"tick": 2, "t": 1e999, "type": "wall", "id": 1}\n')
+    _forge(tree, serialize.EVENTS_FILE, b'{"tick": 2, "t": 1e999, "type": "wall", "id": 1}\n')
 
 
 def _long_int_event(tree):
-    _forge(tree, ser.EVENTS_FILE, b'{"tick": ' + b"9" * 5000 + b', "t": 0.2}\n')
+    _forge(tree, serialize.EVENTS_FILE, b'{"tick": ' + b"9" * 5000 + b', "t": 0.2}\n')
 
 
 def _big_int_event(tree):
-    _forge(tree, ser.EVENTS_FILE, b'{"tick": ' + b"9" * 40 + b', "t": 0.2}\n')
+    _forge(tree, serialize.EVENTS_FILE, b'{"tick": ' + b"9" * 40 + b', "t": 0.2}\n')
 
 
 def _nan_event(tree):
-    _forge(tree, ser.EVENTS_FILE, b'{"tick": 2, "t": NaN}\n')
+    _forge(tree, serialize.EVENTS_FILE, b'{"tick": 2, "t": NaN}\n')
 
 
 def _inf_final(tree):
-    _forge(tree, ser.FINAL_FILE, b"id,x,y,vx,vy\n0,1e999,2,10,0\n1,5.5,3,-10,2.5\n")
+    _forge(tree, serialize.FINAL_FILE, b"id,x,y,vx,vy\n0,1e999,2,10,0\n1,5.5,3,-10,2.5\n")
 
 
 def _long_number_final(tree):
-    _forge(tree, ser.FINAL_FILE, b"id,x,y,vx,vy\n0," + b"9" * 400 + b",2,10,0\n1,5.5,3,-10,2.5\n")
+    _forge(
+        tree, serialize.FINAL_FILE, b"id,x,y,vx,vy\n0," + b"9" * 400 + b",2,10,0\n1,5.5,3,-10,2.5\n"
+    )
 
 
 def _not_a_png(tree):
-    (tree / "goldens" / "demo" / ser.frame_file(4)).write_bytes(b"GIF89a" + bytes(100))
+    (tree / "goldens" / "demo" / serialize.frame_file(4)).write_bytes(b"GIF89a" + bytes(100))
 
 
 def _truncated_png(tree):
-    path = tree / "goldens" / "demo" / ser.frame_file(4)
+    path = tree / "goldens" / "demo" / serialize.frame_file(4)
     path.write_bytes(path.read_bytes()[:40])
 
 
 def _bomb_header(tree):
     # A few hundred bytes whose header claims 100000 x 100000 pixels (30 GB of RGB).
-    (tree / "goldens" / "demo" / ser.frame_file(4)).write_bytes(
+    (tree / "goldens" / "demo" / serialize.frame_file(4)).write_bytes(
         _png(100_000, 100_000, idat=zlib.compress(bytes(1000)))
     )
 
@@ -307,7 +312,7 @@ _BOMB_SIDE = 9000  # 81 M pixels: under Pillow's own bomb limit, 243 MB once dec
 
 def _bomb_valid(tree):
     # A whole, valid 1-bit PNG of 9000 x 9000 pixels in about 10 kB, and a manifest that agrees.
-    (tree / "goldens" / "demo" / ser.frame_file(4)).write_bytes(
+    (tree / "goldens" / "demo" / serialize.frame_file(4)).write_bytes(
         _png(_BOMB_SIDE, _BOMB_SIDE, bit_depth=1, color=0)
     )
     _set_frame_size(tree, _BOMB_SIDE, _BOMB_SIDE)

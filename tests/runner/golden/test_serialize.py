@@ -15,7 +15,7 @@ from hypothesis.extra.numpy import arrays
 from PIL import Image
 
 from collide2d.engine.events import EVENT_DTYPE, event_dict, format_event
-from collide2d.runner.golden import serialize as ser
+from collide2d.runner.golden import serialize
 
 from . import synthetic
 
@@ -30,20 +30,20 @@ def _events():
 
 def test_events_jsonl_is_the_events_log_and_reads_back():
     ev = _events()
-    data = ser.events_jsonl(ev)
+    data = serialize.events_jsonl(ev)
     assert data.decode().splitlines() == [format_event(r) for r in ev]
     assert data.endswith(b"\n")
     assert data.decode().splitlines()[0] == (
         '{"tick": 6, "t": 0.6, "type": "pair", "a": 0, "b": 1, "axis": "x", '
         '"xdiff": 2, "ydiff": 10}'
     )
-    assert ser.parse_events(data) == [event_dict(r) for r in ev] == ser.event_dicts(ev)
-    assert ser.events_jsonl(np.zeros(0, EVENT_DTYPE)) == b""
+    assert serialize.parse_events(data) == [event_dict(r) for r in ev] == serialize.event_dicts(ev)
+    assert serialize.events_jsonl(np.zeros(0, EVENT_DTYPE)) == b""
 
 
 def test_parse_events_names_a_bad_line():
     try:
-        ser.parse_events(b'{"tick": 1}\nnot json\n')
+        serialize.parse_events(b'{"tick": 1}\nnot json\n')
     except ValueError as exc:
         assert "line 2" in str(exc)
     else:
@@ -57,16 +57,16 @@ finite = st.floats(allow_nan=False, allow_infinity=False, width=64)
 @given(st.lists(st.tuples(finite, finite, finite, finite), max_size=6))
 def test_final_csv_reads_back_every_float64_exactly(rows):
     state = np.array(rows, dtype=np.float64).reshape(-1, 4)
-    data = ser.final_csv(state[:, :2], state[:, 2:])
+    data = serialize.final_csv(state[:, :2], state[:, 2:])
     lines = data.decode().splitlines()
     assert lines[0] == "id,x,y,vx,vy" and len(lines) == len(rows) + 1
-    back = ser.parse_final(data)
+    back = serialize.parse_final(data)
     assert back.shape == state.shape
     assert np.array_equal(back, state)  # exact, not approximately
 
 
 def test_final_csv_writes_whole_numbers_as_integers():
-    data = ser.final_csv(np.array([[100.0, 115.0]]), np.array([[-10.0, 0.5]]))
+    data = serialize.final_csv(np.array([[100.0, 115.0]]), np.array([[-10.0, 0.5]]))
     assert data == b"id,x,y,vx,vy\n0,100,115,-10,0.5\n"
 
 
@@ -80,17 +80,23 @@ def _png(rgb, level):
 @given(arrays(np.uint8, st.tuples(st.integers(1, 9), st.integers(1, 9), st.just(3))))
 def test_pixel_hash_is_of_decoded_pixels_not_png_bytes(rgb):
     a, b = _png(rgb, 0), _png(rgb, 9)
-    assert ser.pixel_sha256(ser.decode_png(a)) == ser.pixel_sha256(ser.decode_png(b))
-    assert ser.pixel_sha256(ser.decode_png(ser.png_bytes(rgb))) == ser.pixel_sha256(rgb)
+    assert serialize.pixel_sha256(serialize.decode_png(a)) == serialize.pixel_sha256(
+        serialize.decode_png(b)
+    )
+    assert serialize.pixel_sha256(
+        serialize.decode_png(serialize.png_bytes(rgb))
+    ) == serialize.pixel_sha256(rgb)
 
 
 def test_pixel_hash_covers_width_and_height():
     flat = np.arange(18, dtype=np.uint8)
-    assert ser.pixel_sha256(flat.reshape(2, 3, 3)) != ser.pixel_sha256(flat.reshape(3, 2, 3))
+    assert serialize.pixel_sha256(flat.reshape(2, 3, 3)) != serialize.pixel_sha256(
+        flat.reshape(3, 2, 3)
+    )
     one = np.zeros((2, 3, 3), np.uint8)
     two = one.copy()
     two[1, 2, 2] = 1
-    assert ser.pixel_sha256(one) != ser.pixel_sha256(two)
+    assert serialize.pixel_sha256(one) != serialize.pixel_sha256(two)
 
 
 def _chunks(png: bytes) -> list[str]:
@@ -108,27 +114,33 @@ def _chunks(png: bytes) -> list[str]:
 def test_png_is_deterministic_rgb_without_metadata():
     rgb = np.zeros((6, 8, 3), np.uint8)
     rgb[2, 3] = (255, 0, 0)
-    data = ser.png_bytes(rgb)
-    assert data == ser.png_bytes(rgb.copy())
+    data = serialize.png_bytes(rgb)
+    assert data == serialize.png_bytes(rgb.copy())
     assert set(_chunks(data)) <= {"IHDR", "IDAT", "IEND"}
     with Image.open(io.BytesIO(data)) as im:
         assert im.mode == "RGB" and im.size == (8, 6)
-    assert np.array_equal(ser.decode_png(data), rgb)
+    assert np.array_equal(serialize.decode_png(data), rgb)
 
 
 def test_manifest_has_a_format_version_hashes_and_no_timestamps(tmp_path):
     scn = synthetic.load(synthetic.write(tmp_path / "demo.yaml", synthetic.spec()))
     run = synthetic.simulate(scn, keep_frames=(4, 0))
-    events, final = ser.events_jsonl(run.events), ser.final_csv(run.final_pos, run.final_vel)
-    m = ser.manifest(scn, events, final, run.frames)
-    assert m["format"] == ser.FORMAT_VERSION
+    events, final = (
+        serialize.events_jsonl(run.events),
+        serialize.final_csv(run.final_pos, run.final_vel),
+    )
+    m = serialize.manifest(scn, events, final, run.frames)
+    assert m["format"] == serialize.FORMAT_VERSION
     assert (m["scenario"], m["model"], m["ticks"]) == ("demo", "paper", 4)
     assert m["events"]["count"] == 2 and m["final"]["objects"] == 2
     assert [f["frame"] for f in m["frames"]] == [0, 4]
-    assert m["frames"][1]["pixels_sha256"] == ser.pixel_sha256(run.frames[4])
+    assert m["frames"][1]["pixels_sha256"] == serialize.pixel_sha256(run.frames[4])
     assert m["frames"][1]["file"] == "frames/frame_000004.png"
-    text = ser.manifest_bytes(m).decode()
-    assert ser.manifest_bytes(ser.manifest(scn, events, final, dict(run.frames))) == text.encode()
+    text = serialize.manifest_bytes(m).decode()
+    assert (
+        serialize.manifest_bytes(serialize.manifest(scn, events, final, dict(run.frames)))
+        == text.encode()
+    )
     keys = json.dumps(m).lower()
     for word in ("time", "date", "created", "host", "user"):
         assert word not in keys
@@ -145,7 +157,7 @@ def test_manifest_has_a_format_version_hashes_and_no_timestamps(tmp_path):
     ],
 )
 def test_json_depth_counts_nesting_outside_strings(text, depth):
-    assert ser.json_depth(text) == depth
+    assert serialize.json_depth(text) == depth
 
 
 @pytest.mark.parametrize(
@@ -162,15 +174,15 @@ def test_json_depth_counts_nesting_outside_strings(text, depth):
 )
 def test_load_json_refuses_what_no_golden_holds(text, message):
     with pytest.raises(ValueError, match=message):
-        ser.load_json(text)
+        serialize.load_json(text)
 
 
 def test_load_json_keeps_the_extremes_a_golden_may_hold():
-    obj = ser.load_json(b'{"id": -9223372036854775807, "t": 1.7976931348623157e308}')
+    obj = serialize.load_json(b'{"id": -9223372036854775807, "t": 1.7976931348623157e308}')
     assert obj == {"id": -(2**63) + 1, "t": 1.7976931348623157e308}
 
 
 @pytest.mark.parametrize("rel", ["../x", "/abs", "a/../b", "a//b", "./a", "a\\b", "c:x", "", 3])
 def test_check_rel_refuses_paths_that_leave(rel):
     with pytest.raises(ValueError, match="not a plain relative path"):
-        ser.check_rel(rel)
+        serialize.check_rel(rel)

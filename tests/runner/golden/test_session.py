@@ -6,8 +6,7 @@ import json
 
 import pytest
 
-from collide2d.runner.golden import CREATED, UNCHANGED, UPDATED, bless_run, check_run
-from collide2d.runner.golden import serialize as ser
+from collide2d.runner.golden import CREATED, UNCHANGED, UPDATED, bless_run, check_run, serialize
 from collide2d.runner.golden.store import GoldenStore
 
 from . import synthetic
@@ -118,7 +117,7 @@ def test_a_missing_golden_fails_and_names_the_command(tree):
 
 def test_an_unreadable_golden_fails(tree):
     store = _blessed(tree)
-    (store.folder("demo") / ser.FINAL_FILE).write_text("id,x,y,vx,vy\n")
+    (store.folder("demo") / serialize.FINAL_FILE).write_text("id,x,y,vx,vy\n")
     out = _check(tree, store)
     assert out.status == "unreadable"
     assert "final.csv does not match manifest.json" in out.message()
@@ -178,7 +177,7 @@ def test_reblessing_reproduces_every_byte(tree):
 
 def test_bless_keeps_png_bytes_when_pixels_are_the_same(tree):
     store = _blessed(tree)
-    png = store.folder("demo") / ser.frame_file(4)
+    png = store.folder("demo") / serialize.frame_file(4)
     from PIL import Image
 
     with Image.open(png) as im:
@@ -193,7 +192,7 @@ def test_bless_keeps_png_bytes_when_pixels_are_the_same(tree):
 @pytest.mark.parametrize("garbage", [b"{", b"[]"])
 def test_bless_replaces_an_unreadable_golden(tree, garbage):
     store = _blessed(tree)
-    (store.folder("demo") / ser.MANIFEST_FILE).write_bytes(garbage)
+    (store.folder("demo") / serialize.MANIFEST_FILE).write_bytes(garbage)
     scn, run = _scn(tree)
     out = bless_run(scn, run, store)
     assert out.status == UPDATED and out.summary.startswith("replaced an unreadable golden")

@@ -11,8 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from collide2d.runner.golden import golden_files
-from collide2d.runner.golden import serialize as ser
+from collide2d.runner.golden import golden_files, serialize
 from collide2d.runner.golden import store as st
 from collide2d.runner.golden.store import (
     GoldenMissing,
@@ -45,7 +44,7 @@ def test_write_then_read_gives_the_results_back(tmp_path):
     assert written == sorted(files)
     assert _snapshot(store.folder("demo")) == files
     g = store.read("demo")
-    assert g.events == ser.event_dicts(run.events)
+    assert g.events == serialize.event_dicts(run.events)
     assert np.array_equal(g.final[:, :2], run.final_pos)
     assert np.array_equal(g.final[:, 2:], run.final_vel)
     assert sorted(g.frames) == [0, 4]
@@ -277,7 +276,7 @@ def test_a_golden_torn_between_renames_is_unreadable(tmp_path):
     old, new = _old_and_new(tmp_path)
     store = GoldenStore(tmp_path)
     store.write("demo", old)
-    (store.folder("demo") / ser.EVENTS_FILE).write_bytes(new[ser.EVENTS_FILE])
+    (store.folder("demo") / serialize.EVENTS_FILE).write_bytes(new[serialize.EVENTS_FILE])
     with pytest.raises(GoldenUnreadable, match=r"events\.jsonl does not match manifest\.json"):
         store.read("demo")
 
@@ -286,11 +285,11 @@ def test_png_pixels_are_checked_but_not_png_bytes(tmp_path):
     files, run = _files(tmp_path)
     store = GoldenStore(tmp_path)
     store.write("demo", files)
-    png = store.folder("demo") / ser.frame_file(4)
+    png = store.folder("demo") / serialize.frame_file(4)
     from PIL import Image
 
     Image.fromarray(run.frames[4]).save(png, format="PNG", compress_level=0)
-    assert png.read_bytes() != files[ser.frame_file(4)]
+    assert png.read_bytes() != files[serialize.frame_file(4)]
     store.read("demo")  # the same pixels: still the golden
     edited = run.frames[4].copy()
     edited[0, 0] = (1, 1, 1)
@@ -308,10 +307,10 @@ def test_missing_and_unreadable_goldens(tmp_path):
     with pytest.raises(GoldenMissing, match="has no manifest.json"):
         store.read("demo")
     store.write("demo", files)
-    (store.folder("demo") / ser.frame_file(0)).unlink()
+    (store.folder("demo") / serialize.frame_file(0)).unlink()
     with pytest.raises(GoldenUnreadable, match="frame_000000.png is missing"):
         store.read("demo")
-    manifest = store.folder("demo") / ser.MANIFEST_FILE
+    manifest = store.folder("demo") / serialize.MANIFEST_FILE
     manifest.write_text(manifest.read_text().replace('"format": 1', '"format": 99'))
     with pytest.raises(GoldenUnreadable, match="format 99"):
         store.read("demo")
@@ -325,12 +324,12 @@ def test_stale_frames_and_leftover_temporaries_are_removed(tmp_path):
     store = GoldenStore(tmp_path)
     store.write("demo", files)
     folder = store.folder("demo")
-    leftover = folder / ser.FRAMES_DIR / ".frame_000004.png.999.tmp"
+    leftover = folder / serialize.FRAMES_DIR / ".frame_000004.png.999.tmp"
     leftover.write_bytes(b"half")
     fewer, _ = _files(tmp_path, golden={**synthetic.BASE["golden"], "frames": [4]})
     store.write("demo", fewer)
     assert not leftover.exists()
-    assert not (folder / ser.frame_file(0)).exists()
+    assert not (folder / serialize.frame_file(0)).exists()
     assert sorted(store.read("demo").frames) == [4]
 
 

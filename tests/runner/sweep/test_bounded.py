@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from collide2d.runner.command.main import main
-from collide2d.runner.output import folder as rundir
+from collide2d.runner.output import folder
 from collide2d.runner.scenario.load import Scenario, ScenarioError, loads
 from collide2d.runner.sweep import cluster, driver
 from collide2d.runner.sweep.matrix import parse_set
@@ -93,7 +93,7 @@ def test_a_second_sweep_into_the_same_folder_is_refused_and_the_first_stays(tmp_
     args = ["sweep", FIFTY, "--set", "ticks=1", "--seeds", "1-2", "--workers", "1", "--quiet"]
     assert main([*args, "--out", str(out)]) == 0
     first = (out / "sweep" / "results.csv").read_text()
-    with rundir.RunLock(out, "sweep"):  # a sweep into `out` is running
+    with folder.RunLock(out, "sweep"):  # a sweep into `out` is running
         assert main([*args, "--seeds", "1-3", "--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert f"{out / 'sweep'} is being written by process" in err
