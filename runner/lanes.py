@@ -24,9 +24,11 @@ kernels a run needs are the ones it calls (engine.jit.recording), not every kern
 chunks are short (1, 1, 2, 4, ... ticks) so that a slow scene is measured after a tick or two.
 What no pace sees is estimated up front: the bounces of a huge mass ratio within one tick of the
 exact model (a run whose bounces would take longer interpreted, EVENT_INTERPRETED_S each, than
-compiling the exact model's kernels starts compiled), and the first tick of a big scene whose
-model's kernels the wheel ships (engine.kernelstore): a run whose one tick would take longer
-interpreted (TICK_INTERPRETED_S an object) than starting numba and loading them starts compiled.
+compiling the exact model's kernels starts compiled), and the ticks of a run whose model's
+kernels the wheel ships (engine.kernelstore): a run whose ticks would take longer interpreted, at
+the least (TICK_INTERPRETED_S an object a tick), than starting numba and loading them starts
+compiled (a big scene, whose first tick alone would cost seconds, or a small one run for many
+ticks), as `--jit on` would run it.
 
 Mode `on` compiles every run and `off` interprets every run (slow for big scenes); the command
 line's `--jit MODE` sets it (`set_mode`), else `COLLIDE2D_JIT` in the environment, else `auto`.
@@ -77,8 +79,8 @@ LOAD_INTERPRETED_S = 1.3e-4
 # Seconds an interpreted tick takes per object, at the least (the bench's standard scene of
 # 20,000 boxes: 28 us under stepped, 38 under paper, 42 under exact; the gravity pile, 36), and
 # the seconds to load a model's kernels from the kernels the wheel ships once numba has started:
-# a scene whose first tick would take longer interpreted than numba's start and that load (from
-# about 40,000 objects) starts compiled.
+# a run whose ticks would take longer interpreted than numba's start and that load (40,000
+# objects for a tick, 10 objects for 4,000 ticks) starts compiled.
 TICK_INTERPRETED_S = 2.5e-5
 STORED_LOAD_S = 0.5
 
@@ -135,13 +137,14 @@ def bursts_past_compiling(scenario) -> bool:
 
 
 def big_and_stored(scenario) -> bool:
-    """Whether one interpreted tick of `scenario` would take longer than starting numba and
-    loading its model's kernels from the kernels the wheel ships (engine.kernelstore), which hold
-    them: such a run starts compiled, where a first tick interpreted would cost seconds."""
+    """Whether the interpreted ticks of a run of `scenario` would take longer, at the least, than
+    starting numba and loading its model's kernels from the kernels the wheel ships
+    (engine.kernelstore), which hold them: such a run starts compiled, as `--jit on` runs it,
+    without the look (PROBE_S) and the switch a run in `auto` pays otherwise."""
     if not kernelstore.holds_model(scenario.model):
         return False
-    tick = scenario.bodies.n * TICK_INTERPRETED_S
-    return tick > compilecost.start_seconds() + STORED_LOAD_S
+    ticks = scenario.bodies.n * scenario.ticks * TICK_INTERPRETED_S
+    return ticks > compilecost.start_seconds() + STORED_LOAD_S
 
 
 def _wall_bounces(scenario) -> float:

@@ -171,14 +171,17 @@ def test_a_huge_mass_ratio_starts_compiled_a_small_one_interpreted():
         assert not lanes.bursts_past_compiling(loads(CHAIN.replace("mass: 1e10", f"mass: {ratio}")))
 
 
-def test_a_big_scene_whose_models_kernels_the_wheel_ships_starts_compiled(monkeypatch):
-    """One interpreted tick of the scene would take longer than starting numba and loading the
-    stored kernels: the run starts compiled; a small scene, or a model the store lacks, does not."""
-    monkeypatch.setattr(lanes, "TICK_INTERPRETED_S", 0.01)  # GAS: 3 s a tick; SMALL: 0.02 s
+def test_a_run_whose_models_kernels_the_wheel_ships_starts_compiled_when_it_pays(monkeypatch):
+    """The interpreted ticks of the run would take longer than starting numba and loading the
+    stored kernels: the run starts compiled; a short small run, or a model the store lacks, does
+    not."""
+    monkeypatch.setattr(lanes, "TICK_INTERPRETED_S", 1e-3)  # GAS: 30 s; SMALL: 0.06 s
     monkeypatch.setattr(lanes.kernelstore, "holds_model", lambda model: model == "paper")
     gas, small = loads(GAS), loads(SMALL)
     assert lanes.RunLane(gas, 0).started_compiled and not lanes.RunLane(gas, 0).may_switch
     assert not lanes.RunLane(small, 0).started_compiled
+    long = loads(SMALL.replace("ticks: 30", "ticks: 3000"))  # two objects, 6 s of ticks
+    assert lanes.RunLane(long, 0).started_compiled
     assert not lanes.RunLane(loads(GAS + "model: exact\n"), 0).started_compiled
     monkeypatch.setattr(lanes.kernelstore, "holds_model", lambda model: False)
     assert not lanes.RunLane(gas, 0).started_compiled
