@@ -220,16 +220,19 @@ def compile_budgets(quick: bool, echo, tmp: Path) -> list[dict]:
     return rows
 
 
-def bytecode(tmp: Path) -> None:
-    """Python's bytecode of every module of collide2d written into `tmp`/pycache, as pip writes it
-    on install (`user_env`): a first compiled run then pays no bytecode of the modules only the
-    compiled lane imports (0.4 s)."""
+def bytecode(tmp: Path, small: Path) -> None:
+    """Python's bytecode written into `tmp`/pycache (`user_env`) as an installation has it (pip
+    writes it on install): of every module of collide2d, and of the libraries a run imports in
+    either lane (a run of `small` interpreted, then compiled); a first run, or a first compiled
+    one, would otherwise pay it (0.4 to 0.7 s)."""
     import collide2d
     from collide2d import engine, runner
 
     folders = [str(Path(m.__file__).parent) for m in (collide2d, engine, runner)]
     subprocess.run([sys.executable, "-m", "compileall", "-q", *folders], check=True,
                    stdout=subprocess.DEVNULL, env=user_env(str(tmp / "pycache")))  # fmt: skip
+    for mode in ("off", "on"):
+        run_cold(small, mode, tmp)
 
 
 def cold_start(quick: bool, echo, folder: Path = scenes.PROJECT_SCENARIOS) -> list[dict]:
@@ -237,7 +240,7 @@ def cold_start(quick: bool, echo, folder: Path = scenes.PROJECT_SCENARIOS) -> li
     rows = []
     with tempfile.TemporaryDirectory(prefix="collide2d-jit-") as name:
         tmp = Path(name)
-        bytecode(tmp)
+        bytecode(tmp, folder / f"{scenes.SMALL_SCENARIO}.yaml")
         for scene, path, n, ticks in scene_files(folder, tmp, quick):
             auto, auto_lane = run_cold(path, "auto", tmp)
             off, off_lane = run_cold(path, "off", tmp, limit=OFF_PAST_AUTO * auto + 2.0)
