@@ -199,6 +199,7 @@ def run(
             `scale=0`); the message starts with it, and nothing has run.
     """
     from collide2d.runner import run as runner
+    from collide2d.runner.output.options import RunOptions
 
     given = {"png": png, "gif": gif, "viewer": viewer, "overlay": overlay, "scale": scale}
     given |= {"quiet": quiet, "frames": frames}
@@ -218,7 +219,7 @@ def run(
     arguments.with_out(out, {name: (given[name], checked[name]) for name in given})
     scenario = _scenario(scenario, model, limits)
     if out is not None:
-        options = runner.RunOptions.asked(
+        options = RunOptions.asked(
             scenario, events=events, png=png, gif=gif, viewer=viewer, overlay=overlay,
             scale=scale, quiet=quiet,
         )  # fmt: skip

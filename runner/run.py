@@ -58,6 +58,7 @@ from collide2d.runner.output.folder import (
     new_stage,
     swap_in,
 )
+from collide2d.runner.output.options import RunOptions
 from collide2d.runner.output.overlay import Overlay
 from collide2d.runner.output.progress import Progress
 from collide2d.runner.scenario.frames import FrameRule
@@ -362,36 +363,6 @@ def _simulate(scenario: Scenario, keep_frames: FrameRule, log_events: bool, prog
     )
     events = np.concatenate(chunks) if chunks else empty_events()
     return RunResult(scenario, events, model.positions(), model.velocities(), kept, summary)
-
-
-@dataclass(frozen=True)
-class RunOptions:
-    """What `collide2d run` writes: PNG frames, GIF, events (final.csv and summary always)."""
-
-    png: bool
-    gif: bool
-    events: bool
-    scale: int = 1
-    quiet: bool = False
-    viewer: bool = False  # viewer.html beside the GIF (runner.output.viewerdata)
-    overlay: tuple = ()  # overlays drawn into the PNG and GIF frames (runner.output.overlay)
-
-    @classmethod
-    def asked(
-        cls, scenario: Scenario, *, events, png, gif, viewer, overlay, scale, quiet
-    ) -> RunOptions:
-        """What a run was asked to write (`collide2d run`'s options, `collide2d.run`'s arguments),
-        else, where None, what the scenario's `output` says."""
-        said = scenario.output
-        return cls(
-            png=bool(said.frames) if png is None else png,
-            gif=said.gif if gif is None else gif,
-            events=events,
-            scale=scale,
-            quiet=quiet,
-            viewer=said.viewer if viewer is None else viewer,
-            overlay=said.overlay if overlay is None else tuple(overlay),
-        )
 
 
 def output_dir(out_root: str | os.PathLike, scenario: Scenario) -> Path:

@@ -222,13 +222,15 @@ def compile_budgets(quick: bool, echo, tmp: Path) -> list[dict]:
 
 def bytecode(tmp: Path, small: Path) -> None:
     """Python's bytecode written into `tmp`/pycache (`user_env`) as an installation has it (pip
-    writes it on install): of every module of collide2d, and of the libraries a run imports in
-    either lane (a run of `small` interpreted, then compiled); a first run, or a first compiled
-    one, would otherwise pay it (0.4 to 0.7 s)."""
-    import collide2d
-    from collide2d import engine, runner
+    writes it on install): of every module of the engine and the runner, and of the public API and
+    the libraries a run imports in either lane (a run of `small` interpreted, then compiled); a
+    first run, or a first compiled one, would otherwise pay it (0.4 to 0.7 s)."""
+    import collide2d.engine
 
-    folders = [str(Path(m.__file__).parent) for m in (collide2d, engine, runner)]
+    # the runner's folder holds this module; the `collide2d` package's own modules are written by
+    # the runs below, which import them
+    engine = Path(collide2d.engine.__file__).parent
+    folders = [str(engine), str(Path(__file__).resolve().parents[1])]
     subprocess.run([sys.executable, "-m", "compileall", "-q", *folders], check=True,
                    stdout=subprocess.DEVNULL, env=user_env(str(tmp / "pycache")))  # fmt: skip
     for mode in ("off", "on"):

@@ -170,7 +170,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         limits_from_args,
         overrides_from_args,
     )
-    from collide2d.runner.run import RunInterrupted, RunOptions, write_run
+    from collide2d.runner.output.options import RunOptions
+    from collide2d.runner.run import RunInterrupted, write_run
     from collide2d.runner.scenario.load import load
 
     project = settings.find()

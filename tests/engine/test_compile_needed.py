@@ -161,18 +161,19 @@ from collide2d.engine import broadphase
 
 @njit
 def split_candidates(finder, lo, hi, movable, cell, order, keys, ws, found):
-    return bp.find_split(finder, lo, hi, movable, cell, order, keys, ws, found)
+    return broadphase.find_split(finder, lo, hi, movable, cell, order, keys, ws, found)
 
 
 lo = np.array([[0.0, 0.0], [5.0, 5.0], [50.0, 50.0]])
 hi = lo + 10.0
 movable = np.ones(3, bool)
-assert bp.find_pairs(bp.METHOD_SWEEP, lo, hi, movable).tolist() == [[0, 1]]
+assert broadphase.find_pairs(broadphase.METHOD_SWEEP, lo, hi, movable).tolist() == [[0, 1]]
 keys = np.empty(16, np.int64)
 order = np.arange(3, dtype=np.int64)
-finder = bp.marker(bp.METHOD_SWEEP)
+finder = broadphase.marker(broadphase.METHOD_SWEEP)
 found = np.zeros(2, np.int64)
-assert split_candidates(finder, lo, hi, movable, 1.0, order, keys, bp.workspace(3), found) == 1
+ws = broadphase.workspace(3)
+assert split_candidates(finder, lo, hi, movable, 1.0, order, keys, ws, found) == 1
 names = ("sweep_candidates", "grid_candidates", "cell_candidates", "cell_candidates_split_into")
 print(*(name for name in names if name in compiled))
 """

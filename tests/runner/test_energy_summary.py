@@ -12,7 +12,8 @@ import pytest
 
 from collide2d.engine.invariants import energies, potential_energy
 from collide2d.engine.world import Bodies
-from collide2d.runner.run import RunOptions, run_to_dir, simulate
+from collide2d.runner.output.options import RunOptions
+from collide2d.runner.run import run_to_dir, simulate
 from collide2d.runner.scenario.load import loads
 
 SCENE = """version: 1

@@ -63,7 +63,7 @@ def test_first_overlap_with_mixed_sizes_matches_all_pairs():
 @settings(max_examples=40, deadline=None)
 @given(st.data())
 def test_the_numpy_check_says_apart_only_when_no_two_overlap(data):
-    """gen._apart (numpy alone, before any kernel) may decline, but never misses an overlap."""
+    """generate._apart (numpy alone, before any kernel) may decline, but never misses an overlap."""
     n = data.draw(st.integers(2, 40))
     corner = st.tuples(st.integers(0, 30), st.integers(0, 30))
     side = st.tuples(st.integers(1, 6), st.integers(1, 6))
@@ -330,14 +330,14 @@ SCRIPT = """
 import json, numpy as np
 from collide2d.runner.scenario import generate
 fixed = np.array([[3.5, 4.0], [20.0, 20.0]]); fsize = np.array([[6.0, 6.0], [9.0, 2.0]])
-blocks = [gen.BlockSpec(40, (3, 2), 5, speed_range=(1.0, 4.0), whole=True),
-          gen.BlockSpec(20, (2, 2), 6, speed=2.5)]
-out = gen.generate(64, 48, fixed, fsize, blocks)
+blocks = [generate.BlockSpec(40, (3, 2), 5, speed_range=(1.0, 4.0), whole=True),
+          generate.BlockSpec(20, (2, 2), 6, speed=2.5)]
+out = generate.generate(64, 48, fixed, fsize, blocks)
 pos = np.concatenate([fixed] + [o[0] for o in out]); size = np.concatenate(
     [fsize, np.tile([3.0, 2.0], (40, 1)), np.full((20, 2), 2.0)])
 pos[-1] = pos[5]
 print(json.dumps({"out": [[o[0].tolist(), o[1].tolist()] for o in out],
-                  "overlap": gen.first_overlap(pos, size)}))
+                  "overlap": generate.first_overlap(pos, size)}))
 """
 
 

@@ -105,7 +105,7 @@ def test_killed_gif_writer_leaves_old_gif_whole(tmp_path):
         import os, signal, numpy as np
         from collide2d.runner.output import files
         pal = np.array({PALETTE.tolist()}, np.uint8)
-        g = outputs.GifWriter({str(target)!r}, pal, 8, 6, 10, 50)
+        g = files.GifWriter({str(target)!r}, pal, 8, 6, 10, 50)
         for i in range(20):
             g.add(np.full((6, 8), i % 5, np.uint8))
         os.kill(os.getpid(), signal.SIGKILL)
