@@ -14,8 +14,7 @@ kernels (runner.lanes, `--jit auto`), the kernels it called; else every kernel o
 model's and the shared ones), those the wheel ships left out. Then, while the burst lasts, a bar
 counts the table's seconds of the kernels compiled so far against that estimate, redrawn every
 second while one kernel compiles for long, and erased when the burst ends. A burst a cluster's
-worker begins (a sweep's) is only said: its kernels compile in another process, and the other
-workers load what it compiled.
+worker begins (a sweep's) is only said: its kernels compile in another process.
 """
 
 from __future__ import annotations
