@@ -54,6 +54,9 @@ objects:
 def auto_mode(monkeypatch):
     monkeypatch.delenv("COLLIDE2D_JIT", raising=False)
     monkeypatch.delenv("NUMBA_DISABLE_JIT", raising=False)
+    # the runs here weigh interpreting against compiling as in a checkout without the kernels the
+    # wheel ships, whose runs of these scenes would start compiled (the test of that sets them)
+    monkeypatch.setattr(lanes.kernelstore, "holds_model", lambda model: False)
     lanes.set_mode(None)
     yield
     lanes.set_mode(None)
