@@ -38,11 +38,22 @@ def batch_size(runs: int, threads: int) -> int:
 
 
 def run_sweep(client, plan, *, progress=None, on_row=None, batch=None) -> tuple[Table, bool]:
-    """(the table of the runs done, complete)."""
+    """(the table of the runs done, complete). A Ctrl-C before the first task is sent (asking the
+    cluster its threads, starting the seeds' checks) cancels the sweep as one later does: no run
+    done, `complete` False, the table written as such."""
+    table = Table(plan)
+    try:
+        complete = _run_sweep(client, plan, table, progress, on_row, batch)
+    except KeyboardInterrupt:
+        complete = False
+    table.finish()
+    return table, complete
+
+
+def _run_sweep(client, plan, table, progress, on_row, batch) -> bool:
     threads = sum(client.nthreads().values())
     if batch is None:
         batch = batch_size(len(plan), threads)
-    table = Table(plan)
     sent: dict[int, list] = {}  # task number -> its runs, until its result is taken
     started = time.time()
 
@@ -66,7 +77,7 @@ def run_sweep(client, plan, *, progress=None, on_row=None, batch=None) -> tuple[
                 on_row(run, row)
 
     with SeedChecks(plan) as checks:
-        complete = cluster.run_all(
+        return cluster.run_all(
             client,
             run_batch,
             batches(checks),
@@ -76,5 +87,3 @@ def run_sweep(client, plan, *, progress=None, on_row=None, batch=None) -> tuple[
             size=len,
             window=max(2, WINDOW_PER_THREAD * threads),
         )
-    table.finish()
-    return table, complete

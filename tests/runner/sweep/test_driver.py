@@ -116,6 +116,19 @@ def test_ctrl_c_keeps_the_finished_rows_marked_incomplete(client, checked, tmp_p
     )
 
 
+def test_ctrl_c_before_any_run_is_sent_is_a_cancelled_sweep_of_no_rows(checked, tmp_path):
+    class Busy:  # a cluster asked for its threads when Ctrl-C comes
+        def nthreads(self):
+            raise KeyboardInterrupt
+
+    table, complete = driver.run_sweep(Busy(), checked)
+    assert not complete and table.done == 0
+    (tmp_path / "sweep").mkdir()
+    results.write(tmp_path / "sweep", table, False)
+    status = json.loads((tmp_path / "sweep" / "sweep.json").read_text())
+    assert status == {"runs": 6, "done": 0, "complete": False}
+
+
 def test_a_run_the_model_stops_is_a_row_with_its_message():
     runaway = expand([FIFTY], [parse_set("model=exact"), parse_set("ticks=5")], None)[0]
     figures, pos = run_one(runaway.scenario)
